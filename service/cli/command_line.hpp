@@ -1,0 +1,35 @@
+#pragma once
+// Shared conventions of the `facet` command-line tool's subcommands.
+//
+// - A measuring command takes --json and then prints exactly one JSON object on stdout.
+// - Bad input (unreadable file, bad value) throws InputError: main prints "facet: <message>" on
+//   stderr and exits with 1.
+// - A measurement that ran but found nothing usable throws MeasurementFailure: with --json,
+//   main prints {"error": {"cause": ..., "message": ...}} on stdout; the exit code is 2.
+
+#include <stdexcept>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+namespace facet::cli {
+
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct MeasurementFailure : std::runtime_error {
+  MeasurementFailure(std::string cause, const std::string& message)
+      : std::runtime_error(message), cause(std::move(cause)) {}
+  std::string cause;  // machine-readable, snake_case
+};
+
+// Prints one JSON object on stdout, on one line.
+void printJson(const nlohmann::json& object);
+
+// Every subcommand is added by a function of this shape, one file per subcommand.
+// The subcommand's callback does the work; `json` tells whether --json was given anywhere.
+void addVersionCommand(CLI::App& app);
+
+}  // namespace facet::cli
