@@ -1,0 +1,53 @@
+#pragma once
+// Subpixel edge points from Haralick's cubic facet model.
+//
+// Each pixel's 5x5 neighbourhood is fitted with a bicubic polynomial through fixed convolution
+// kernels; along the gradient direction the second directional derivative's zero crossing gives
+// the subpixel edge position, kept when it lies inside the pixel. Candidate pixels come from
+// Canny with hysteresis (canny.hpp), whose thresholds may be chosen automatically
+// (auto_thresholds.hpp).
+//
+// Coordinates: x right, y down, centre of pixel (0,0) at (0,0).
+
+#include <optional>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace facet {
+
+struct EdgePoint {
+  cv::Point2d position;  // subpixel position, image pixels
+  cv::Point2d normal;    // unit gradient direction (dark -> light), image axes
+  double magnitude = 0;  // gradient magnitude, grey levels per pixel (8-bit scale for 16-bit
+                         // input divided by 256)
+};
+
+struct EdgeParams {
+  // Hysteresis thresholds on the gradient magnitude (grey levels per pixel). When either is
+  // missing, both are chosen automatically from the region's gradient histogram.
+  std::optional<double> low;
+  std::optional<double> high;
+  // Region of interest in image pixels; empty = the whole image.
+  cv::Rect roi;
+  // Optional 8-bit mask of the same size as the image: only non-zero pixels may be edge pixels.
+  cv::Mat mask;
+  // Link points into contours (EdgeContours::contours); off saves time when only points are needed.
+  bool linkContours = false;
+  // Correct the systematic radial bias of second-derivative edges on curved contours
+  // (about -k/r pixels for curvature radius r); uses the local curvature along linked contours.
+  bool correctCurvatureBias = false;
+};
+
+struct EdgeContours {
+  std::vector<EdgePoint> points;
+  // Each contour lists indices into `points`, in order along the edge (filled when linkContours).
+  std::vector<std::vector<int>> contours;
+  double lowThreshold = 0;   // thresholds actually used
+  double highThreshold = 0;
+};
+
+// Subpixel edges of an 8-bit or 16-bit single-channel image.
+EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params = {});
+
+}  // namespace facet
