@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <numbers>
 #include <vector>
@@ -67,6 +68,9 @@ StraightResult measureStraight(double deg, double blur, double noise, std::uint6
       continue;
     const double d = (p.position - p0).dot(n);
     if (std::abs(d) > 3) continue;  // not this edge (cannot happen without clutter)
+    if (std::getenv("BENCH_EDGES_DUMP"))
+      std::printf("dump %.1f %.3f %.3f %+.4f n=(%.4f,%.4f) m=%.1f\n", deg, p.position.x,
+                  p.position.y, d, p.normal.x, p.normal.y, p.magnitude);
     sum += d * d;
     ++r.points;
     along.push_back((p.position - p0).dot(t));
@@ -119,6 +123,15 @@ double medianMs(std::vector<double> v) {
 int main(int argc, char** argv) {
   bool smoke = false;
   for (int i = 1; i < argc; ++i) smoke = smoke || std::strcmp(argv[i], "--smoke") == 0;
+  // Development aid: --angle DEG BLUR NOISE prints every point's error for one straight edge.
+  for (int i = 1; i + 3 < argc; ++i)
+    if (std::strcmp(argv[i], "--angle") == 0) {
+      setenv("BENCH_EDGES_DUMP", "1", 1);
+      const StraightResult r = measureStraight(std::atof(argv[i + 1]), std::atof(argv[i + 2]),
+                                               std::atof(argv[i + 3]), 1, false);
+      std::printf("rms %.4f points %d doubled %d\n", r.rms, r.points, r.doubled);
+      return 0;
+    }
   const int angleStep = smoke ? 15 : 1;
   cv::setNumThreads(1);  // one core for both us and the baseline
 
