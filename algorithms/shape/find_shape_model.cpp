@@ -317,7 +317,7 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius) {
   const double sStep = s.scaleMax > s.scaleMin ? s.level->scaleStep : 0.0;
   Candidate best = c;
   best.score = -1.0;
-  for (int climb = 0; climb < 3; ++climb) {
+  for (int climb = 0; climb < 6; ++climb) {
     Candidate centre = climb == 0 ? c : best;
     bool onBorder = false;
     const int ns = sStep > 0.0 ? 1 : 0;
@@ -429,7 +429,7 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, const 
   double sign = 1.0;               // global polarity, decided on the first pass
   const int unknowns = withScale ? 4 : 3;
   for (int iteration = 0; iteration < 12; ++iteration) {
-    const int radius = iteration < 2 ? 2 : 1;
+    const int radius = iteration < 2 ? 3 - iteration : 1;
     const double c = std::cos(pose.angle), s = std::sin(pose.angle);
     Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
     Eigen::Vector4d g = Eigen::Vector4d::Zero();
@@ -599,8 +599,9 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     if (params.subpixel == SubpixelMode::LeastSquares) {
       const Refined r =
           refineLeastSquares(image, model, box, pose, params.polarity, scaleMax > scaleMin);
-      // A refinement that wanders off by more than a pixel has locked onto something else.
-      if (r.ok && std::hypot(r.pose.x - pose.x, r.pose.y - pose.y) < 2.0) {
+      // A refinement that wanders off by more than the search's own uncertainty has locked onto
+      // something else.
+      if (r.ok && std::hypot(r.pose.x - pose.x, r.pose.y - pose.y) < 3.0) {
         pose = r.pose;
         m.residual = r.residual;
       }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 #include <string>
 
 #include <opencv2/imgproc.hpp>
@@ -128,6 +129,10 @@ LevelResult levelPoints(const cv::Mat& grey, const cv::Mat& mask, cv::Point2d re
          cv::Point2f(gx.at<float>(p) / m, gy.at<float>(p) / m)});
   }
   thin(result.points, maxPoints);
+  // The search abandons a pose after a prefix of the points (greediness); a fixed pseudo-random
+  // order keeps an occluded side of the part from being that whole prefix.
+  std::mt19937 shuffle(12345);
+  std::shuffle(result.points.begin(), result.points.end(), shuffle);
   return result;
 }
 

@@ -2,7 +2,7 @@
 // scenes of the bracket part, beside OpenCV baselines on the same scenes: rotated
 // cv::matchTemplate (NCC, 1-degree steps, parabolic subpixel peak) and cv::GeneralizedHoughGuil.
 //
-//   bench_shape [--smoke] [--scenes N]
+//   bench_shape [--smoke] [--scenes N] [--verbose]   (--verbose lists missed scenes)
 //
 // Prints one table; timings are medians per image, on this machine, in the same run.
 
@@ -248,10 +248,11 @@ void printBaseline(const char* name, const Baseline& b, const Errors& ours) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool smoke = false;
+  bool smoke = false, verbose = false;
   int scenes = 50, baselineScenes = 10;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) smoke = true;
+    if (!std::strcmp(argv[i], "--verbose")) verbose = true;
     if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc) scenes = std::atoi(argv[++i]);
   }
   if (smoke) scenes = 4, baselineScenes = 1;
@@ -281,7 +282,18 @@ int main(int argc, char** argv) {
       const auto matches = findShapeModel(sc.image, m, p);
       e.ms.push_back(msSince(t0));
       ++e.scenes;
-      if (!score(sc.truth.front(), matches, e)) ++e.wrong;
+      if (!score(sc.truth.front(), matches, e)) {
+        ++e.wrong;
+        if (verbose) {
+          const Pose2D& t = sc.truth.front();
+          std::printf("missed: truth %.2f %.2f %.2f deg scale %.3f;", t.x, t.y, degrees(t.angle),
+                      t.scale);
+          for (const auto& m : matches)
+            std::printf(" match %.2f %.2f %.2f deg scale %.3f score %.3f;", m.x, m.y,
+                        degrees(m.angle), m.scale, m.score);
+          std::printf("\n");
+        }
+      }
     };
     vgaScenes.push_back(randomScene({640, 480}, 1000 + i, 1.0, 1.0, 0.0));
     run(vgaScenes.back(), model, find, vga);
