@@ -43,7 +43,7 @@ struct EdgeContours {
   std::vector<EdgePoint> points;
   // Each contour lists indices into `points`, in order along the edge (filled when linkContours).
   std::vector<std::vector<int>> contours;
-  double lowThreshold = 0;   // thresholds actually used
+  double lowThreshold = 0;  // thresholds actually used
   double highThreshold = 0;
 };
 
