@@ -8,6 +8,7 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "algorithms/circle/circle_profile_fit.hpp"
 #include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/geometry/ransac.hpp"
 
@@ -337,6 +338,14 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   m.coverageDeg = coverageDeg(in, circle);
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
+  if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
+    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints)) {
+      m.centre = fine->centre;
+      m.radius = fine->radius;
+      m.blur = fine->blur;
+      m.greyRefined = true;
+    }
+  }
   m.diameter = 2.0 * m.radius;
 
   if (m.inliers < params.minInliers)

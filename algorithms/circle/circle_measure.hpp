@@ -68,13 +68,19 @@ struct CircleMeasureParams {
   CircleRobustWeight robustWeight = CircleRobustWeight::Tukey;
   // Largest acceptable RMS of the inliers' orthogonal residuals, pixels. Default 0.5.
   double maxRms = 0.5;
-  // Correct the radial bias of second-derivative edges on a curved, blurred rim: the fitted radius
-  // is too small by about radiusBiasK / radius pixels. Default on.
+  // Final grey-value refinement (circle_profile_fit.hpp): fits a blurred-disc model to every
+  // pixel of a band around the rim where the inliers lie; reaches the Cramer-Rao bound of small
+  // circles and corrects the curvature bias from the fitted blur. Default on.
+  bool refineWithGreyValues = true;
+  // Without the grey-value refinement (or when it fails): correct the radial bias of
+  // second-derivative edges on a curved, blurred rim, which puts the fitted radius about
+  // radiusBiasK / radius pixels too small. Default on.
   bool correctRadiusBias = true;
-  // Curvature-bias constant k, pixels^2 (bias = -k / r). The default was measured with the Facet
-  // 5x5 operator on discs blurred with a Gaussian PSF of sigma 1 px (bench/circle); it scales
-  // with the blur variance of the optics.
-  double radiusBiasK = 0.5;
+  // Curvature-bias constant k of the edge-point fit, pixels^2 (bias = -k / r). The default was
+  // measured with the Facet 5x5 operator on discs blurred with a Gaussian PSF of sigma 1 px
+  // (bench_circle --no-grey-refinement --no-bias-correction prints it); it grows with the blur
+  // variance of the optics (about (sigma^2 + 1.2) / 2).
+  double radiusBiasK = 1.1;
 };
 
 // Failure causes; CircleMeasurement::failures is a bit set of these.
@@ -97,6 +103,8 @@ struct CircleMeasurement {
   int candidates = 0;         // edge points left after the gradient-direction test
   int inliers = 0;            // inliers of the final fit
   double coverageDeg = 0.0;   // angular extent covered by the inliers, degrees
+  bool greyRefined = false;   // centre and radius come from the grey-value refinement
+  double blur = 0.0;          // blur fitted by the grey-value refinement, pixels (0 without)
   double lowThreshold = 0.0;  // Canny thresholds actually used
   double highThreshold = 0.0;
   std::vector<cv::Point2d> inlierPoints;  // subpixel edge points of the fit, for display

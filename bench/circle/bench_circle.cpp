@@ -89,24 +89,30 @@ Trial makeTrial(double radius, Case kind, bool hole, int subrows, std::mt19937_6
 }
 
 struct Errors {
-  double sumC2 = 0, sumR2 = 0;
+  double sumC2 = 0, sumR2 = 0, sumKr = 0;
   int measured = 0, failed = 0;
   void add(cv::Point2d c, double r, const Trial& t) {
     sumC2 += std::pow(c.x - t.centre.x, 2) + std::pow(c.y - t.centre.y, 2);
     sumR2 += std::pow(r - t.radius, 2);
+    sumKr += (t.radius - r) * t.radius;  // curvature-bias constant k if the error were -k/r
     ++measured;
   }
   double centreRms() const { return measured ? std::sqrt(sumC2 / measured) : NAN; }
   double radiusRms() const { return measured ? std::sqrt(sumR2 / measured) : NAN; }
+  double biasK() const { return measured ? sumKr / measured : NAN; }
 };
 
 constexpr double kWidth = 5.0;
+bool gCorrectBias = true;
+bool gGreyRefinement = true;
 
 facet::CircleMeasureParams paramsFor(const Trial& t) {
   facet::CircleMeasureParams p;
   p.centre = t.coarse;
   p.radius = t.nominal;
   p.width = kWidth;
+  p.correctRadiusBias = gCorrectBias;
+  p.refineWithGreyValues = gGreyRefinement;
   p.polarity = t.hole ? facet::CirclePolarity::DarkToLight : facet::CirclePolarity::LightToDark;
   return p;
 }
@@ -152,6 +158,10 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke"))
       smoke = true;
+    else if (!std::strcmp(argv[i], "--no-bias-correction"))
+      gCorrectBias = false;
+    else if (!std::strcmp(argv[i], "--no-grey-refinement"))
+      gGreyRefinement = false;
     else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc)
       scenes = std::atoi(argv[++i]);
   }
@@ -165,9 +175,9 @@ int main(int argc, char** argv) {
       scenes, smoke ? " [smoke]" : "");
   std::printf(
       "errors are RMS in px over measured scenes; fail = no result; ratio = hough / ours\n\n");
-  std::printf("%-12s %5s | %9s %9s %4s | %9s %9s %4s | %9s %9s %4s | %7s %7s | %s\n", "case", "r",
-              "ours c", "ours r", "fail", "HG c", "HG r", "miss", "ALT c", "ALT r", "miss", "HG/c",
-              "ALT/c", "target");
+  std::printf("%-12s %5s | %9s %9s %4s | %9s %9s %4s | %9s %9s %4s | %7s %7s | %-16s | %s\n",
+              "case", "r", "ours c", "ours r", "fail", "HG c", "HG r", "miss", "ALT c", "ALT r",
+              "miss", "HG/c", "ALT/c", "target", "k");
   bool allMet = true;
   for (Case kind : {Case::Clean, Case::Hard, Case::LowContrast}) {
     for (double radius : radii) {
@@ -195,12 +205,12 @@ int main(int argc, char** argv) {
       const bool met = ours.failed == 0 && ours.centreRms() <= bound && ours.radiusRms() <= bound;
       allMet = allMet && met;
       std::printf(
-          "%-12s %5.0f | %9.4f %9.4f %4d | %9.4f %9.4f %4d | %9.4f %9.4f %4d | %7.1f %7.1f | %s "
-          "(<= %.2f)\n",
+          "%-12s %5.0f | %9.4f %9.4f %4d | %9.4f %9.4f %4d | %9.4f %9.4f %4d | %7.1f %7.1f | %6s "
+          "(<= %.2f) | %.3f\n",
           caseName(kind), radius, ours.centreRms(), ours.radiusRms(), ours.failed, hg.centreRms(),
           hg.radiusRms(), hg.failed, alt.centreRms(), alt.radiusRms(), alt.failed,
           hg.centreRms() / ours.centreRms(), alt.centreRms() / ours.centreRms(),
-          met ? "met" : "MISSED", bound);
+          met ? "met" : "MISSED", bound, ours.biasK());
     }
   }
 
