@@ -1,0 +1,19 @@
+#include "camera/camera_factory.hpp"
+
+#include "camera/replay_camera.hpp"
+
+namespace facet {
+
+std::unique_ptr<Camera> makeCamera(const CameraSettings& settings) {
+  switch (settings.backend) {
+    case CameraBackend::Replay:
+      return std::make_unique<ReplayCamera>(settings.replay);
+    case CameraBackend::Aravis:
+    case CameraBackend::V4l2:
+      break;
+  }
+  throw CameraError("camera backend \"" + std::string(toString(settings.backend)) +
+                    "\" is not available in this build");
+}
+
+}  // namespace facet
