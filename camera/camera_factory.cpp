@@ -1,5 +1,6 @@
 #include "camera/camera_factory.hpp"
 
+#include "camera/aravis_camera.hpp"
 #include "camera/replay_camera.hpp"
 
 namespace facet {
@@ -9,6 +10,7 @@ std::unique_ptr<Camera> makeCamera(const CameraSettings& settings) {
     case CameraBackend::Replay:
       return std::make_unique<ReplayCamera>(settings.replay);
     case CameraBackend::Aravis:
+      return std::make_unique<AravisCamera>(settings.aravis);
     case CameraBackend::V4l2:
       break;
   }
