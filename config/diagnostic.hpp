@@ -27,6 +27,9 @@ struct Diagnostic {
   std::string message;
 };
 
+// `file:line:column` (or `file:line`, or `file`, as far as known).
+std::string format(const SourceLocation& where);
+
 // `file:line:column: message` (or `file: message` when the line is unknown).
 std::string format(const Diagnostic& diagnostic);
 
