@@ -33,5 +33,6 @@ void printJson(const nlohmann::json& object);
 void addVersionCommand(CLI::App& app);
 void addCircleCommand(CLI::App& app);
 void addScanMatchCommand(CLI::App& app);
+void addResultsCommand(CLI::App& app);
 
 }  // namespace facet::cli

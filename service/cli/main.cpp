@@ -19,6 +19,7 @@ int main(int argc, char** argv) {
   addVersionCommand(app);
   addCircleCommand(app);
   addScanMatchCommand(app);
+  addResultsCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
