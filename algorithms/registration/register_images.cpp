@@ -330,10 +330,11 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
   result.H = stage.H;
   result.inliers = stage.inliers;
 
+  const std::size_t globalInliers = result.inliers.size();
   if (params.refineIterations > 0) {
-    TransformFitParams fp;
-    fp.model = params.model;
-    fp.inlierThreshold = params.inlierThreshold;
+    TransformFitParams tight;
+    tight.model = params.model;
+    tight.inlierThreshold = params.finalThreshold;
     const std::vector<HarrisCorner> dense =
         detectHarrisGrid(ref, params.refineCell, params.corners);
     for (int it = 0; it < params.refineIterations; ++it) {
@@ -343,12 +344,27 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
         s2.push_back(m.ref);
         d2.push_back(m.image);
       }
-      const auto refit = fitTransformRobust(s2, d2, fp);
-      if (!refit || refit->inliers.size() < result.inliers.size()) break;
+      // The re-matched pairs are subpixel: the consensus is sought at the tight threshold so that
+      // a cluster of slightly wrong pairs cannot bias H; inliers are then counted as usual.
+      const auto refit = fitTransformRobust(s2, d2, tight);
+      if (!refit) break;
+      std::vector<int> inliers;
+      for (std::size_t i = 0; i < s2.size(); ++i)
+        if (transferError(refit->H, s2[i], d2[i]) <= params.inlierThreshold)
+          inliers.push_back(static_cast<int>(i));
+      if (inliers.size() < result.inliers.size()) break;
       result.H = refit->H;
       result.matches = std::move(rm);
-      result.inliers = refit->inliers;
+      result.inliers = std::move(inliers);
     }
+    // A transform resting on very few global matches must be confirmed by the re-matching.
+    if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
+        static_cast<int>(result.inliers.size()) < params.confirmInliers)
+      return failure(result, "too_few_inliers",
+                     std::to_string(globalInliers) +
+                         " global inliers, not confirmed by re-matching (" +
+                         std::to_string(result.inliers.size()) + " inliers, " +
+                         std::to_string(params.confirmInliers) + " needed)");
   }
   result.ok = true;
   return result;

@@ -28,7 +28,11 @@ struct RegistrationParams {
   LogPolarParams window;         // log-polar window sampled around each point
   NccMatchParams matching;       // minimum NCC, shift ranges and the three accelerations
   double inlierThreshold = 3.0;  // pixels; RANSAC reprojection threshold in the image
-  int minInliers = 8;            // fewer inliers than this -> failure "too_few_inliers"
+  int minInliers = 5;            // fewer global inliers than this -> failure "too_few_inliers"
+  // A global fit with fewer than `confirmBelowInliers` inliers is accepted only when the
+  // re-matching (refineIterations > 0) then finds at least `confirmInliers` inliers.
+  int confirmBelowInliers = 10;
+  int confirmInliers = 20;
   // Per-match rotation/scale estimates prune matches that disagree with the dominant rotation
   // (degrees) and log2-scale before RANSAC. <= 0 disables the pruning.
   double pruneRotationDeg = 40.0;
@@ -47,6 +51,7 @@ struct RegistrationParams {
   int refineCell = 10;          // pixels of the reference
   int refineSearchRadius = 8;   // pixels, in the image
   int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
+  double finalThreshold = 1.0;  // pixels; RANSAC threshold of the fit to the re-matched pairs
   double refineMinScore = 0.8;  // minimum NCC of a re-matched patch
 };
 
