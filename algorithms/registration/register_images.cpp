@@ -34,22 +34,31 @@ bool isBlank(const cv::Mat& grey) {
 }
 
 struct Features {
+  std::vector<HarrisCorner> corners;  // detected, in spreading order
+  int described = 0;                  // corners [0, described) have been turned into windows
   std::vector<AffineRegion> regions;  // only those with a valid window
   std::vector<LogPolarWindow> windows;
   std::vector<int> ranks;  // the corner's position in spreading order
 };
 
-Features describe(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
-                  const RegistrationParams& params, int budget) {
+Features detect(const cv::Mat& grey, const RegistrationParams& params, int budget) {
   HarrisParams hp = params.corners;
   hp.maxCorners = budget;
-  const std::vector<HarrisCorner> corners = detectHarrisCorners(grey, hp);
   Features f;
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    AffineRegion r{corners[i].pt, cv::Matx22d(corners[i].scale, 0, 0, corners[i].scale),
-                   corners[i].response};
+  f.corners = detectHarrisCorners(grey, hp);
+  return f;
+}
+
+// Regions (adapted when asked) and windows of the corners up to rank `count`; lazily, so that
+// the corners kept for escalation cost nothing unless it happens.
+void describeUpTo(Features& f, const std::vector<cv::Mat>& pyramid,
+                  const RegistrationParams& params, int count) {
+  const int end = std::min(count, static_cast<int>(f.corners.size()));
+  for (int i = f.described; i < end; ++i) {
+    const HarrisCorner& c = f.corners[i];
+    AffineRegion r{c.pt, cv::Matx22d(c.scale, 0, 0, c.scale), c.response};
     if (params.affineRegions) {
-      const std::vector<AffineRegion> adapted = adaptAffineRegions(pyramid, {corners[i]});
+      const std::vector<AffineRegion> adapted = adaptAffineRegions(pyramid, {c});
       if (adapted.empty()) continue;
       r = adapted.front();
     }
@@ -57,9 +66,9 @@ Features describe(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
     if (!w.valid) continue;
     f.regions.push_back(r);
     f.windows.push_back(std::move(w));
-    f.ranks.push_back(static_cast<int>(i));
+    f.ranks.push_back(i);
   }
-  return f;
+  f.described = std::max(f.described, end);
 }
 
 double rotationDegOf(const cv::Matx22d& L) {
@@ -136,7 +145,7 @@ double parabolaPeak(float a, float b, float c) {
 // corner's predicted position, with the image; the NCC peak (subpixel) gives the match.
 std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
                                   const std::vector<HarrisCorner>& corners, const cv::Matx33d& H,
-                                  const RegistrationParams& params) {
+                                  int R, const RegistrationParams& params) {
   const cv::Point2d centre((refGrey.cols - 1) / 2.0, (refGrey.rows - 1) / 2.0);
   const double s = std::sqrt(std::abs(cv::determinant(jacobianAt(H, centre))));
   // Match resolutions: blur whichever image is seen at the finer scale.
@@ -152,7 +161,7 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
   cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
   cv::Mat ones(refGrey.size(), CV_8U, cv::Scalar(255));
   cv::warpPerspective(ones, valid, H, imgGrey.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
-  const int r = params.refinePatchRadius, R = params.refineSearchRadius;
+  const int r = params.refinePatchRadius;
   const cv::Rect bounds(0, 0, imgGrey.cols, imgGrey.rows);
   std::vector<FeatureMatch> out;
   cv::Mat result;
@@ -310,17 +319,21 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
   // Detected once with the larger budget: the corners come in spreading order, so the first
   // maxCorners of them are what a smaller budget would have kept.
   const int budget = std::max(params.corners.maxCorners, params.escalateCorners);
-  const Features fr = describe(ref, refPyramid, params, budget);
-  const Features fi = describe(img, imgPyramid, params, budget);
+  Features fr = detect(ref, params, budget);
+  Features fi = detect(img, params, budget);
+  describeUpTo(fr, refPyramid, params, params.corners.maxCorners);
+  describeUpTo(fi, imgPyramid, params, params.corners.maxCorners);
 
   GlobalStage stage =
       matchGlobally(fr, fi, params.corners.maxCorners, params.matching.minScore, params);
   if (params.escalateCorners > params.corners.maxCorners &&
       static_cast<int>(stage.inliers.size()) < params.escalateBelowInliers) {
+    describeUpTo(fr, refPyramid, params, params.escalateCorners);
+    describeUpTo(fi, imgPyramid, params, params.escalateCorners);
     GlobalStage wider =
         matchGlobally(fr, fi, params.escalateCorners, params.escalateMinScore, params);
     if (wider.inliers.size() > stage.inliers.size() ||
-        (stage.failureCause.empty() == false && wider.failureCause.empty()))
+        (!stage.failureCause.empty() && wider.failureCause.empty()))
       stage = std::move(wider);
   }
   result.refCorners = stage.refCorners;
@@ -338,7 +351,10 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
     const std::vector<HarrisCorner> dense =
         detectHarrisGrid(ref, params.refineCell, params.corners);
     for (int it = 0; it < params.refineIterations; ++it) {
-      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, params);
+      // Once H rests on the dense pairs, the prediction is within a pixel or two.
+      const int radius =
+          it == 0 ? params.refineSearchRadius : std::min(params.refineSearchRadius, 3);
+      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, radius, params);
       std::vector<cv::Point2d> s2, d2;
       for (const auto& m : rm) {
         s2.push_back(m.ref);

@@ -43,13 +43,13 @@ struct RegistrationParams {
   // disables it.
   int escalateCorners = 800;
   double escalateMinScore = 0.7;
-  int escalateBelowInliers = 15;
+  int escalateBelowInliers = 12;
   // Iterative refinement: warp the reference with the current H, re-match Harris points spread
   // on a grid (the strongest per `refineCell` x `refineCell` block) around their predicted
   // positions (NCC of square patches within `refineSearchRadius` pixels), refit. 0 disables it.
   int refineIterations = 2;
   int refineCell = 10;          // pixels of the reference
-  int refineSearchRadius = 8;   // pixels, in the image
+  int refineSearchRadius = 8;   // pixels, in the image (3 after the first iteration)
   int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
   double finalThreshold = 1.0;  // pixels; RANSAC threshold of the fit to the re-matched pairs
   double refineMinScore = 0.8;  // minimum NCC of a re-matched patch

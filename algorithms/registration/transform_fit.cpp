@@ -207,9 +207,10 @@ std::optional<TransformFit> fitTransformWithLocalMaps(const std::vector<cv::Poin
       const cv::Point2d d = src[i] - src[k];
       const cv::Point2d q(dst[k].x + L(0, 0) * d.x + L(0, 1) * d.y,
                           dst[k].y + L(1, 0) * d.x + L(1, 1) * d.y);
-      const double tolerance = 2.0 * params.inlierThreshold + 0.1 * std::hypot(d.x, d.y);
-      if (std::hypot(q.x - dst[i].x, q.y - dst[i].y) <= tolerance)
-        support.push_back(static_cast<int>(i));
+      const double tolerance =
+          2.0 * params.inlierThreshold + 0.1 * std::sqrt(d.x * d.x + d.y * d.y);
+      const double ex = q.x - dst[i].x, ey = q.y - dst[i].y;
+      if (ex * ex + ey * ey <= tolerance * tolerance) support.push_back(static_cast<int>(i));
     }
     if (support.size() >= minimal + 1) seeds.push_back({k, std::move(support)});
   }

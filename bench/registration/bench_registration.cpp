@@ -167,8 +167,16 @@ void syntheticTable(const std::string& dir, int count) {
     // image pixel q shows img1 at origin + truth^-1 q
     const cv::Matx33d shift(1, 0, -origin.x, 0, 1, -origin.y, 0, 0, 1);
     const cv::Matx33d full = truth * shift;
+    // A camera integrates over its pixels: when the view shrinks, low-pass first (no aliasing).
+    cv::Mat source;
+    if (s < 1) {
+      const double sigma = 0.5 * std::sqrt(1.0 / (s * s) - 1.0);
+      cv::GaussianBlur(img1, source, cv::Size(), sigma, sigma);
+    } else {
+      source = img1;
+    }
     cv::Mat image;
-    cv::warpAffine(img1, image,
+    cv::warpAffine(source, image,
                    cv::Mat(cv::Matx23d(full(0, 0), full(0, 1), full(0, 2), full(1, 0), full(1, 1),
                                        full(1, 2))),
                    cv::Size(320, 320), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
