@@ -41,7 +41,7 @@ struct RegistrationParams {
   // fewer than `escalateBelowInliers` inliers, it is repeated with `escalateCorners` corners per
   // image and the minimum NCC lowered to `escalateMinScore`. escalateCorners <= maxCorners
   // disables it.
-  int escalateCorners = 800;
+  int escalateCorners = 650;
   double escalateMinScore = 0.7;
   int escalateBelowInliers = 12;
   // Iterative refinement: warp the reference with the current H, re-match Harris points spread
