@@ -17,13 +17,22 @@ cv::Mat toGrey(const cv::Mat& image) {
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   else if (image.channels() == 4)
     cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
-  double scale = 1.0;
-  if (grey.depth() == CV_8U)
+  double scale = 1.0, offset = 0.0;
+  if (grey.depth() == CV_8U) {
     scale = 1.0 / 255.0;
-  else if (grey.depth() == CV_16U)
+  } else if (grey.depth() == CV_16U) {
     scale = 1.0 / 65535.0;
+  } else {
+    // Other depths (float, signed): brought to [0, 1] by their own range when outside it.
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(grey, &lo, &hi);
+    if ((hi > 1.0 || lo < 0.0) && hi > lo) {
+      scale = 1.0 / (hi - lo);
+      offset = -lo * scale;
+    }
+  }
   cv::Mat out;
-  grey.convertTo(out, CV_32F, scale);
+  grey.convertTo(out, CV_32F, scale, offset);
   return out;
 }
 
