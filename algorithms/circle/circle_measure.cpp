@@ -65,11 +65,14 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
   double lambda = 1e-6;
   auto cost = [&](const Circle& k) {
     double s = 0;
-    for (std::size_t i = 0; i < pts.size(); ++i) s += w[i] * std::pow(residual(k, pts[i]), 2);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double r = residual(k, pts[i]);
+      s += w[i] * r * r;
+    }
     return s;
   };
   double current = cost(c);
-  for (int it = 0; it < 30; ++it) {
+  for (int it = 0; it < 20; ++it) {
     Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
     Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -91,7 +94,7 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
       const double nextCost = cost(next);
       if (nextCost <= current) {
         improved = true;
-        const bool converged = step.norm() < 1e-9;
+        const bool converged = step.norm() < 1e-6;  // pixels: far below the accuracy sought
         c = next;
         current = nextCost;
         lambda = std::max(lambda * 0.1, 1e-12);
@@ -306,7 +309,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
       if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
     if (static_cast<int>(in.size()) < params.minInliers) break;
     w.assign(in.size(), 1.0);
-    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 4;
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 3;
     for (int k = 0; k < irls; ++k) {
       if (k > 0) {
         std::vector<double> a;

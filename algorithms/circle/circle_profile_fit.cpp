@@ -24,6 +24,18 @@ struct Model {
   int nodes = 0;
 };
 
+// Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): Abramowitz & Stegun
+// 7.1.26 for erfc (absolute error below 1.5e-7), which reuses the exponential the Jacobian needs.
+double upperTail(double z, double gauss) {
+  const double x = std::abs(z) / std::numbers::sqrt2;
+  const double t = 1.0 / (1.0 + 0.3275911 * x);
+  const double poly =
+      t *
+      (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
+  const double tail = 0.5 * poly * gauss;  // 0.5 erfc(x) with exp(-x^2) = gauss
+  return z >= 0.0 ? tail : 1.0 - tail;
+}
+
 double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -47,12 +59,19 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   };
   std::vector<std::uint8_t> covered(bins, 0);
   for (const auto& q : rimPoints) covered[binOf(q.x - centre.x, q.y - centre.y)] = 1;
-
-  // Sector nodes for a and b: about one per 25 px of arc, at least 4.
-  const int nodes = std::clamp(static_cast<int>(2.0 * kPi * radius / 25.0), 4, 32);
-
-  // The band |rho - R| <= 3 px inside the image.
+  // Large circles have far more pixels than the accuracy needs: keep an evenly spread share of
+  // the bins so that about kMaxPixels pixels take part (bounds the time of big circles).
   constexpr double kBand = 3.0;
+  constexpr double kMaxPixels = 2500.0;
+  const double share = std::min(1.0, kMaxPixels / (2.0 * kPi * radius * 2.0 * kBand));
+  if (share < 1.0)
+    for (int i = 0; i < bins; ++i)
+      if (std::floor((i + 1) * share) == std::floor(i * share)) covered[i] = 0;
+
+  // Sector nodes for a and b: about one per 40 px of arc, 4 to 16 (illumination varies smoothly).
+  const int nodes = std::clamp(static_cast<int>(2.0 * kPi * radius / 40.0), 4, 16);
+
+  // The band |rho - R| <= kBand inside the image.
   std::vector<Sample> samples;
   const double rOut = radius + kBand, rIn = std::max(0.0, radius - kBand);
   const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - rOut)));
@@ -61,16 +80,26 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const int y1 = std::min(image.rows - 1, static_cast<int>(std::ceil(centre.y + rOut)));
   for (int y = y0; y <= y1; ++y) {
     const double dy = y - centre.y;
-    for (int x = x0; x <= x1; ++x) {
+    if (dy * dy > rOut * rOut) continue;
+    // The row meets the band in up to two runs: |dx| in [inner, outer].
+    const double outer = std::sqrt(rOut * rOut - dy * dy);
+    const double inner = dy * dy < rIn * rIn ? std::sqrt(rIn * rIn - dy * dy) : 0.0;
+    const int xa = std::max(x0, static_cast<int>(std::ceil(centre.x - outer)));
+    const int xb = std::min(x1, static_cast<int>(std::floor(centre.x + outer)));
+    for (int x = xa; x <= xb; ++x) {
       const double dx = x - centre.x;
-      const double r2 = dx * dx + dy * dy;
-      if (r2 < rIn * rIn || r2 > rOut * rOut || !covered[binOf(dx, dy)]) continue;
+      if (std::abs(dx) < inner) {
+        x = static_cast<int>(std::ceil(centre.x + inner)) - 1;  // jump over the inner disc
+        continue;
+      }
+      const double turn = (std::atan2(dy, dx) + kPi) / (2.0 * kPi);  // 0..1
+      if (!covered[std::min(bins - 1, static_cast<int>(turn * bins))]) continue;
       const double grey = image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
                                                   : image.at<std::uint8_t>(y, x);
-      const double t = (std::atan2(dy, dx) + kPi) / (2.0 * kPi) * nodes;  // 0..nodes
-      const int k0 = static_cast<int>(std::floor(t)) % nodes;
-      samples.push_back({static_cast<double>(x), static_cast<double>(y), grey, k0, (k0 + 1) % nodes,
-                         t - std::floor(t)});
+      const double t = turn * nodes;
+      const int k0 = std::min(static_cast<int>(t), nodes - 1);
+      samples.push_back(
+          {static_cast<double>(x), static_cast<double>(y), grey, k0, (k0 + 1) % nodes, t - k0});
     }
   }
   if (samples.size() < 30) return std::nullopt;
@@ -78,7 +107,9 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // Start: outside and inside levels from the band's two halves, blur 1.2 px.
   std::vector<double> inside, outside;
   for (const Sample& s : samples) {
-    const double d = std::hypot(s.x - centre.x, s.y - centre.y) - radius;
+    const double d =
+        std::sqrt((s.x - centre.x) * (s.x - centre.x) + (s.y - centre.y) * (s.y - centre.y)) -
+        radius;
     if (d < -2.0) inside.push_back(s.grey);
     if (d > 2.0) outside.push_back(s.grey);
   }
@@ -110,8 +141,9 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       const double a = w0 * q(4 + 2 * e.k0) + e.w1 * q(4 + 2 * e.k1);
       const double b = w0 * q(5 + 2 * e.k0) + e.w1 * q(5 + 2 * e.k1);
       const double z = d * inv;
-      const double phi = 0.5 * std::erfc(z / std::numbers::sqrt2);  // Phi(-d / s)
-      const double bg = b * norm * std::exp(-0.5 * z * z);          // b * pdf(d; s)
+      const double gauss = std::exp(-0.5 * z * z);
+      const double phi = upperTail(z, gauss);  // Phi(-d / s)
+      const double bg = b * norm * gauss;      // b * pdf(d; s)
       res[i] = e.grey - (a + b * phi);
       // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
       double* row = &j[8 * i];
@@ -132,20 +164,62 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   };
   Eigen::MatrixXd jtj(n, n);
   Eigen::VectorXd jtr(n);
+  // Normal equations by blocks: geometry (4x4), geometry x node (4x2 per node), node (2x2) and
+  // neighbouring nodes (2x2), since a pixel touches only two adjacent nodes.
+  struct NodeBlocks {
+    double cross[4][2] = {};  // geometry x (a, b) of this node
+    double self[2][2] = {};   // (a, b) x (a, b)
+    double next[2][2] = {};   // (a, b) of this node x (a, b) of the next node
+    double rhs[2] = {};
+  };
+  std::vector<NodeBlocks> blocks(nodes);
   auto normalEquations = [&] {
-    jtj.setZero();
-    jtr.setZero();
-    double* h = jtj.data();
+    double geo[4][4] = {}, geoRhs[4] = {};
+    std::fill(blocks.begin(), blocks.end(), NodeBlocks{});
     for (std::size_t i = 0; i < m; ++i) {
       const double w = weight[i];
       if (w == 0.0) continue;
       const Sample& e = samples[i];
-      const int cols[8] = {0, 1, 2, 3, 4 + 2 * e.k0, 4 + 2 * e.k1, 5 + 2 * e.k0, 5 + 2 * e.k1};
       const double* row = &jac[8 * i];
-      for (int u = 0; u < 8; ++u) {
+      const double wr = w * r[i];
+      const double v0[2] = {row[4], row[6]}, v1[2] = {row[5], row[7]};  // (a, b) at k0 and k1
+      NodeBlocks& b0 = blocks[e.k0];
+      NodeBlocks& b1 = blocks[e.k1];
+      for (int u = 0; u < 4; ++u) {
         const double wu = w * row[u];
-        jtr(cols[u]) += wu * r[i];
-        for (int v = 0; v < 8; ++v) h[cols[u] * n + cols[v]] += wu * row[v];
+        geoRhs[u] += wu * r[i];
+        for (int v = u; v < 4; ++v) geo[u][v] += wu * row[v];
+        for (int v = 0; v < 2; ++v) {
+          b0.cross[u][v] += wu * v0[v];
+          b1.cross[u][v] += wu * v1[v];
+        }
+      }
+      for (int u = 0; u < 2; ++u) {
+        b0.rhs[u] += wr * v0[u];
+        b1.rhs[u] += wr * v1[u];
+        for (int v = 0; v < 2; ++v) {
+          b0.self[u][v] += w * v0[u] * v0[v];
+          b1.self[u][v] += w * v1[u] * v1[v];
+          b0.next[u][v] += w * v0[u] * v1[v];  // k1 is the node after k0 (cyclic)
+        }
+      }
+    }
+    jtj.setZero();
+    for (int u = 0; u < 4; ++u) {
+      jtr(u) = geoRhs[u];
+      for (int v = u; v < 4; ++v) jtj(u, v) = jtj(v, u) = geo[u][v];
+    }
+    for (int k = 0; k < nodes; ++k) {
+      const NodeBlocks& b = blocks[k];
+      const int c = 4 + 2 * k, cn = 4 + 2 * ((k + 1) % nodes);
+      for (int v = 0; v < 2; ++v) {
+        jtr(c + v) = b.rhs[v];
+        for (int u = 0; u < 4; ++u) jtj(u, c + v) = jtj(c + v, u) = b.cross[u][v];
+        for (int u = 0; u < 2; ++u) {
+          jtj(c + u, c + v) += b.self[u][v];
+          jtj(c + u, cn + v) += b.next[u][v];
+          jtj(cn + v, c + u) += b.next[u][v];
+        }
       }
     }
   };
@@ -167,7 +241,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   double lambda = 1e-4;
   for (int it = 0; it < 10; ++it) {
     // Robust weights once the grey levels have settled (after the first, linear-ish step).
-    if (it == 1 || it == 3) {
+    if (it == 1) {
       sigma = tukeyWeights();
       current = cost(r);
     }
@@ -196,7 +270,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       lambda *= 10;
     }
     if (!accepted) break;
-    if (it >= 3 && step.head<4>().norm() < 1e-4) break;
+    if (it >= 2 && step.head<4>().norm() < 1e-3) break;
   }
 
   const double blur = p(3);

@@ -9,10 +9,10 @@
 //
 // Usage: bench_circle [--smoke] [--scenes N]
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <numbers>
 #include <random>
 #include <string>
@@ -25,7 +25,13 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
+// Thread CPU time: "one core" is what the target means, and the machine is shared, so wall time
+// would measure the other processes too.
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec * 1e-6;
+}
 
 enum class Case { Clean, Hard, LowContrast };
 const char* caseName(Case c) {
@@ -220,23 +226,23 @@ int main(int argc, char** argv) {
   const int reps = smoke ? 20 : 200;
   std::vector<double> ours, hgT, altT;
   for (int i = 0; i < reps; ++i) {
-    auto t0 = Clock::now();
+    const double t0 = cpuMs();
     const auto m = facet::measureCircle(t.image, paramsFor(t));
-    auto t1 = Clock::now();
+    const double t1 = cpuMs();
     cv::Point2d c;
     double r;
     hough(t, cv::HOUGH_GRADIENT, &c, &r);
-    auto t2 = Clock::now();
+    const double t2 = cpuMs();
     hough(t, cv::HOUGH_GRADIENT_ALT, &c, &r);
-    auto t3 = Clock::now();
+    const double t3 = cpuMs();
     if (!m.ok()) std::printf("timing scene failed: %s\n", m.message.c_str());
-    ours.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
-    hgT.push_back(std::chrono::duration<double, std::milli>(t2 - t1).count());
-    altT.push_back(std::chrono::duration<double, std::milli>(t3 - t2).count());
+    ours.push_back(t1 - t0);
+    hgT.push_back(t2 - t1);
+    altT.push_back(t3 - t2);
   }
   const double ms = medianMs(ours);
   std::printf(
-      "\ntime per circle r=100 (%dx%d image, median of %d, one core): ours %.3f ms | "
+      "\ntime per circle r=100 (%dx%d image, median of %d, thread CPU time): ours %.3f ms | "
       "HOUGH_GRADIENT %.3f ms | HOUGH_GRADIENT_ALT %.3f ms | target <= 1 ms: %s\n",
       t.image.cols, t.image.rows, reps, ms, medianMs(hgT), medianMs(altT),
       ms <= 1.0 ? "met" : "MISSED");
