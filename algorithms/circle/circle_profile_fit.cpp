@@ -1,6 +1,7 @@
 #include "algorithms/circle/circle_profile_fit.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -11,18 +12,13 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// One pixel of the band: position and grey value, with its fixed angular interpolation.
+// One pixel of the band, relative to the starting centre.
 struct Sample {
   double x, y, grey;
-  int k0, k1;  // sector nodes either side of the pixel's angle
-  double w1;   // weight of k1 (k0 gets 1 - w1)
 };
 
-// Parameters: 0 cx, 1 cy, 2 R, 3 s, then a_k (4 + 2k) and b_k (5 + 2k) per sector node.
-struct Model {
-  Eigen::VectorXd p;
-  int nodes = 0;
-};
+using Vector8 = Eigen::Matrix<double, 8, 1>;
+using Matrix8 = Eigen::Matrix<double, 8, 8>;
 
 // Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): Abramowitz & Stegun
 // 7.1.26 for erfc (absolute error below 1.5e-7), which reuses the exponential the Jacobian needs.
@@ -59,6 +55,20 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   };
   std::vector<std::uint8_t> covered(bins, 0);
   for (const auto& q : rimPoints) covered[binOf(q.x - centre.x, q.y - centre.y)] = 1;
+  // Close gaps of up to 2 bins (edge points missed in noise), then drop 2 bins at each end of
+  // every covered run: next to an occluder or a clutter blob the band mixes in foreign edges.
+  {
+    std::vector<std::uint8_t> closed = covered;
+    for (int i = 0; i < bins; ++i)
+      if (!covered[i] && ((covered[(i + bins - 1) % bins] || covered[(i + bins - 2) % bins]) &&
+                          (covered[(i + 1) % bins] || covered[(i + 2) % bins])))
+        closed[i] = 1;
+    for (int i = 0; i < bins; ++i) {
+      bool inside = true;
+      for (int k = -2; k <= 2 && inside; ++k) inside = closed[(i + k + bins) % bins] != 0;
+      covered[i] = inside ? 1 : 0;
+    }
+  }
   // Large circles have far more pixels than the accuracy needs: keep an evenly spread share of
   // the bins so that about kMaxPixels pixels take part (bounds the time of big circles).
   constexpr double kBand = 3.0;
@@ -67,9 +77,6 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   if (share < 1.0)
     for (int i = 0; i < bins; ++i)
       if (std::floor((i + 1) * share) == std::floor(i * share)) covered[i] = 0;
-
-  // Sector nodes for a and b: about one per 40 px of arc, 4 to 16 (illumination varies smoothly).
-  const int nodes = std::clamp(static_cast<int>(2.0 * kPi * radius / 40.0), 4, 16);
 
   // The band |rho - R| <= kBand inside the image.
   std::vector<Sample> samples;
@@ -92,69 +99,43 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
         x = static_cast<int>(std::ceil(centre.x + inner)) - 1;  // jump over the inner disc
         continue;
       }
-      const double turn = (std::atan2(dy, dx) + kPi) / (2.0 * kPi);  // 0..1
-      if (!covered[std::min(bins - 1, static_cast<int>(turn * bins))]) continue;
+      if (!covered[binOf(dx, dy)]) continue;
       const double grey = image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
                                                   : image.at<std::uint8_t>(y, x);
-      const double t = turn * nodes;
-      const int k0 = std::min(static_cast<int>(t), nodes - 1);
-      samples.push_back(
-          {static_cast<double>(x), static_cast<double>(y), grey, k0, (k0 + 1) % nodes, t - k0});
+      samples.push_back({dx, dy, grey});
     }
   }
   if (samples.size() < 30) return std::nullopt;
 
-  // Start: outside and inside levels from the band's two halves, blur 1.2 px.
+  // Start: outside and inside levels from the band's two halves, blur 1.2 px, no ramp.
   std::vector<double> inside, outside;
-  for (const Sample& s : samples) {
-    const double d =
-        std::sqrt((s.x - centre.x) * (s.x - centre.x) + (s.y - centre.y) * (s.y - centre.y)) -
-        radius;
-    if (d < -2.0) inside.push_back(s.grey);
-    if (d > 2.0) outside.push_back(s.grey);
+  for (const Sample& e : samples) {
+    const double d = std::sqrt(e.x * e.x + e.y * e.y) - radius;
+    if (d < -2.0) inside.push_back(e.grey);
+    if (d > 2.0) outside.push_back(e.grey);
   }
   if (inside.empty() || outside.empty()) return std::nullopt;
-  const double a0 = medianOf(outside), b0 = medianOf(inside) - a0;
-  const int n = 4 + 2 * nodes;
-  Eigen::VectorXd p(n);
-  p(0) = centre.x;
-  p(1) = centre.y;
-  p(2) = radius;
-  p(3) = 1.2;
-  for (int k = 0; k < nodes; ++k) {
-    p(4 + 2 * k) = a0;
-    p(5 + 2 * k) = b0;
-  }
+  Vector8 p;
+  p << 0.0, 0.0, radius, 1.2, medianOf(outside), 0.0, 0.0, 0.0;
+  p(7) = medianOf(inside) - p(4);
 
-  // One pass over the band at parameters q: residuals (grey - model) and Jacobian rows (8
-  // non-zero entries per pixel: cx, cy, R, s, and a, b at the two sector nodes).
+  // One pass over the band at parameters q: residuals (grey - model) and Jacobian rows.
   const std::size_t m = samples.size();
-  std::vector<double> r(m), rTry(m), jac(8 * m), jacTry(8 * m), weight(m, 1.0);
-  auto evaluate = [&](const Eigen::VectorXd& q, std::vector<double>& res, std::vector<double>& j) {
+  std::vector<double> r(m), rTry(m), weight(m, 1.0);
+  std::vector<Vector8> jac(m), jacTry(m);
+  auto evaluate = [&](const Vector8& q, std::vector<double>& res, std::vector<Vector8>& j) {
     const double s = q(3), inv = 1.0 / s, norm = 1.0 / (std::sqrt(2.0 * kPi) * s);
     for (std::size_t i = 0; i < m; ++i) {
       const Sample& e = samples[i];
       const double ex = e.x - q(0), ey = e.y - q(1);
       const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
-      const double d = rho - q(2);
-      const double w0 = 1.0 - e.w1;
-      const double a = w0 * q(4 + 2 * e.k0) + e.w1 * q(4 + 2 * e.k1);
-      const double b = w0 * q(5 + 2 * e.k0) + e.w1 * q(5 + 2 * e.k1);
-      const double z = d * inv;
+      const double z = (rho - q(2)) * inv;
       const double gauss = std::exp(-0.5 * z * z);
       const double phi = upperTail(z, gauss);  // Phi(-d / s)
-      const double bg = b * norm * gauss;      // b * pdf(d; s)
-      res[i] = e.grey - (a + b * phi);
+      const double bg = q(7) * norm * gauss;   // b * pdf(d; s)
+      res[i] = e.grey - (q(4) + q(5) * e.x + q(6) * e.y + q(7) * phi);
       // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
-      double* row = &j[8 * i];
-      row[0] = bg * ex / rho;
-      row[1] = bg * ey / rho;
-      row[2] = bg;
-      row[3] = bg * z;
-      row[4] = w0;
-      row[5] = e.w1;
-      row[6] = w0 * phi;
-      row[7] = e.w1 * phi;
+      j[i] << bg * ex / rho, bg * ey / rho, bg, bg * z, 1.0, e.x, e.y, phi;
     }
   };
   auto cost = [&](const std::vector<double>& res) {
@@ -162,66 +143,17 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     for (std::size_t i = 0; i < m; ++i) c += weight[i] * res[i] * res[i];
     return c;
   };
-  Eigen::MatrixXd jtj(n, n);
-  Eigen::VectorXd jtr(n);
-  // Normal equations by blocks: geometry (4x4), geometry x node (4x2 per node), node (2x2) and
-  // neighbouring nodes (2x2), since a pixel touches only two adjacent nodes.
-  struct NodeBlocks {
-    double cross[4][2] = {};  // geometry x (a, b) of this node
-    double self[2][2] = {};   // (a, b) x (a, b)
-    double next[2][2] = {};   // (a, b) of this node x (a, b) of the next node
-    double rhs[2] = {};
-  };
-  std::vector<NodeBlocks> blocks(nodes);
+  Matrix8 jtj;
+  Vector8 jtr;
   auto normalEquations = [&] {
-    double geo[4][4] = {}, geoRhs[4] = {};
-    std::fill(blocks.begin(), blocks.end(), NodeBlocks{});
-    for (std::size_t i = 0; i < m; ++i) {
-      const double w = weight[i];
-      if (w == 0.0) continue;
-      const Sample& e = samples[i];
-      const double* row = &jac[8 * i];
-      const double wr = w * r[i];
-      const double v0[2] = {row[4], row[6]}, v1[2] = {row[5], row[7]};  // (a, b) at k0 and k1
-      NodeBlocks& b0 = blocks[e.k0];
-      NodeBlocks& b1 = blocks[e.k1];
-      for (int u = 0; u < 4; ++u) {
-        const double wu = w * row[u];
-        geoRhs[u] += wu * r[i];
-        for (int v = u; v < 4; ++v) geo[u][v] += wu * row[v];
-        for (int v = 0; v < 2; ++v) {
-          b0.cross[u][v] += wu * v0[v];
-          b1.cross[u][v] += wu * v1[v];
-        }
-      }
-      for (int u = 0; u < 2; ++u) {
-        b0.rhs[u] += wr * v0[u];
-        b1.rhs[u] += wr * v1[u];
-        for (int v = 0; v < 2; ++v) {
-          b0.self[u][v] += w * v0[u] * v0[v];
-          b1.self[u][v] += w * v1[u] * v1[v];
-          b0.next[u][v] += w * v0[u] * v1[v];  // k1 is the node after k0 (cyclic)
-        }
-      }
-    }
     jtj.setZero();
-    for (int u = 0; u < 4; ++u) {
-      jtr(u) = geoRhs[u];
-      for (int v = u; v < 4; ++v) jtj(u, v) = jtj(v, u) = geo[u][v];
+    jtr.setZero();
+    for (std::size_t i = 0; i < m; ++i) {
+      if (weight[i] == 0.0) continue;
+      jtj.selfadjointView<Eigen::Lower>().rankUpdate(jac[i], weight[i]);
+      jtr += (weight[i] * r[i]) * jac[i];
     }
-    for (int k = 0; k < nodes; ++k) {
-      const NodeBlocks& b = blocks[k];
-      const int c = 4 + 2 * k, cn = 4 + 2 * ((k + 1) % nodes);
-      for (int v = 0; v < 2; ++v) {
-        jtr(c + v) = b.rhs[v];
-        for (int u = 0; u < 4; ++u) jtj(u, c + v) = jtj(c + v, u) = b.cross[u][v];
-        for (int u = 0; u < 2; ++u) {
-          jtj(c + u, c + v) += b.self[u][v];
-          jtj(c + u, cn + v) += b.next[u][v];
-          jtj(cn + v, c + u) += b.next[u][v];
-        }
-      }
-    }
+    jtj.triangularView<Eigen::StrictlyUpper>() = jtj.transpose();
   };
   auto tukeyWeights = [&] {
     std::vector<double> absR(m);
@@ -235,46 +167,70 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     return sigma;
   };
 
-  evaluate(p, r, jac);
-  double current = cost(r);
+  // Levenberg-Marquardt over the parameters marked free (a fixed one keeps its value).
   double sigma = 0.0;
-  double lambda = 1e-4;
-  for (int it = 0; it < 10; ++it) {
-    // Robust weights once the grey levels have settled (after the first, linear-ish step).
-    if (it == 1) {
-      sigma = tukeyWeights();
-      current = cost(r);
-    }
-    normalEquations();
-    bool accepted = false;
-    Eigen::VectorXd step;
-    for (int tries = 0; tries < 6 && !accepted; ++tries) {
-      Eigen::MatrixXd a = jtj;
-      a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-9);
-      step = a.ldlt().solve(jtr);
-      if (!step.allFinite()) return std::nullopt;
-      const Eigen::VectorXd next = p + step;
-      if (next(3) > 0.05) {
-        evaluate(next, rTry, jacTry);
-        const double c = cost(rTry);
-        if (c <= current) {
-          accepted = true;
-          p = next;
-          current = c;
-          std::swap(r, rTry);
-          std::swap(jac, jacTry);
-          lambda = std::max(lambda * 0.3, 1e-9);
-          break;
-        }
+  auto solve = [&](const std::array<bool, 8>& free, int maxIterations, bool reweight) {
+    evaluate(p, r, jac);
+    double current = cost(r);
+    double lambda = 1e-4;
+    for (int it = 0; it < maxIterations; ++it) {
+      // Robust weights once the grey levels have settled (after the first, nearly linear step).
+      if (reweight && it == 1) {
+        sigma = tukeyWeights();
+        current = cost(r);
       }
-      lambda *= 10;
+      normalEquations();
+      for (int k = 0; k < 8; ++k)
+        if (!free[k]) {
+          jtj.row(k).setZero();
+          jtj.col(k).setZero();
+          jtj(k, k) = 1.0;
+          jtr(k) = 0.0;
+        }
+      bool accepted = false;
+      Vector8 step;
+      for (int tries = 0; tries < 6 && !accepted; ++tries) {
+        Matrix8 a = jtj;
+        a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-9);
+        step = a.ldlt().solve(jtr);
+        if (!step.allFinite()) return false;
+        const Vector8 next = p + step;
+        if (next(3) > 0.05) {
+          evaluate(next, rTry, jacTry);
+          const double c = cost(rTry);
+          if (c <= current) {
+            accepted = true;
+            p = next;
+            current = c;
+            std::swap(r, rTry);
+            std::swap(jac, jacTry);
+            lambda = std::max(lambda * 0.3, 1e-9);
+            break;
+          }
+        }
+        lambda *= 10;
+      }
+      if (!accepted) break;
+      if (it >= 2 && step.head<4>().norm() < 1e-3) break;
     }
-    if (!accepted) break;
-    if (it >= 2 && step.head<4>().norm() < 1e-3) break;
+    return true;
+  };
+
+  // With the illumination ramp first; in a thin band a ramp resembles a shifted rim, so keeping
+  // it costs about half the precision of a small circle: drop it unless it is significant
+  // (chi-square of the two slopes, 2 degrees of freedom, 99.9%).
+  if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
+  normalEquations();
+  const Matrix8 cov = jtj.inverse() * (sigma * sigma);
+  const Eigen::Vector2d slope = p.segment<2>(5);
+  const Eigen::Matrix2d slopeCov = cov.block<2, 2>(5, 5);
+  if (slopeCov.allFinite() && slope.dot(slopeCov.ldlt().solve(slope)) < 13.8) {
+    p(5) = p(6) = 0.0;
+    if (!solve({true, true, true, true, true, false, false, true}, 6, false)) return std::nullopt;
   }
 
   const double blur = p(3);
-  const cv::Point2d c{p(0), p(1)};
+  const cv::Point2d c{centre.x + p(0), centre.y + p(1)};
   if (!p.allFinite() || blur < 0.2 || blur > 5.0 || p(2) <= 0.0 ||
       std::hypot(c.x - centre.x, c.y - centre.y) > maxShift || std::abs(p(2) - radius) > maxShift)
     return std::nullopt;
