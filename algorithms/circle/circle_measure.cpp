@@ -94,7 +94,7 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
       const double nextCost = cost(next);
       if (nextCost <= current) {
         improved = true;
-        const bool converged = step.norm() < 1e-6;  // pixels: far below the accuracy sought
+        const bool converged = step.norm() < 1e-5;  // pixels: far below the accuracy sought
         c = next;
         current = nextCost;
         lambda = std::max(lambda * 0.1, 1e-12);
@@ -283,7 +283,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
       if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
     if (static_cast<int>(in.size()) < params.minInliers) break;
     w.assign(in.size(), 1.0);
-    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 3;
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 2;
     for (int k = 0; k < irls; ++k) {
       if (k > 0) {
         std::vector<double> a;
@@ -316,7 +316,8 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
   if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
-    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints)) {
+    if (auto fine =
+            fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints, edges.noiseSigma)) {
       m.centre = fine->centre;
       m.radius = fine->radius;
       m.blur = fine->blur;

@@ -15,10 +15,20 @@ constexpr double kPi = std::numbers::pi;
 // One pixel of the band, relative to the starting centre.
 struct Sample {
   double x, y, grey;
+  int bin;  // angular bin
 };
 
 using Vector8 = Eigen::Matrix<double, 8, 1>;
 using Matrix8 = Eigen::Matrix<double, 8, 8>;
+
+// A monotonic stand-in for the polar angle, in [0, 4) (no atan2 in the pixel loops); bins of
+// equal width in it are within a factor 1.5 of equal angles.
+double diamondAngle(double dx, double dy) {
+  const double sum = std::abs(dx) + std::abs(dy);
+  if (sum == 0.0) return 0.0;
+  const double q = dy / sum;
+  return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
+}
 
 // Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): Abramowitz & Stegun
 // 7.1.26 for erfc (absolute error below 1.5e-7), which reuses the exponential the Jacobian needs.
@@ -43,15 +53,14 @@ double medianOf(std::vector<double> v) {
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
-                                                 double maxShift) {
+                                                 double noiseSigma, double maxShift) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
 
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
   const int bins = std::max(16, static_cast<int>(2.0 * kPi * radius / 2.0));
   auto binOf = [&](double dx, double dy) {
-    const double a = std::atan2(dy, dx) + kPi;  // 0..2pi
-    return std::min(bins - 1, static_cast<int>(a / (2.0 * kPi) * bins));
+    return std::min(bins - 1, static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins));
   };
   std::vector<std::uint8_t> covered(bins, 0);
   for (const auto& q : rimPoints) covered[binOf(q.x - centre.x, q.y - centre.y)] = 1;
@@ -69,14 +78,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       covered[i] = inside ? 1 : 0;
     }
   }
-  // Large circles have far more pixels than the accuracy needs: keep an evenly spread share of
-  // the bins so that about kMaxPixels pixels take part (bounds the time of big circles).
   constexpr double kBand = 3.0;
-  constexpr double kMaxPixels = 2500.0;
-  const double share = std::min(1.0, kMaxPixels / (2.0 * kPi * radius * 2.0 * kBand));
-  if (share < 1.0)
-    for (int i = 0; i < bins; ++i)
-      if (std::floor((i + 1) * share) == std::floor(i * share)) covered[i] = 0;
 
   // The band |rho - R| <= kBand inside the image.
   std::vector<Sample> samples;
@@ -99,10 +101,11 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
         x = static_cast<int>(std::ceil(centre.x + inner)) - 1;  // jump over the inner disc
         continue;
       }
-      if (!covered[binOf(dx, dy)]) continue;
+      const int bin = binOf(dx, dy);
+      if (!covered[bin]) continue;
       const double grey = image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
                                                   : image.at<std::uint8_t>(y, x);
-      samples.push_back({dx, dy, grey});
+      samples.push_back({dx, dy, grey, bin});
     }
   }
   if (samples.size() < 30) return std::nullopt;
@@ -118,6 +121,22 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   Vector8 p;
   p << 0.0, 0.0, radius, 1.2, medianOf(outside), 0.0, 0.0, 0.0;
   p(7) = medianOf(inside) - p(4);
+
+  // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
+  // bins, enough for a centre precision of about kTargetSigma px per axis by the Cramer-Rao bound
+  // (information per band pixel about (b / noise)^2 / (2 sqrt(pi) s) / (2 * 2 kBand)); this
+  // bounds the time of big, high-contrast circles and keeps every pixel of faint ones.
+  constexpr double kTargetSigma = 0.003;
+  if (noiseSigma > 0.0) {
+    const double snr = p(7) / noiseSigma;
+    const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * kBand);
+    const double needed = std::max(1000.0, 1.0 / (kTargetSigma * kTargetSigma * infoPerPixel));
+    const double share = needed / static_cast<double>(samples.size());
+    if (share < 1.0)
+      std::erase_if(samples, [&](const Sample& e) {
+        return std::floor((e.bin + 1) * share) == std::floor(e.bin * share);
+      });
+  }
 
   // One pass over the band at parameters q: residuals (grey - model) and Jacobian rows.
   const std::size_t m = samples.size();
@@ -148,12 +167,21 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   auto normalEquations = [&] {
     jtj.setZero();
     jtr.setZero();
+    double h[8][8] = {}, g[8] = {};
     for (std::size_t i = 0; i < m; ++i) {
-      if (weight[i] == 0.0) continue;
-      jtj.selfadjointView<Eigen::Lower>().rankUpdate(jac[i], weight[i]);
-      jtr += (weight[i] * r[i]) * jac[i];
+      const double w = weight[i];
+      if (w == 0.0) continue;
+      const double* j = jac[i].data();
+      for (int u = 0; u < 8; ++u) {
+        const double wu = w * j[u];
+        g[u] += wu * r[i];
+        for (int v = 0; v <= u; ++v) h[u][v] += wu * j[v];
+      }
     }
-    jtj.triangularView<Eigen::StrictlyUpper>() = jtj.transpose();
+    for (int u = 0; u < 8; ++u) {
+      jtr(u) = g[u];
+      for (int v = 0; v <= u; ++v) jtj(u, v) = jtj(v, u) = h[u][v];
+    }
   };
   auto tukeyWeights = [&] {
     std::vector<double> absR(m);
@@ -226,7 +254,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const Eigen::Matrix2d slopeCov = cov.block<2, 2>(5, 5);
   if (slopeCov.allFinite() && slope.dot(slopeCov.ldlt().solve(slope)) < 13.8) {
     p(5) = p(6) = 0.0;
-    if (!solve({true, true, true, true, true, false, false, true}, 6, false)) return std::nullopt;
+    if (!solve({true, true, true, true, true, false, false, true}, 4, false)) return std::nullopt;
   }
 
   const double blur = p(3);
