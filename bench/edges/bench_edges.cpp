@@ -36,7 +36,7 @@ struct StraightResult {
 // (dark 40 -> light 140 along the normal). Points within `margin` of the border are ignored.
 StraightResult measureStraight(double deg, double blur, double noise, std::uint64_t seed,
                                bool correct) {
-  const int size = 64, margin = 10;
+  const int size = 160, margin = 12;
   SceneSpec spec;
   spec.size = {size, size};
   spec.background = 40;
