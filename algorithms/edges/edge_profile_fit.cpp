@@ -343,6 +343,18 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
 
 }  // namespace
 
+double profileHalfAlong(double curvature, const EdgeProfileParams& params) {
+  const double k = std::abs(curvature);
+  if (k * params.halfAlong * params.halfAlong <= 6 * params.maxCurvatureBias)
+    return params.halfAlong;
+  return std::clamp(std::sqrt(6 * params.maxCurvatureBias / k), params.minAlong, params.halfAlong);
+}
+
+double profileCurvatureBias(double curvature, const EdgeProfileParams& params) {
+  const double l = std::floor(profileHalfAlong(curvature, params));
+  return std::abs(curvature) * l * (l + 1) / 6;
+}
+
 int edgeProfileReach(const EdgeProfileParams& params) {
   return static_cast<int>(std::ceil(std::hypot(params.halfAcross + 1.5, params.halfAlong)));
 }

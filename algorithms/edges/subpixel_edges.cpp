@@ -65,7 +65,7 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   // Facet zero crossings of every Canny pixel.
   std::vector<EdgeSeed> seeds;
-  std::vector<double> magnitudes;
+  std::vector<double> magnitudes, curvatures;
   for (int y = candidates.y; y < candidates.y + candidates.height; ++y) {
     const auto* e = edges.ptr<uchar>(y);
     for (int x = candidates.x; x < candidates.x + candidates.width; ++x) {
@@ -74,6 +74,7 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
       const auto z = facetZeroCrossing(fitCubicFacet(image, p));
       if (!z || std::abs(z->rho) > 1.0) continue;
       seeds.push_back({p, z->normal, z->rho});
+      curvatures.push_back(z->curvature);
       magnitudes.push_back(z->magnitude);
     }
   }
@@ -90,7 +91,9 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
     const EdgeSeed& s = seeds[i];
     EdgePoint point{cv::Point2d(s.pixel) + s.offset * s.normal, s.normal, magnitudes[i]};
     if (params.fitProfile && fitArea.contains(s.pixel)) {
-      const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, profile);
+      EdgeProfileParams local = profile;
+      local.halfAlong = profileHalfAlong(curvatures[i], profile);
+      const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, local);
       if (!refined) continue;
       point = *refined;
     }
