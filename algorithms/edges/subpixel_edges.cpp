@@ -26,7 +26,8 @@ bool crossesInsidePixel(const EdgePoint& point, cv::Point pixel) {
 }  // namespace
 
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params) {
-  if (image.empty()) throw std::invalid_argument("detectSubpixelEdges: the image is empty");
+  EdgeContours result;
+  if (image.empty()) return result;
   if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
     throw std::invalid_argument(
         "detectSubpixelEdges: expected an 8-bit or 16-bit single-channel image, got " +
@@ -37,7 +38,6 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   const cv::Rect full(0, 0, image.cols, image.rows);
   const cv::Rect roi = params.roi.empty() ? full : (params.roi & full);
-  EdgeContours result;
   if (roi.empty()) return result;
 
   // The gradient covers the ROI plus one pixel for suppression; edge pixels need the facet's
