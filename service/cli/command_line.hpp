@@ -32,5 +32,6 @@ void printJson(const nlohmann::json& object);
 // The subcommand's callback does the work; `json` tells whether --json was given anywhere.
 void addVersionCommand(CLI::App& app);
 void addCircleCommand(CLI::App& app);
+void addEdgesCommand(CLI::App& app);
 
 }  // namespace facet::cli
