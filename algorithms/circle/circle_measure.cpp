@@ -145,6 +145,11 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
     return "the nominal radius must be positive (got " + std::to_string(p.radius) + ")";
   if (!(p.width > 0.0) || !std::isfinite(p.width))
     return "the search width must be positive (got " + std::to_string(p.width) + ")";
+  if (p.radius + p.width > 1e5)
+    return "the annulus (radius + width = " + std::to_string(p.radius + p.width) +
+           " px) is larger than any image";
+  if (std::abs(p.centre.x) > 1e7 || std::abs(p.centre.y) > 1e7)
+    return "the expected centre lies absurdly far outside the image";
   if (!(p.directionToleranceDeg > 0.0 && p.directionToleranceDeg <= 90.0))
     return "the direction tolerance must be in (0, 90] degrees";
   if (!(p.ransacThreshold > 0.0)) return "the RANSAC threshold must be positive";
