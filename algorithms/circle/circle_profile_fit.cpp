@@ -78,7 +78,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       covered[i] = inside ? 1 : 0;
     }
   }
-  constexpr double kBand = 3.0;
+  constexpr double kBand = 4.0;
 
   // The band |rho - R| <= kBand inside the image.
   std::vector<Sample> samples;
@@ -126,7 +126,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // bins, enough for a centre precision of about kTargetSigma px per axis by the Cramer-Rao bound
   // (information per band pixel about (b / noise)^2 / (2 sqrt(pi) s) / (2 * 2 kBand)); this
   // bounds the time of big, high-contrast circles and keeps every pixel of faint ones.
-  constexpr double kTargetSigma = 0.003;
+  constexpr double kTargetSigma = 0.0035;
   if (noiseSigma > 0.0) {
     const double snr = p(7) / noiseSigma;
     const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * kBand);
