@@ -250,6 +250,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::optional<Circle> best;
   std::vector<Eigen::Vector2d> bestPts;
   std::size_t bestCount = 0;
+  int rimSign = +1;  // +1: gradient points outwards (dark inside), -1: inwards
   for (int sign : {+1, -1}) {
     std::vector<Eigen::Vector2d> pts;
     for (const Candidate& c : candidates)
@@ -268,6 +269,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     auto found = ransac<Circle>(pts.size(), 3, fit, res, rp);
     if (found && found->inliers.size() > bestCount) {
       bestCount = found->inliers.size();
+      rimSign = sign;
       best = found->model;
       bestPts = std::move(pts);
     }
@@ -321,8 +323,21 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
   if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
-    if (auto fine =
-            fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints, edges.noiseSigma)) {
+    // Strong edge points that are not the rim: off the circle, or not radial with its polarity.
+    std::vector<cv::Point2d> foreign;
+    for (const EdgePoint& e : edges.points) {
+      const Eigen::Vector2d p{e.position.x, e.position.y};
+      const Eigen::Vector2d radial = p - circle.centre;
+      const double d = radial.norm();
+      if (d == 0.0) continue;
+      const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
+      // Weak points (below the high threshold) are mostly noise; they must not punch holes.
+      if (e.magnitude >= edges.highThreshold &&
+          (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
+        foreign.push_back(e.position);
+    }
+    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints, foreign,
+                                     edges.noiseSigma)) {
       m.centre = fine->centre;
       m.radius = fine->radius;
       m.blur = fine->blur;

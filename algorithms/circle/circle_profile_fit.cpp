@@ -53,6 +53,7 @@ double medianOf(std::vector<double> v) {
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
+                                                 const std::vector<cv::Point2d>& foreignPoints,
                                                  double noiseSigma, double maxShift) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
@@ -87,6 +88,18 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
   const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - rOut)));
   const int y1 = std::min(image.rows - 1, static_cast<int>(std::ceil(centre.y + rOut)));
+  // Pixels within 2 px of a foreign edge (clutter, an occluder's border) stay out of the fit.
+  cv::Mat tainted;
+  if (!foreignPoints.empty() && x1 >= x0 && y1 >= y0) {
+    tainted = cv::Mat::zeros(y1 - y0 + 1, x1 - x0 + 1, CV_8U);
+    for (const auto& q : foreignPoints) {
+      const int qx = static_cast<int>(std::lround(q.x)), qy = static_cast<int>(std::lround(q.y));
+      for (int v = std::max(y0, qy - 2); v <= std::min(y1, qy + 2); ++v)
+        for (int u = std::max(x0, qx - 2); u <= std::min(x1, qx + 2); ++u)
+          if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= 4.0)
+            tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
+    }
+  }
   for (int y = y0; y <= y1; ++y) {
     const double dy = y - centre.y;
     if (dy * dy > rOut * rOut) continue;
@@ -102,7 +115,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
         continue;
       }
       const int bin = binOf(dx, dy);
-      if (!covered[bin]) continue;
+      if (!covered[bin] || (!tainted.empty() && tainted.at<std::uint8_t>(y - y0, x - x0))) continue;
       const double grey = image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
                                                   : image.at<std::uint8_t>(y, x);
       samples.push_back({dx, dy, grey, bin});
@@ -126,7 +139,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // bins, enough for a centre precision of about kTargetSigma px per axis by the Cramer-Rao bound
   // (information per band pixel about (b / noise)^2 / (2 sqrt(pi) s) / (2 * 2 kBand)); this
   // bounds the time of big, high-contrast circles and keeps every pixel of faint ones.
-  constexpr double kTargetSigma = 0.0035;
+  constexpr double kTargetSigma = 0.004;
   if (noiseSigma > 0.0) {
     const double snr = p(7) / noiseSigma;
     const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * kBand);
@@ -244,17 +257,30 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     return true;
   };
 
-  // With the illumination ramp first; in a thin band a ramp resembles a shifted rim, so keeping
-  // it costs about half the precision of a small circle: drop it unless it is significant
-  // (chi-square of the two slopes, 2 degrees of freedom, 99.9%).
-  if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
+  // Without the illumination ramp first: in a thin band a ramp resembles a shifted rim, and
+  // fitting one costs about half the precision of a small circle. A score test at that solution
+  // (chi-square of the ramp's gradient, 2 degrees of freedom, 99.9%) decides whether the image
+  // has a ramp worth fitting.
+  if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
   normalEquations();
-  const Matrix8 cov = jtj.inverse() * (sigma * sigma);
-  const Eigen::Vector2d slope = p.segment<2>(5);
-  const Eigen::Matrix2d slopeCov = cov.block<2, 2>(5, 5);
-  if (slopeCov.allFinite() && slope.dot(slopeCov.ldlt().solve(slope)) < 13.8) {
-    p(5) = p(6) = 0.0;
-    if (!solve({true, true, true, true, true, false, false, true}, 4, false)) return std::nullopt;
+  {
+    constexpr int kRamp[2] = {5, 6};
+    constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
+    Eigen::Matrix2d hgg;
+    Eigen::Matrix<double, 2, 6> hgo;
+    Eigen::Matrix<double, 6, 6> hoo;
+    Eigen::Vector2d score;
+    for (int u = 0; u < 2; ++u) {
+      score(u) = jtr(kRamp[u]);
+      for (int v = 0; v < 2; ++v) hgg(u, v) = jtj(kRamp[u], kRamp[v]);
+      for (int v = 0; v < 6; ++v) hgo(u, v) = jtj(kRamp[u], kRest[v]);
+    }
+    for (int u = 0; u < 6; ++u)
+      for (int v = 0; v < 6; ++v) hoo(u, v) = jtj(kRest[u], kRest[v]);
+    const Eigen::Matrix2d schur = hgg - hgo * hoo.ldlt().solve(hgo.transpose());
+    const double statistic = score.dot(schur.ldlt().solve(score)) / std::max(sigma * sigma, 1e-12);
+    if (std::isfinite(statistic) && statistic > 13.8)
+      if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
   }
 
   const double blur = p(3);
