@@ -139,7 +139,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // bins, enough for a centre precision of about kTargetSigma px per axis by the Cramer-Rao bound
   // (information per band pixel about (b / noise)^2 / (2 sqrt(pi) s) / (2 * 2 kBand)); this
   // bounds the time of big, high-contrast circles and keeps every pixel of faint ones.
-  constexpr double kTargetSigma = 0.004;
+  constexpr double kTargetSigma = 0.0035;
   if (noiseSigma > 0.0) {
     const double snr = p(7) / noiseSigma;
     const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * kBand);
