@@ -21,6 +21,8 @@ int main(int argc, char** argv) {
   addScanMatchCommand(app);
   addResultsCommand(app);
   addEdgesCommand(app);
+  addModelCommand(app);
+  addMatchCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
