@@ -115,6 +115,9 @@ class PlcLink {
   // Timings of the handshakes completed since the last call (at most the last 1024).
   std::vector<HandshakeTiming> takeTimings();
 
+  // Server role: the port the daemon serves on (useful with port 0); -1 in the client role.
+  int serverPort() const;
+
   const RegisterMap& registerMap() const;
   const PlcSettings& settings() const;
 
