@@ -16,8 +16,8 @@
 namespace facet {
 namespace {
 
-using shape_detail::sobelGradients;
-using shape_detail::toGreyFloat;
+using shape_detail::DirectionField;
+using Direction = cv::Vec<schar, 2>;  // unit gradient direction scaled by 127
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr int kBins = 32;               // quantised orientations of the top-level response maps
@@ -76,29 +76,6 @@ std::optional<Interval> angleRange(const ShapeModel& model, const FindParams& pa
 }
 
 // ---------------------------------------------------------------------------------------------
-// Image side: normalised gradient directions per pyramid level
-
-// Unit gradient directions (CV_32FC2); zero where the gradient is weaker than minContrast, so
-// that noise contributes nothing to the score.
-cv::Mat directionField(const cv::Mat& grey, double minContrast) {
-  cv::Mat gx, gy;
-  sobelGradients(grey, gx, gy);
-  cv::Mat field(grey.size(), CV_32FC2);
-  const float min2 = static_cast<float>(std::max(minContrast * minContrast, 1e-6));
-  for (int y = 0; y < grey.rows; ++y) {
-    const float* px = gx.ptr<float>(y);
-    const float* py = gy.ptr<float>(y);
-    auto* out = field.ptr<cv::Vec2f>(y);
-    for (int x = 0; x < grey.cols; ++x) {
-      const float m2 = px[x] * px[x] + py[x] * py[x];
-      const float inv = m2 >= min2 ? 1.0f / std::sqrt(m2) : 0.0f;
-      out[x] = {px[x] * inv, py[x] * inv};
-    }
-  }
-  return field;
-}
-
-// ---------------------------------------------------------------------------------------------
 // Model side: points at a pose
 
 struct PosedPoints {
@@ -135,8 +112,9 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
   for (int j = 0; j < n; ++j) {
     const int x = at.x + posed.offsets[j].x, y = at.y + posed.offsets[j].y;
     if (x >= 0 && y >= 0 && x < w && y < h) {
-      const cv::Vec2f g = field.ptr<cv::Vec2f>(y)[x];
-      const double dot = g[0] * posed.directions[j].x + g[1] * posed.directions[j].y;
+      const Direction g = field.ptr<Direction>(y)[x];
+      const double dot =
+          (g[0] * posed.directions[j].x + g[1] * posed.directions[j].y) * (1.0 / 127);
       sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
     }
     if ((j & 7) == 7 && minScore > 0.0) {
@@ -197,12 +175,12 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
     sinB[b] = static_cast<float>(std::sin(b * kTwoPi / kBins));
   }
   for (int y = 0; y < h; ++y) {
-    const auto* row = field.ptr<cv::Vec2f>(y);
+    const auto* row = field.ptr<Direction>(y);
     const std::size_t base = static_cast<std::size_t>(y + border) * stride + border;
     for (int x = 0; x < w; ++x) {
-      if (row[x][0] == 0.0f && row[x][1] == 0.0f) continue;
+      if (row[x][0] == 0 && row[x][1] == 0) continue;
       for (int b = 0; b < kBins; ++b) {
-        float v = 127.0f * (row[x][0] * cosB[b] + row[x][1] * sinB[b]);
+        float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
         if (local) v = std::abs(v);
         maps[b * plane + base + x] = static_cast<std::int8_t>(std::lround(v));
       }
@@ -534,21 +512,23 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   int levels =
       params.numLevels > 0 ? std::min(params.numLevels, model.numLevels()) : model.numLevels();
   while (levels > 1 && (std::min(image.cols, image.rows) >> (levels - 1)) < 8) --levels;
-  std::vector<cv::Mat> fields(levels);
+  std::vector<DirectionField> fields;
   {
-    cv::Mat grey = toGreyFloat(image);
+    // 8-bit images stay 8-bit (fast pyramid and Sobel); 16-bit ones go to the 8-bit float scale.
+    cv::Mat grey = image.depth() == CV_8U ? image : shape_detail::toGreyFloat(image);
     for (int l = 0; l < levels; ++l) {
       if (l > 0) cv::pyrDown(grey, grey);
-      fields[l] = directionField(grey, model.minContrast);
+      fields.emplace_back(grey, model.minContrast);
     }
   }
 
   const int top = levels - 1;
   const ShapeLevel& topLevel = model.levels[top];
   const int maxCandidates = params.numMatches == 0 ? 400 : 20 + 10 * params.numMatches;
-  std::vector<Candidate> candidates =
-      searchTopLevel(fields[top], topLevel.points, angleSamples(*angles, topLevel.angleStep),
-                     scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params, maxCandidates);
+  fields[top].ensureAll();
+  std::vector<Candidate> candidates = searchTopLevel(
+      fields[top].directions(), topLevel.points, angleSamples(*angles, topLevel.angleStep),
+      scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params, maxCandidates);
 
   LevelSearch search;
   search.angles = *angles;
@@ -557,8 +537,16 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   search.polarity = params.polarity;
   search.greediness = params.greediness;
   for (int l = top - 1; l >= 0; --l) {
-    search.field = &fields[l];
+    search.field = &fields[l].directions();
     search.level = &model.levels[l];
+    // Directions are needed only around the candidates.
+    double levelRadius = 0.0;
+    for (const auto& p : model.levels[l].points)
+      levelRadius = std::max(levelRadius, std::hypot(double(p.position.x), double(p.position.y)));
+    const int reach = static_cast<int>(std::ceil(levelRadius * scaleMax)) + 16;
+    for (const Candidate& c : candidates)
+      fields[l].ensure(cv::Rect(cvRound(2 * c.x) - reach, cvRound(2 * c.y) - reach, 2 * reach + 1,
+                                2 * reach + 1));
     search.minScore = params.minScore * (l == 0 ? 1.0 : kMiddleFactor);
     std::vector<Candidate> next;
     for (Candidate c : candidates) {
@@ -589,7 +577,7 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     if (params.numMatches > 0 && static_cast<int>(kept.size()) >= params.numMatches) break;
   }
 
-  search.field = &fields[0];
+  search.field = &fields[0].directions();
   search.level = &model.levels[0];
   std::vector<ShapeMatch> matches;
   for (Candidate c : kept) {
