@@ -21,13 +21,47 @@ void requireGreyImage(const cv::Mat& image) {
                                 cv::typeToString(image.type()));
 }
 
-// Non-maximum suppression along the image axis nearest to the gradient. Ties are broken towards
-// the left/upper pixel so that a plateau of two equal magnitudes yields one pixel.
-bool isAxisMaximum(const cv::Mat& gx, const cv::Mat& gy, const cv::Mat& mag, int x, int y) {
-  const float m = mag.at<float>(y, x);
-  if (std::abs(gx.at<float>(y, x)) >= std::abs(gy.at<float>(y, x)))
-    return m > mag.at<float>(y, x - 1) && m >= mag.at<float>(y, x + 1);
-  return m > mag.at<float>(y - 1, x) && m >= mag.at<float>(y + 1, x);
+template <typename T>
+void magnitudeOf(const cv::Mat& gx, const cv::Mat& gy, float scale, cv::Mat& mag) {
+  mag.create(gx.size(), CV_32F);
+  for (int y = 0; y < gx.rows; ++y) {
+    const T* a = gx.ptr<T>(y);
+    const T* b = gy.ptr<T>(y);
+    float* m = mag.ptr<float>(y);
+    for (int x = 0; x < gx.cols; ++x) {
+      const float fa = static_cast<float>(a[x]), fb = static_cast<float>(b[x]);
+      m[x] = scale * std::sqrt(fa * fa + fb * fb);
+    }
+  }
+}
+
+// Non-maximum suppression along the image axis nearest to the gradient, then hysteresis.
+// Ties are broken towards the left/upper pixel so that a plateau of two equal magnitudes yields
+// one pixel. state: 0 = no, 1 = candidate, 2 = edge.
+template <typename T>
+void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask, cv::Rect area,
+              cv::Mat& state, std::vector<cv::Point>& strong) {
+  const size_t step = g.magnitude.step1();
+  for (int y = area.y; y < area.y + area.height; ++y) {
+    const float* m = g.magnitude.ptr<float>(y);
+    const T* gx = g.gx.ptr<T>(y);
+    const T* gy = g.gy.ptr<T>(y);
+    const uchar* k = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+    uchar* s = state.ptr<uchar>(y);
+    for (int x = area.x; x < area.x + area.width; ++x) {
+      const float v = m[x];
+      if (v < low || (k && !k[x])) continue;
+      const bool horizontal = std::abs(gx[x]) >= std::abs(gy[x]);
+      const float before = horizontal ? m[x - 1] : m[x - step];
+      const float after = horizontal ? m[x + 1] : m[x + step];
+      if (!(v > before && v >= after)) continue;
+      s[x] = 1;
+      if (v >= high) {
+        s[x] = 2;
+        strong.emplace_back(x, y);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -43,26 +77,26 @@ EdgeGradient computeEdgeGradient(const cv::Mat& image, cv::Rect area) {
   const cv::Rect outer = cv::Rect(area.x - 2, area.y - 2, area.width + 4, area.height + 4) & full;
   const cv::Rect inner(area.x - outer.x, area.y - outer.y, area.width, area.height);
   const cv::Mat src = image(outer);
-  const double scale = (image.depth() == CV_16U ? 1.0 / 256.0 : 1.0) / kSobelGain;
+  const bool eightBit = image.depth() == CV_8U;
+  g.scale = (eightBit ? 1.0 : 1.0 / 256.0) / kSobelGain;
   cv::Mat dx, dy;
-  if (image.depth() == CV_8U) {
-    cv::Sobel(src, dx, CV_16S, 1, 0, 5, 1, 0, cv::BORDER_REPLICATE);
-    cv::Sobel(src, dy, CV_16S, 0, 1, 5, 1, 0, cv::BORDER_REPLICATE);
-  } else {
-    cv::Sobel(src, dx, CV_32F, 1, 0, 5, 1, 0, cv::BORDER_REPLICATE);
-    cv::Sobel(src, dy, CV_32F, 0, 1, 5, 1, 0, cv::BORDER_REPLICATE);
-  }
-  dx(inner).convertTo(g.gx, CV_32F, scale);
-  dy(inner).convertTo(g.gy, CV_32F, scale);
-  cv::magnitude(g.gx, g.gy, g.magnitude);
+  const int ddepth = eightBit ? CV_16S : CV_32F;
+  cv::Sobel(src, dx, ddepth, 1, 0, 5, 1, 0, cv::BORDER_REPLICATE);
+  cv::Sobel(src, dy, ddepth, 0, 1, 5, 1, 0, cv::BORDER_REPLICATE);
+  g.gx = dx(inner);
+  g.gy = dy(inner);
+  if (eightBit)
+    magnitudeOf<short>(g.gx, g.gy, static_cast<float>(g.scale), g.magnitude);
+  else
+    magnitudeOf<float>(g.gx, g.gy, static_cast<float>(g.scale), g.magnitude);
   return g;
 }
 
 cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,
                           const cv::Mat& mask, cv::Rect candidates) {
   const cv::Size size = gradient.area.size();
-  cv::Mat edges = cv::Mat::zeros(size, CV_8U);
-  if (size.empty()) return edges;
+  cv::Mat state = cv::Mat::zeros(size, CV_8U);
+  if (size.empty()) return state;
   if (!mask.empty() && (mask.size() != size || mask.type() != CV_8UC1))
     throw std::invalid_argument("edges: the mask must be CV_8UC1 of the region's size");
   const cv::Rect inside(1, 1, size.width - 2, size.height - 2);
@@ -71,24 +105,13 @@ cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,
   const auto lowF = static_cast<float>(low);
   const auto highF = static_cast<float>(std::max(low, high));
 
-  // 1 = candidate (local maximum >= low), 2 = accepted edge.
-  cv::Mat state = cv::Mat::zeros(size, CV_8U);
   std::vector<cv::Point> stack;
-  for (int y = candidates.y; y < candidates.y + candidates.height; ++y) {
-    const auto* m = gradient.magnitude.ptr<float>(y);
-    const uchar* k = mask.empty() ? nullptr : mask.ptr<uchar>(y);
-    auto* s = state.ptr<uchar>(y);
-    for (int x = candidates.x; x < candidates.x + candidates.width; ++x) {
-      if (m[x] < lowF || (k && !k[x])) continue;
-      if (!isAxisMaximum(gradient.gx, gradient.gy, gradient.magnitude, x, y)) continue;
-      s[x] = 1;
-      if (m[x] >= highF) {
-        s[x] = 2;
-        stack.emplace_back(x, y);
-      }
-    }
-  }
-  // Hysteresis: grow the strong pixels through 8-connected candidates.
+  if (gradient.gx.depth() == CV_16S)
+    suppress<short>(gradient, lowF, highF, mask, candidates, state, stack);
+  else
+    suppress<float>(gradient, lowF, highF, mask, candidates, state, stack);
+  // Hysteresis: grow the strong pixels through 8-connected candidates (state 0 at the border of
+  // `inside`, so the neighbours are always in the image).
   while (!stack.empty()) {
     const cv::Point p = stack.back();
     stack.pop_back();
@@ -102,12 +125,9 @@ cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,
       }
     }
   }
-  for (int y = 0; y < size.height; ++y) {
-    const auto* s = state.ptr<uchar>(y);
-    auto* e = edges.ptr<uchar>(y);
-    for (int x = 0; x < size.width; ++x) e[x] = s[x] == 2 ? 255 : 0;
-  }
-  return edges;
+  // 2 -> 255, everything else -> 0.
+  cv::compare(state, 2, state, cv::CMP_EQ);
+  return state;
 }
 
 cv::Mat cannyEdges(const cv::Mat& image, double low, double high, cv::Rect roi,

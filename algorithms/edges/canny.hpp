@@ -15,8 +15,10 @@ namespace facet {
 
 struct EdgeGradient {
   cv::Rect area;      // the image area the maps cover (image coordinates)
-  cv::Mat gx, gy;     // CV_32F, grey levels per pixel, x right / y down
-  cv::Mat magnitude;  // CV_32F, sqrt(gx^2 + gy^2)
+  cv::Mat gx, gy;     // raw 5x5 Sobel derivatives, x right / y down: CV_16S for 8-bit input,
+                      // CV_32F for 16-bit input; multiply by `scale` for grey levels per pixel
+  double scale = 1;   // 1/128 for 8-bit, 1/(128*256) for 16-bit input
+  cv::Mat magnitude;  // CV_32F, grey levels per pixel (8-bit scale): scale * |(gx, gy)|
 };
 
 // Gradient of `image` (CV_8UC1 or CV_16UC1) over `area` (clipped to the image; empty = all).
