@@ -20,10 +20,11 @@ using shape_detail::DirectionField;
 using Direction = cv::Vec<schar, 2>;  // unit gradient direction scaled by 127
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr int kBins = 32;               // quantised orientations of the top-level response maps
-constexpr int kMaxTopPoints = 250;      // 16-bit sums: 250 * 127 < 32767
-constexpr double kTopFactor = 0.7;      // top-level threshold, relative to minScore
-constexpr double kMiddleFactor = 0.85;  // threshold on levels between top and 0
+constexpr int kBins = 32;              // quantised orientations of the top-level response maps
+constexpr int kMaxTopPoints = 250;     // 16-bit sums: 250 * 127 < 32767
+constexpr double kTopFactor = 0.7;     // top-level threshold, relative to minScore
+constexpr double kMiddleFactor = 0.8;  // threshold on levels between top and 0
+constexpr double kFinalFactor = 0.8;   // level 0 before refinement (the refined score decides)
 
 // ---------------------------------------------------------------------------------------------
 // Search space
@@ -403,16 +404,19 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, const 
   }
 
   constexpr double kMinCos = 0.8;  // direction agreement of a correspondence (about 37 degrees)
-  constexpr double kHuber = 0.25;  // pixels: beyond this, residuals are down-weighted
   double sign = 1.0;               // global polarity, decided on the first pass
   const int unknowns = withScale ? 4 : 3;
-  for (int iteration = 0; iteration < 12; ++iteration) {
+  struct Pair {
+    Eigen::Vector4d J;
+    double r;
+  };
+  std::vector<Pair> pairs;
+  std::vector<double> absResiduals;
+  for (int iteration = 0; iteration < 15; ++iteration) {
     const int radius = iteration < 2 ? 3 - iteration : 1;
     const double c = std::cos(pose.angle), s = std::sin(pose.angle);
-    Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d g = Eigen::Vector4d::Zero();
-    double sumSq = 0.0, polaritySum = 0.0;
-    int used = 0;
+    double polaritySum = 0.0;
+    pairs.clear();
     for (const auto& mp : model.finePoints) {
       const double px = mp.position.x, py = mp.position.y;
       const cv::Point2d q = pose.apply({px, py});
@@ -445,27 +449,78 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, const 
       const double r = e.normal.x * (q.x - e.position.x) + e.normal.y * (q.y - e.position.y);
       // q = t + s R(a) p: dq/da = s R'(a) p, dq/ds = R(a) p.
       const double rpx = c * px + s * py, rpy = -s * px + c * py;
-      Eigen::Vector4d J(e.normal.x, e.normal.y, pose.scale * (e.normal.x * rpy - e.normal.y * rpx),
-                        e.normal.x * rpx + e.normal.y * rpy);
-      const double w = std::abs(r) <= kHuber ? 1.0 : kHuber / std::abs(r);
-      H += w * J * J.transpose();
-      g += w * r * J;
-      sumSq += r * r;
-      ++used;
+      pairs.push_back({Eigen::Vector4d(e.normal.x, e.normal.y,
+                                       pose.scale * (e.normal.x * rpy - e.normal.y * rpx),
+                                       e.normal.x * rpx + e.normal.y * rpy),
+                       r});
     }
     if (iteration == 0 && polarity == Polarity::IgnoreGlobal) sign = polaritySum < 0 ? -1.0 : 1.0;
-    if (used < 6) return result;
+    if (pairs.size() < 6) return result;
+
+    // Robust weights: Huber while the pose is coarse, then Tukey's biweight with a cut-off from
+    // the median residual, so that edges of occluders and clutter drop out entirely.
+    absResiduals.clear();
+    for (const auto& pr : pairs) absResiduals.push_back(std::abs(pr.r));
+    auto mid = absResiduals.begin() + static_cast<std::ptrdiff_t>(absResiduals.size() / 2);
+    std::nth_element(absResiduals.begin(), mid, absResiduals.end());
+    const double cutoff = std::clamp(4.685 * 1.4826 * *mid, 0.15, 1.5);
+    Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d g = Eigen::Vector4d::Zero();
+    double sumSq = 0.0, weightSum = 0.0;
+    for (const auto& pr : pairs) {
+      const double a = std::abs(pr.r);
+      double w = 0.0;
+      if (iteration < 2) {
+        w = a <= 0.5 ? 1.0 : 0.5 / a;
+      } else if (a < cutoff) {
+        const double t = 1.0 - (a / cutoff) * (a / cutoff);
+        w = t * t;
+      }
+      H += w * pr.J * pr.J.transpose();
+      g += w * pr.r * pr.J;
+      sumSq += w * pr.r * pr.r;
+      weightSum += w;
+    }
+    if (weightSum < 6.0) return result;
     Eigen::VectorXd delta = H.topLeftCorner(unknowns, unknowns).ldlt().solve(-g.head(unknowns));
     if (!delta.allFinite()) return result;
     pose.x += delta[0];
     pose.y += delta[1];
     pose.angle += delta[2];
     if (withScale) pose.scale += delta[3];
-    result = {pose, std::sqrt(sumSq / used), true};
-    if (std::hypot(delta[0], delta[1]) < 1e-4 && std::abs(delta[2]) < 1e-6) break;
+    result = {pose, std::sqrt(sumSq / weightSum), true};
+    if (iteration >= 3 && std::hypot(delta[0], delta[1]) < 1e-4 && std::abs(delta[2]) < 1e-6) break;
   }
   result.pose.angle = wrapAngle(result.pose.angle);
   return result;
+}
+
+// Steger's similarity of the model's subpixel points at a subpixel pose, with the image's
+// directions interpolated bilinearly: the score of the refined pose.
+double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
+                    Polarity polarity) {
+  const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+  double sum = 0.0;
+  for (const auto& mp : model.finePoints) {
+    const cv::Point2d q = pose.apply(mp.position);
+    const int x0 = static_cast<int>(std::floor(q.x)), y0 = static_cast<int>(std::floor(q.y));
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= field.cols || y0 + 1 >= field.rows) continue;
+    const double fx = q.x - x0, fy = q.y - y0;
+    const Direction* r0 = field.ptr<Direction>(y0) + x0;
+    const Direction* r1 = field.ptr<Direction>(y0 + 1) + x0;
+    double gx = 0.0, gy = 0.0;
+    const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    const Direction* d[4] = {r0, r0 + 1, r1, r1 + 1};
+    for (int k = 0; k < 4; ++k) gx += w[k] * (*d[k])[0], gy += w[k] * (*d[k])[1];
+    const double norm = std::hypot(gx, gy);
+    if (norm < 1e-6) continue;
+    const double dot = ((c * mp.direction.x + s * mp.direction.y) * gx +
+                        (-s * mp.direction.x + c * mp.direction.y) * gy) /
+                       norm;
+    sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
+  }
+  const double n = static_cast<double>(model.finePoints.size());
+  return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) / n;
 }
 
 double overlap(const cv::RotatedRect& a, const cv::RotatedRect& b) {
@@ -547,40 +602,41 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     for (const Candidate& c : candidates)
       fields[l].ensure(cv::Rect(cvRound(2 * c.x) - reach, cvRound(2 * c.y) - reach, 2 * reach + 1,
                                 2 * reach + 1));
-    search.minScore = params.minScore * (l == 0 ? 1.0 : kMiddleFactor);
+    search.minScore = params.minScore * (l > 0                                   ? kMiddleFactor
+                                         : params.subpixel == SubpixelMode::None ? 1.0
+                                                                                 : kFinalFactor);
     std::vector<Candidate> next;
     for (Candidate c : candidates) {
       c.x *= 2.0;
       c.y *= 2.0;
-      const Candidate r = refineOnLevel(search, c, l == top - 1 ? 2 : 1);
+      const Candidate r = refineOnLevel(search, c, 2);
       if (r.score >= search.minScore) next.push_back(r);
     }
     candidates.swap(next);
   }
   if (top == 0) {
-    std::erase_if(candidates, [&](const Candidate& c) { return c.score < params.minScore; });
+    const double keep =
+        params.minScore * (params.subpixel == SubpixelMode::None ? 1.0 : kFinalFactor);
+    std::erase_if(candidates, [&](const Candidate& c) { return c.score < keep; });
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
 
-  // Non-maximum suppression by overlap of the placed model boxes.
+  // Best first: refine, check the refined score, suppress overlaps with the matches kept.
   const Box box = modelBox(model);
-  std::vector<Candidate> kept;
-  std::vector<cv::RotatedRect> keptBoxes;
-  for (const Candidate& c : candidates) {
-    const cv::RotatedRect r = placedBox(box, {c.x, c.y, c.angle, c.scale});
-    bool clash = false;
-    for (const auto& k : keptBoxes) clash = clash || overlap(r, k) > params.maxOverlap;
-    if (clash) continue;
-    kept.push_back(c);
-    keptBoxes.push_back(r);
-    if (params.numMatches > 0 && static_cast<int>(kept.size()) >= params.numMatches) break;
-  }
-
   search.field = &fields[0].directions();
   search.level = &model.levels[0];
   std::vector<ShapeMatch> matches;
-  for (Candidate c : kept) {
+  std::vector<cv::RotatedRect> keptBoxes;
+  auto clashes = [&](const Pose2D& pose) {
+    const cv::RotatedRect r = placedBox(box, pose);
+    for (const auto& k : keptBoxes)
+      if (overlap(r, k) > params.maxOverlap) return true;
+    return false;
+  };
+  for (Candidate c : candidates) {
+    if (params.numMatches > 0 && static_cast<int>(matches.size()) >= params.numMatches) break;
+    if (clashes({c.x, c.y, c.angle, c.scale})) continue;
     ShapeMatch m;
     if (params.subpixel != SubpixelMode::None) c = interpolate(search, c);
     Pose2D pose{c.x, c.y, c.angle, c.scale};
@@ -594,6 +650,11 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
         m.residual = r.residual;
       }
     }
+    if (params.subpixel != SubpixelMode::None) {
+      fields[0].ensure(placedBox(box, pose).boundingRect() + cv::Size(4, 4) - cv::Point(2, 2));
+      c.score = refinedScore(fields[0].directions(), model, pose, params.polarity);
+      if (c.score < params.minScore || clashes(pose)) continue;
+    }
     m.x = pose.x;
     m.y = pose.y;
     m.angle = wrapAngle(pose.angle);
@@ -601,8 +662,11 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     m.score = c.score;
     m.contour.reserve(model.finePoints.size());
     for (const auto& p : model.finePoints) m.contour.push_back(pose.apply(p.position));
+    keptBoxes.push_back(placedBox(box, pose));
     matches.push_back(std::move(m));
   }
+  std::sort(matches.begin(), matches.end(),
+            [](const ShapeMatch& a, const ShapeMatch& b) { return a.score > b.score; });
   return matches;
 }
 

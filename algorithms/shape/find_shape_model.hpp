@@ -65,7 +65,9 @@ struct ShapeMatch {
   double y = 0.0;
   double angle = 0.0;  // radians, counter-clockwise on screen (wrapped to (-pi, pi])
   double scale = 1.0;  // unitless
-  double score = 0.0;  // 0..1, see above, on the level-0 pose grid before subpixel refinement
+  // 0..1, see above. With subpixel refinement: the similarity of the model's subpixel points at
+  // the refined pose (image directions interpolated bilinearly); without: on the level-0 grid.
+  double score = 0.0;
   // The model's subpixel edge points placed into the image at this pose, for overlays.
   std::vector<cv::Point2d> contour;
   // Least squares only: RMS point-to-line distance of the matched points, pixels (0 otherwise).
