@@ -1,27 +1,27 @@
 #include "algorithms/shape/find_shape_model.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
-#include <cstdint>
+#include <optional>
 #include <stdexcept>
-#include <thread>
 
-#include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
-#include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/shape/image_gradients.hpp"
+#include "algorithms/shape/least_squares_refinement.hpp"
+#include "algorithms/shape/response_map_search.hpp"
+#include "algorithms/shape/shape_similarity.hpp"
 
 namespace facet {
 namespace {
 
+using shape_detail::Candidate;
 using shape_detail::DirectionField;
-using Direction = cv::Vec<schar, 2>;  // unit gradient direction scaled by 127
+using shape_detail::PosedPoints;
+using shape_detail::posePoints;
+using shape_detail::scorePose;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr int kBins = 32;              // quantised orientations of the top-level response maps
-constexpr int kMaxTopPoints = 250;     // 16-bit sums: 250 * 127 < 32767
 constexpr double kTopFactor = 0.7;     // top-level threshold, relative to minScore
 constexpr double kMiddleFactor = 0.8;  // threshold on levels between top and 0
 constexpr double kFinalFactor = 0.8;   // level 0 before refinement (the refined score decides)
@@ -74,202 +74,6 @@ std::optional<Interval> angleRange(const ShapeModel& model, const FindParams& pa
   }
   if (best < 0.0) return std::nullopt;
   return Interval{bestStart, best, false};
-}
-
-// ---------------------------------------------------------------------------------------------
-// Model side: points at a pose
-
-struct PosedPoints {
-  std::vector<cv::Point> offsets;       // rounded s R(a) p, pixels of the level
-  std::vector<cv::Point2f> directions;  // R(a) d
-};
-
-PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, double scale) {
-  const double c = std::cos(angle), s = std::sin(angle);
-  PosedPoints out;
-  out.offsets.reserve(points.size());
-  out.directions.reserve(points.size());
-  for (const auto& p : points) {
-    const double x = p.position.x, y = p.position.y;
-    out.offsets.emplace_back(cvRound(scale * (c * x + s * y)), cvRound(scale * (-s * x + c * y)));
-    const double dx = p.direction.x, dy = p.direction.y;
-    out.directions.emplace_back(static_cast<float>(c * dx + s * dy),
-                                static_cast<float>(-s * dx + c * dy));
-  }
-  return out;
-}
-
-// Steger's similarity at an integer position, with early termination: after j of n points the
-// pose is abandoned when the partial mean falls below a bound between the safe one (every
-// remaining point matches perfectly, greediness 0) and the greedy one (the remaining points match
-// at exactly minScore, greediness 1). Returns the score, or a value below minScore if abandoned.
-double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, Polarity polarity,
-                 double minScore, double greediness) {
-  const int n = static_cast<int>(posed.offsets.size());
-  const double invN = 1.0 / n;
-  const double safe = minScore - 1.0, greedy = minScore;
-  double sum = 0.0;
-  const int w = field.cols, h = field.rows;
-  for (int j = 0; j < n; ++j) {
-    const int x = at.x + posed.offsets[j].x, y = at.y + posed.offsets[j].y;
-    if (x >= 0 && y >= 0 && x < w && y < h) {
-      const Direction g = field.ptr<Direction>(y)[x];
-      const double dot =
-          (g[0] * posed.directions[j].x + g[1] * posed.directions[j].y) * (1.0 / 127);
-      sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
-    }
-    if ((j & 7) == 7 && minScore > 0.0) {
-      const double f = (j + 1) * invN;
-      const double bound = (1.0 - greediness) * (safe + f) + greediness * greedy * f;
-      const double partial = (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
-      if (partial < bound) return -1.0;
-    }
-  }
-  return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
-}
-
-// ---------------------------------------------------------------------------------------------
-// Top level: exhaustive search over (x, y, angle, scale) with quantised-orientation response
-// maps. Map b holds 127 cos(theta - theta_b) for every pixel, so the score of a template is a sum
-// of shifted map rows: one vectorisable 8-bit add per point and row.
-
-struct TopTemplate {
-  double angle = 0.0;
-  double scale = 1.0;
-  std::vector<int> offsets;  // into a padded map plane
-  std::vector<int> bins;
-};
-
-struct Candidate {
-  double x = 0.0, y = 0.0;  // position on the current level, pixels
-  double angle = 0.0;
-  double scale = 1.0;
-  double score = 0.0;
-};
-
-std::vector<Candidate> searchTopLevel(const cv::Mat& field,
-                                      const std::vector<ShapePoint>& modelPoints,
-                                      const std::vector<double>& angles,
-                                      const std::vector<double>& scales, const FindParams& params,
-                                      int maxCandidates) {
-  std::vector<ShapePoint> points = modelPoints;
-  if (points.size() > kMaxTopPoints) {
-    std::vector<ShapePoint> kept;
-    const double stride = static_cast<double>(points.size()) / kMaxTopPoints;
-    for (int i = 0; i < kMaxTopPoints; ++i)
-      kept.push_back(points[static_cast<std::size_t>(i * stride)]);
-    points.swap(kept);
-  }
-  double radius = 0.0;
-  for (const auto& p : points)
-    radius = std::max(radius, std::hypot(double(p.position.x), double(p.position.y)));
-  const int border = static_cast<int>(std::ceil(radius * scales.back())) + 2;
-  const int w = field.cols, h = field.rows;
-  const int stride = w + 2 * border;
-  const std::size_t plane = static_cast<std::size_t>(stride) * (h + 2 * border);
-  const bool local = params.polarity == Polarity::IgnoreLocal;
-
-  std::vector<std::int8_t> maps(plane * kBins, 0);
-  std::array<float, kBins> cosB{}, sinB{};
-  for (int b = 0; b < kBins; ++b) {
-    cosB[b] = static_cast<float>(std::cos(b * kTwoPi / kBins));
-    sinB[b] = static_cast<float>(std::sin(b * kTwoPi / kBins));
-  }
-  for (int y = 0; y < h; ++y) {
-    const auto* row = field.ptr<Direction>(y);
-    const std::size_t base = static_cast<std::size_t>(y + border) * stride + border;
-    for (int x = 0; x < w; ++x) {
-      if (row[x][0] == 0 && row[x][1] == 0) continue;
-      for (int b = 0; b < kBins; ++b) {
-        float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
-        if (local) v = std::abs(v);
-        maps[b * plane + base + x] = static_cast<std::int8_t>(std::lround(v));
-      }
-    }
-  }
-
-  std::vector<TopTemplate> templates;
-  for (double s : scales) {
-    for (double a : angles) {
-      TopTemplate t{a, s, {}, {}};
-      const PosedPoints posed = posePoints(points, a, s);
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        t.offsets.push_back(posed.offsets[i].y * stride + posed.offsets[i].x);
-        const double theta = std::atan2(posed.directions[i].y, posed.directions[i].x);
-        t.bins.push_back(((static_cast<int>(std::lround(theta / kTwoPi * kBins)) % kBins) + kBins) %
-                         kBins);
-      }
-      templates.push_back(std::move(t));
-    }
-  }
-
-  // Best template per pixel.
-  std::vector<std::int16_t> best(static_cast<std::size_t>(w) * h, 0);
-  std::vector<std::int32_t> bestTemplate(best.size(), -1);
-  const bool global = params.polarity == Polarity::IgnoreGlobal;
-  auto work = [&](int y0, int y1) {
-    std::vector<std::int16_t> acc(w);
-    for (int y = y0; y < y1; ++y) {
-      const std::size_t rowBase = static_cast<std::size_t>(y + border) * stride + border;
-      std::int16_t* bestRow = best.data() + static_cast<std::size_t>(y) * w;
-      std::int32_t* bestIdx = bestTemplate.data() + static_cast<std::size_t>(y) * w;
-      for (std::size_t t = 0; t < templates.size(); ++t) {
-        const TopTemplate& tpl = templates[t];
-        std::fill(acc.begin(), acc.end(), 0);
-        std::int16_t* a = acc.data();
-        for (std::size_t i = 0; i < tpl.offsets.size(); ++i) {
-          const std::int8_t* src = maps.data() + tpl.bins[i] * plane + rowBase + tpl.offsets[i];
-          for (int x = 0; x < w; ++x) a[x] = static_cast<std::int16_t>(a[x] + src[x]);
-        }
-        for (int x = 0; x < w; ++x) {
-          const std::int16_t v = global ? static_cast<std::int16_t>(std::abs(a[x])) : a[x];
-          if (v > bestRow[x]) bestRow[x] = v, bestIdx[x] = static_cast<std::int32_t>(t);
-        }
-      }
-    }
-  };
-  const int threads = std::clamp(params.threads, 1, 8);
-  if (threads == 1 || h < 2 * threads) {
-    work(0, h);
-  } else {
-    std::vector<std::thread> pool;
-    for (int k = 1; k < threads; ++k)
-      pool.emplace_back(work, h * k / threads, h * (k + 1) / threads);
-    work(0, h / threads);
-    for (auto& t : pool) t.join();
-  }
-
-  // Local maxima above the threshold.
-  const double norm = 127.0 * static_cast<double>(points.size());
-  const auto threshold =
-      static_cast<std::int16_t>(std::min(32767.0, kTopFactor * params.minScore * norm));
-  std::vector<Candidate> candidates;
-  constexpr int r = 2;
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const std::int16_t v = best[static_cast<std::size_t>(y) * w + x];
-      if (v < threshold || v <= 0) continue;
-      bool isMax = true;
-      for (int dy = -r; dy <= r && isMax; ++dy)
-        for (int dx = -r; dx <= r; ++dx) {
-          const int xx = x + dx, yy = y + dy;
-          if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-          const std::int16_t u = best[static_cast<std::size_t>(yy) * w + xx];
-          // Strict on one side so that a plateau yields one maximum.
-          if (u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0)))) {
-            isMax = false;
-            break;
-          }
-        }
-      if (!isMax) continue;
-      const TopTemplate& tpl = templates[bestTemplate[static_cast<std::size_t>(y) * w + x]];
-      candidates.push_back({double(x), double(y), tpl.angle, tpl.scale, v / norm});
-    }
-  }
-  std::sort(candidates.begin(), candidates.end(),
-            [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-  if (static_cast<int>(candidates.size()) > maxCandidates) candidates.resize(maxCandidates);
-  return candidates;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -349,8 +153,7 @@ Candidate interpolate(const LevelSearch& s, Candidate c) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Least squares: ICP of the model's subpixel points against the image's Facet-model subpixel
-// edges, minimising point-to-line distances along the image edge normals.
+// Matches in the image: oriented boxes for the overlap test and the refinement's region.
 
 struct Box {
   double x0, y0, x1, y1;  // model coordinates
@@ -372,155 +175,6 @@ cv::RotatedRect placedBox(const Box& b, const Pose2D& pose) {
           cv::Size2f(static_cast<float>(pose.scale * (b.x1 - b.x0 + 1)),
                      static_cast<float>(pose.scale * (b.y1 - b.y0 + 1))),
           static_cast<float>(-degrees(pose.angle))};
-}
-
-struct Refined {
-  Pose2D pose;
-  double residual = 0.0;
-  bool ok = false;
-};
-
-Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, const Box& box,
-                           Pose2D pose, Polarity polarity, bool withScale) {
-  Refined result{pose, 0.0, false};
-  const cv::Rect roi = (placedBox(box, pose).boundingRect() + cv::Size(8, 8) - cv::Point(4, 4)) &
-                       cv::Rect(0, 0, image.cols, image.rows);
-  if (roi.width < 3 || roi.height < 3) return result;
-  EdgeParams edgeParams;
-  edgeParams.roi = roi;
-  edgeParams.low = model.minContrast;
-  edgeParams.high = std::max(2.0 * model.minContrast, 0.5 * model.contrastHigh);
-  const EdgeContours edges = detectSubpixelEdges(image, edgeParams);
-  if (edges.points.size() < 6) return result;
-
-  // Edge points indexed by the pixel that holds them.
-  cv::Mat cell(roi.size(), CV_32S, cv::Scalar(-1));
-  for (int i = 0; i < static_cast<int>(edges.points.size()); ++i) {
-    const cv::Point p(cvRound(edges.points[i].position.x) - roi.x,
-                      cvRound(edges.points[i].position.y) - roi.y);
-    if (!cv::Rect(0, 0, roi.width, roi.height).contains(p)) continue;
-    int& slot = cell.at<int>(p);
-    if (slot < 0 || edges.points[slot].magnitude < edges.points[i].magnitude) slot = i;
-  }
-
-  constexpr double kMinCos = 0.8;  // direction agreement of a correspondence (about 37 degrees)
-  double sign = 1.0;               // global polarity, decided on the first pass
-  const int unknowns = withScale ? 4 : 3;
-  struct Pair {
-    Eigen::Vector4d J;
-    double r;
-  };
-  std::vector<Pair> pairs;
-  std::vector<double> absResiduals;
-  for (int iteration = 0; iteration < 15; ++iteration) {
-    const int radius = iteration < 2 ? 3 - iteration : 1;
-    const double c = std::cos(pose.angle), s = std::sin(pose.angle);
-    double polaritySum = 0.0;
-    pairs.clear();
-    for (const auto& mp : model.finePoints) {
-      const double px = mp.position.x, py = mp.position.y;
-      const cv::Point2d q = pose.apply({px, py});
-      const double dx = c * mp.direction.x + s * mp.direction.y;
-      const double dy = -s * mp.direction.x + c * mp.direction.y;
-      const int cx = cvRound(q.x) - roi.x, cy = cvRound(q.y) - roi.y;
-      int bestIdx = -1;
-      double bestD2 = 1e30, bestDot = 0.0;
-      for (int v = cy - radius; v <= cy + radius; ++v) {
-        if (v < 0 || v >= roi.height) continue;
-        const int* row = cell.ptr<int>(v);
-        for (int u = cx - radius; u <= cx + radius; ++u) {
-          if (u < 0 || u >= roi.width || row[u] < 0) continue;
-          const EdgePoint& e = edges.points[row[u]];
-          const double dot = e.normal.x * dx + e.normal.y * dy;
-          const double agree = polarity == Polarity::IgnoreLocal    ? std::abs(dot)
-                               : polarity == Polarity::IgnoreGlobal ? sign * dot
-                                                                    : dot;
-          if (agree < kMinCos &&
-              !(iteration == 0 && polarity == Polarity::IgnoreGlobal && std::abs(dot) >= kMinCos))
-            continue;
-          const double d2 = (e.position.x - q.x) * (e.position.x - q.x) +
-                            (e.position.y - q.y) * (e.position.y - q.y);
-          if (d2 < bestD2) bestD2 = d2, bestIdx = row[u], bestDot = dot;
-        }
-      }
-      if (bestIdx < 0) continue;
-      polaritySum += bestDot;
-      const EdgePoint& e = edges.points[bestIdx];
-      const double r = e.normal.x * (q.x - e.position.x) + e.normal.y * (q.y - e.position.y);
-      // q = t + s R(a) p: dq/da = s R'(a) p, dq/ds = R(a) p.
-      const double rpx = c * px + s * py, rpy = -s * px + c * py;
-      pairs.push_back({Eigen::Vector4d(e.normal.x, e.normal.y,
-                                       pose.scale * (e.normal.x * rpy - e.normal.y * rpx),
-                                       e.normal.x * rpx + e.normal.y * rpy),
-                       r});
-    }
-    if (iteration == 0 && polarity == Polarity::IgnoreGlobal) sign = polaritySum < 0 ? -1.0 : 1.0;
-    if (pairs.size() < 6) return result;
-
-    // Robust weights: Huber while the pose is coarse, then Tukey's biweight with a cut-off from
-    // the median residual, so that edges of occluders and clutter drop out entirely.
-    absResiduals.clear();
-    for (const auto& pr : pairs) absResiduals.push_back(std::abs(pr.r));
-    auto mid = absResiduals.begin() + static_cast<std::ptrdiff_t>(absResiduals.size() / 2);
-    std::nth_element(absResiduals.begin(), mid, absResiduals.end());
-    const double cutoff = std::clamp(4.685 * 1.4826 * *mid, 0.15, 1.5);
-    Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d g = Eigen::Vector4d::Zero();
-    double sumSq = 0.0, weightSum = 0.0;
-    for (const auto& pr : pairs) {
-      const double a = std::abs(pr.r);
-      double w = 0.0;
-      if (iteration < 2) {
-        w = a <= 0.5 ? 1.0 : 0.5 / a;
-      } else if (a < cutoff) {
-        const double t = 1.0 - (a / cutoff) * (a / cutoff);
-        w = t * t;
-      }
-      H += w * pr.J * pr.J.transpose();
-      g += w * pr.r * pr.J;
-      sumSq += w * pr.r * pr.r;
-      weightSum += w;
-    }
-    if (weightSum < 6.0) return result;
-    Eigen::VectorXd delta = H.topLeftCorner(unknowns, unknowns).ldlt().solve(-g.head(unknowns));
-    if (!delta.allFinite()) return result;
-    pose.x += delta[0];
-    pose.y += delta[1];
-    pose.angle += delta[2];
-    if (withScale) pose.scale += delta[3];
-    result = {pose, std::sqrt(sumSq / weightSum), true};
-    if (iteration >= 3 && std::hypot(delta[0], delta[1]) < 1e-4 && std::abs(delta[2]) < 1e-6) break;
-  }
-  result.pose.angle = wrapAngle(result.pose.angle);
-  return result;
-}
-
-// Steger's similarity of the model's subpixel points at a subpixel pose, with the image's
-// directions interpolated bilinearly: the score of the refined pose.
-double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
-                    Polarity polarity) {
-  const double c = std::cos(pose.angle), s = std::sin(pose.angle);
-  double sum = 0.0;
-  for (const auto& mp : model.finePoints) {
-    const cv::Point2d q = pose.apply(mp.position);
-    const int x0 = static_cast<int>(std::floor(q.x)), y0 = static_cast<int>(std::floor(q.y));
-    if (x0 < 0 || y0 < 0 || x0 + 1 >= field.cols || y0 + 1 >= field.rows) continue;
-    const double fx = q.x - x0, fy = q.y - y0;
-    const Direction* r0 = field.ptr<Direction>(y0) + x0;
-    const Direction* r1 = field.ptr<Direction>(y0 + 1) + x0;
-    double gx = 0.0, gy = 0.0;
-    const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
-    const Direction* d[4] = {r0, r0 + 1, r1, r1 + 1};
-    for (int k = 0; k < 4; ++k) gx += w[k] * (*d[k])[0], gy += w[k] * (*d[k])[1];
-    const double norm = std::hypot(gx, gy);
-    if (norm < 1e-6) continue;
-    const double dot = ((c * mp.direction.x + s * mp.direction.y) * gx +
-                        (-s * mp.direction.x + c * mp.direction.y) * gy) /
-                       norm;
-    sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
-  }
-  const double n = static_cast<double>(model.finePoints.size());
-  return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) / n;
 }
 
 double overlap(const cv::RotatedRect& a, const cv::RotatedRect& b) {
@@ -581,9 +235,10 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   const ShapeLevel& topLevel = model.levels[top];
   const int maxCandidates = params.numMatches == 0 ? 400 : 20 + 10 * params.numMatches;
   fields[top].ensureAll();
-  std::vector<Candidate> candidates = searchTopLevel(
+  std::vector<Candidate> candidates = shape_detail::searchTopLevel(
       fields[top].directions(), topLevel.points, angleSamples(*angles, topLevel.angleStep),
-      scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params, maxCandidates);
+      scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params.polarity,
+      kTopFactor * params.minScore, params.threads, maxCandidates);
 
   LevelSearch search;
   search.angles = *angles;
@@ -641,8 +296,9 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     if (params.subpixel != SubpixelMode::None) c = interpolate(search, c);
     Pose2D pose{c.x, c.y, c.angle, c.scale};
     if (params.subpixel == SubpixelMode::LeastSquares) {
-      const Refined r =
-          refineLeastSquares(image, model, box, pose, params.polarity, scaleMax > scaleMin);
+      const cv::Rect roi = placedBox(box, pose).boundingRect() + cv::Size(8, 8) - cv::Point(4, 4);
+      const shape_detail::Refined r = shape_detail::refineLeastSquares(
+          image, model, roi, pose, params.polarity, scaleMax > scaleMin);
       // A refinement that wanders off by more than the search's own uncertainty has locked onto
       // something else.
       if (r.ok && std::hypot(r.pose.x - pose.x, r.pose.y - pose.y) < 3.0) {
@@ -652,7 +308,7 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     }
     if (params.subpixel != SubpixelMode::None) {
       fields[0].ensure(placedBox(box, pose).boundingRect() + cv::Size(4, 4) - cv::Point(2, 2));
-      c.score = refinedScore(fields[0].directions(), model, pose, params.polarity);
+      c.score = shape_detail::refinedScore(fields[0].directions(), model, pose, params.polarity);
       if (c.score < params.minScore || clashes(pose)) continue;
     }
     m.x = pose.x;

@@ -12,6 +12,8 @@ cv::Mat toGreyFloat(const cv::Mat& image);
 // Sobel derivatives of a CV_32F image in grey levels per pixel (3x3 Sobel divided by 8).
 void sobelGradients(const cv::Mat& image, cv::Mat& gx, cv::Mat& gy);
 
+using Direction = cv::Vec<schar, 2>;  // unit gradient direction scaled by 127
+
 // Unit gradient directions of one pyramid level, scaled by 127 (CV_8SC2), zero where the gradient
 // is weaker than minContrast so that noise adds nothing to a score. Computed tile by tile on
 // demand: the search only looks near its candidates, and large images need few tiles.
