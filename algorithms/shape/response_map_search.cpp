@@ -5,7 +5,6 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
-#include <thread>
 
 #include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
@@ -111,11 +110,13 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   if (threads == 1 || h < 2 * threads) {
     work(0, h);
   } else {
-    std::vector<std::thread> pool;
-    for (int k = 1; k < threads; ++k)
-      pool.emplace_back(work, h * k / threads, h * (k + 1) / threads);
-    work(0, h / threads);
-    for (auto& t : pool) t.join();
+    // OpenCV's worker pool: the algorithms start no threads of their own.
+    cv::parallel_for_(
+        cv::Range(0, threads),
+        [&](const cv::Range& r) {
+          for (int k = r.start; k < r.end; ++k) work(h * k / threads, h * (k + 1) / threads);
+        },
+        threads);
   }
 
   // Local maxima above the threshold.
