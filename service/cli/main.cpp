@@ -17,6 +17,9 @@ int main(int argc, char** argv) {
   CLI::App app{"facet: machine-vision inspection tool", "facet"};
   app.require_subcommand(1);
   addVersionCommand(app);
+  addCircleCommand(app);
+  addScanMatchCommand(app);
+  addResultsCommand(app);
   addEdgesCommand(app);
   addModelCommand(app);
   addMatchCommand(app);
