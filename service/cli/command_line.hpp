@@ -37,5 +37,6 @@ void addResultsCommand(CLI::App& app);
 void addEdgesCommand(CLI::App& app);
 void addModelCommand(CLI::App& app);
 void addMatchCommand(CLI::App& app);
+void addRegisterCommand(CLI::App& app);
 
 }  // namespace facet::cli

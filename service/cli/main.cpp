@@ -23,6 +23,7 @@ int main(int argc, char** argv) {
   addEdgesCommand(app);
   addModelCommand(app);
   addMatchCommand(app);
+  addRegisterCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
