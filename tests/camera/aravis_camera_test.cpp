@@ -167,6 +167,40 @@ TEST(AravisCamera, Mono16RgbAndBayerFormats) {
   }
 }
 
+TEST(AravisCamera, OpensBySerialThroughDiscovery) {
+  FakeGigECamera fake("FACETSN7");
+  ASSERT_TRUE(fake.running());
+  auto s = settingsFor();
+  s.address.clear();
+  s.serial = "FACETSN7";
+  AravisCamera camera(s);
+  camera.open();
+  camera.start();
+  GrabResult r = grabOk(camera);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_NE(r.frame.source.find("FACETSN7"), std::string::npos) << r.frame.source;
+  s.serial = "NO-SUCH-SERIAL";
+  AravisCamera missing(s);
+  EXPECT_THROW(missing.open(), CameraError);
+}
+
+TEST(AravisCamera, HardwareTriggerWaitsForTheLine) {
+  FakeGigECamera fake;
+  ASSERT_TRUE(fake.running());
+  auto s = settingsFor();
+  s.frame_rate_hz.reset();
+  s.trigger = TriggerMode::Hardware;
+  s.trigger_line = "Line0";  // the fake camera's only line: nothing ever drives it
+  AravisCamera camera(s);
+  camera.open();
+  camera.start();
+  EXPECT_EQ(camera.grab(400ms).status, GrabStatus::Timeout);
+  camera.softwareTrigger();  // ignored outside software-trigger mode
+  EXPECT_EQ(camera.grab(300ms).status, GrabStatus::Timeout);
+  EXPECT_EQ(camera.health().frames, 0u);
+  EXPECT_TRUE(camera.health().connected) << "a quiet triggered camera is not a lost camera";
+}
+
 TEST(AravisCamera, SoftwareTriggerGivesExactlyOneFramePerTrigger) {
   FakeGigECamera fake;
   ASSERT_TRUE(fake.running());
