@@ -91,6 +91,7 @@ struct PlcSimulator::State {
 
 void PlcSimulator::State::scan() {
   Tables tables(*server, map);
+  tables.setFlag(map.control.enable, true);  // a running line enables inspections
   const bool triggered = options.mode == HandshakeMode::Triggered;
   const auto ratePeriod = options.triggerRate > 0
                               ? std::chrono::duration_cast<SteadyClock::duration>(

@@ -31,5 +31,6 @@ void printJson(const nlohmann::json& object);
 // Every subcommand is added by a function of this shape, one file per subcommand.
 // The subcommand's callback does the work; `json` tells whether --json was given anywhere.
 void addVersionCommand(CLI::App& app);
+void addPlcSimCommand(CLI::App& app);
 
 }  // namespace facet::cli
