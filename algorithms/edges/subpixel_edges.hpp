@@ -37,17 +37,24 @@ struct EdgeParams {
   // Correct the systematic radial bias of second-derivative edges on curved contours
   // (about -k/r pixels for curvature radius r); uses the local curvature along linked contours.
   bool correctCurvatureBias = false;
+  // Refine each facet point by fitting a blurred-step model over a 7x7 px window along the edge
+  // (edge_profile_fit.hpp): removes the cubic facet's shape bias and averages noise along the
+  // edge. Off gives the plain facet zero crossings. Points closer than 5 px to the image border
+  // keep their facet position.
+  bool fitProfile = true;
 };
 
 struct EdgeContours {
   std::vector<EdgePoint> points;
   // Each contour lists indices into `points`, in order along the edge (filled when linkContours).
   std::vector<std::vector<int>> contours;
-  double lowThreshold = 0;   // thresholds actually used
+  double lowThreshold = 0;  // thresholds actually used
   double highThreshold = 0;
 };
 
-// Subpixel edges of an 8-bit or 16-bit single-channel image.
+// Subpixel edges of an 8-bit or 16-bit single-channel image. An empty image gives no points;
+// any other type (colour, float, ...) or a mask of the wrong size/type throws
+// std::invalid_argument.
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params = {});
 
 }  // namespace facet

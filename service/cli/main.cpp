@@ -18,6 +18,12 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   addVersionCommand(app);
   addPlcSimCommand(app);
+  addCircleCommand(app);
+  addScanMatchCommand(app);
+  addResultsCommand(app);
+  addEdgesCommand(app);
+  addModelCommand(app);
+  addMatchCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";

@@ -1,0 +1,346 @@
+#include "algorithms/circle/circle_measure.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+#include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/circle/annulus_edges.hpp"
+#include "algorithms/circle/circle_profile_fit.hpp"
+#include "algorithms/geometry/ransac.hpp"
+
+namespace facet {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+struct Circle {
+  Eigen::Vector2d centre;
+  double radius = 0.0;
+};
+
+double residual(const Circle& c, const Eigen::Vector2d& p) {
+  return (p - c.centre).norm() - c.radius;
+}
+
+// The circle through three points, or nothing when they are (nearly) collinear.
+std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
+                                    const Eigen::Vector2d& c) {
+  const Eigen::Vector2d ab = b - a, ac = c - a;
+  const double d = 2.0 * (ab.x() * ac.y() - ab.y() * ac.x());
+  if (std::abs(d) < 1e-9 * ab.squaredNorm() * ac.norm() + 1e-12) return std::nullopt;
+  const double ab2 = ab.squaredNorm(), ac2 = ac.squaredNorm();
+  const Eigen::Vector2d o{(ac.y() * ab2 - ab.y() * ac2) / d, (ab.x() * ac2 - ac.x() * ab2) / d};
+  return Circle{a + o, o.norm()};
+}
+
+// Robust weight of a residual given the scale sigma (IRLS).
+double robustWeight(CircleRobustWeight kind, double r, double sigma) {
+  const double a = std::abs(r);
+  switch (kind) {
+    case CircleRobustWeight::Huber: {
+      const double k = 1.345 * sigma;
+      return a <= k ? 1.0 : k / a;
+    }
+    case CircleRobustWeight::Tukey: {
+      const double k = 4.685 * sigma;
+      if (a >= k) return 0.0;
+      const double u = 1.0 - (a / k) * (a / k);
+      return u * u;
+    }
+    case CircleRobustWeight::None:
+      break;
+  }
+  return 1.0;
+}
+
+// Weighted geometric (orthogonal distance) fit by Levenberg-Marquardt: minimises
+// sum w_i (|p_i - c| - R)^2. Returns nothing when it does not converge to a finite circle.
+std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
+                                   const std::vector<double>& w, Circle c) {
+  double lambda = 1e-6;
+  auto cost = [&](const Circle& k) {
+    double s = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double r = residual(k, pts[i]);
+      s += w[i] * r * r;
+    }
+    return s;
+  };
+  double current = cost(c);
+  for (int it = 0; it < 20; ++it) {
+    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const Eigen::Vector2d d = pts[i] - c.centre;
+      const double n = d.norm();
+      if (n < 1e-12 || w[i] == 0.0) continue;
+      const Eigen::Vector3d j{-d.x() / n, -d.y() / n, -1.0};
+      const double r = n - c.radius;
+      jtj.noalias() += w[i] * j * j.transpose();
+      jtr.noalias() += w[i] * j * r;
+    }
+    bool improved = false;
+    for (int tries = 0; tries < 10 && !improved; ++tries) {
+      Eigen::Matrix3d a = jtj;
+      a.diagonal() *= 1.0 + lambda;
+      const Eigen::Vector3d step = a.ldlt().solve(-jtr);
+      if (!step.allFinite()) return std::nullopt;
+      const Circle next{c.centre + step.head<2>(), c.radius + step.z()};
+      const double nextCost = cost(next);
+      if (nextCost <= current) {
+        improved = true;
+        const bool converged = step.norm() < 1e-6;  // pixels: far below the accuracy sought
+        c = next;
+        current = nextCost;
+        lambda = std::max(lambda * 0.1, 1e-12);
+        if (converged) return c;
+      } else {
+        lambda *= 10.0;
+      }
+    }
+    if (!improved) break;  // at the minimum up to rounding
+  }
+  if (!c.centre.allFinite() || !std::isfinite(c.radius) || c.radius <= 0.0) return std::nullopt;
+  return c;
+}
+
+// Angular extent covered by points around `centre`, degrees: 360 minus every gap between
+// neighbouring points wider than a few pixels of arc (the natural spacing of edge points).
+double coverageDeg(const std::vector<Eigen::Vector2d>& pts, const Circle& c) {
+  if (pts.size() < 2) return 0.0;
+  std::vector<double> a;
+  a.reserve(pts.size());
+  for (const auto& p : pts) a.push_back(std::atan2(p.y() - c.centre.y(), p.x() - c.centre.x()));
+  std::sort(a.begin(), a.end());
+  const double maxGap = std::max(3.0 / std::max(c.radius, 1e-6), 2.0 * kPi / 180.0);
+  double uncovered = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double gap = i + 1 < a.size() ? a[i + 1] - a[i] : a.front() + 2.0 * kPi - a.back();
+    if (gap > maxGap) uncovered += gap;
+  }
+  return std::clamp(360.0 - uncovered * 180.0 / kPi, 0.0, 360.0);
+}
+
+CircleMeasurement failed(CircleMeasurement m, CircleFailure f, std::string message) {
+  m.failures |= static_cast<std::uint32_t>(f);
+  if (m.message.empty()) m.message = std::move(message);
+  m.centre = {kNaN, kNaN};
+  m.radius = m.diameter = kNaN;
+  return m;
+}
+
+std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
+  if (image.empty()) return "the image is empty";
+  if (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U))
+    return "the image must be 8-bit or 16-bit single-channel (got type " +
+           std::to_string(image.type()) + ")";
+  if (!std::isfinite(p.centre.x) || !std::isfinite(p.centre.y))
+    return "the expected centre is not finite";
+  if (!(p.radius > 0.0) || !std::isfinite(p.radius))
+    return "the nominal radius must be positive (got " + std::to_string(p.radius) + ")";
+  if (!(p.width > 0.0) || !std::isfinite(p.width))
+    return "the search width must be positive (got " + std::to_string(p.width) + ")";
+  if (!(p.directionToleranceDeg > 0.0 && p.directionToleranceDeg <= 90.0))
+    return "the direction tolerance must be in (0, 90] degrees";
+  if (!(p.ransacThreshold > 0.0)) return "the RANSAC threshold must be positive";
+  if (p.minInliers < 3) return "min inliers must be at least 3";
+  if (!(p.minCoverageDeg >= 0.0 && p.minCoverageDeg <= 360.0))
+    return "min coverage must be in [0, 360] degrees";
+  if (!(p.maxRms > 0.0)) return "max rms must be positive";
+  if (p.cannyLow && p.cannyHigh && *p.cannyLow > *p.cannyHigh)
+    return "the low Canny threshold exceeds the high one";
+  return {};
+}
+
+// Edge point relative to the expected centre, with its radial alignment.
+struct Candidate {
+  Eigen::Vector2d p;
+  double radialCos = 0;  // cosine between the gradient (dark -> light) and the outward radial
+};
+
+}  // namespace
+
+const char* circleFailureName(CircleFailure failure) {
+  switch (failure) {
+    case CircleFailure::None:
+      return "";
+    case CircleFailure::TooFewPoints:
+      return "too_few_points";
+    case CircleFailure::CoverageTooSmall:
+      return "coverage_too_small";
+    case CircleFailure::FitTooPoor:
+      return "fit_too_poor";
+    case CircleFailure::AnnulusOutsideImage:
+      return "annulus_outside_image";
+    case CircleFailure::BadInput:
+      return "bad_input";
+  }
+  return "";
+}
+
+std::string circleFailureCause(std::uint32_t failures) {
+  for (CircleFailure f :
+       {CircleFailure::BadInput, CircleFailure::AnnulusOutsideImage, CircleFailure::TooFewPoints,
+        CircleFailure::CoverageTooSmall, CircleFailure::FitTooPoor})
+    if (failures & static_cast<std::uint32_t>(f)) return circleFailureName(f);
+  return {};
+}
+
+CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams& params) {
+  CircleMeasurement m;
+  if (std::string why = checkParams(image, params); !why.empty())
+    return failed(m, CircleFailure::BadInput, why);
+
+  const double rIn = std::max(0.0, params.radius - params.width);
+  const double rOut = params.radius + params.width;
+  const cv::Point2d c0 = params.centre;
+
+  // Canny thresholds from the annulus alone, then Facet subpixel points (annulus_edges.hpp).
+  const AnnulusEdges edges =
+      detectAnnulusEdges(image, c0, rIn, rOut, params.cannyLow, params.cannyHigh);
+  if (edges.annulusPixels == 0)
+    return failed(m, CircleFailure::AnnulusOutsideImage,
+                  "the search annulus around (" + std::to_string(c0.x) + ", " +
+                      std::to_string(c0.y) + ") with radius " + std::to_string(params.radius) +
+                      " +- " + std::to_string(params.width) + " lies outside the " +
+                      std::to_string(image.cols) + "x" + std::to_string(image.rows) + " image");
+
+  m.lowThreshold = edges.lowThreshold;
+  m.highThreshold = edges.highThreshold;
+  m.edgePoints = static_cast<int>(edges.points.size());
+
+  // Gradient-direction test against the expected centre.
+  const double cosTol = std::cos(params.directionToleranceDeg * kPi / 180.0);
+  std::vector<Candidate> candidates;
+  candidates.reserve(edges.points.size());
+  for (const EdgePoint& e : edges.points) {
+    const Eigen::Vector2d p{e.position.x, e.position.y};
+    const Eigen::Vector2d radial = p - Eigen::Vector2d{c0.x, c0.y};
+    const double d = radial.norm();
+    if (d < rIn || d > rOut || d == 0.0) continue;
+    const double cosA = (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
+    const bool darkToLight = cosA >= cosTol, lightToDark = cosA <= -cosTol;
+    const bool keep = params.polarity == CirclePolarity::DarkToLight   ? darkToLight
+                      : params.polarity == CirclePolarity::LightToDark ? lightToDark
+                                                                       : darkToLight || lightToDark;
+    if (keep) candidates.push_back({p, cosA});
+  }
+  m.candidates = static_cast<int>(candidates.size());
+  if (m.candidates < params.minInliers)
+    return failed(m, CircleFailure::TooFewPoints,
+                  std::to_string(m.candidates) +
+                      " edge points with a radial gradient in the "
+                      "annulus, fewer than the " +
+                      std::to_string(params.minInliers) + " required");
+
+  // RANSAC, once per polarity when either is allowed: a circle's rim has one polarity.
+  RansacParams rp;
+  rp.inlierThreshold = params.ransacThreshold;
+  rp.maxIterations = 500;
+  std::optional<Circle> best;
+  std::vector<Eigen::Vector2d> bestPts;
+  std::size_t bestCount = 0;
+  for (int sign : {+1, -1}) {
+    std::vector<Eigen::Vector2d> pts;
+    for (const Candidate& c : candidates)
+      if (c.radialCos * sign > 0) pts.push_back(c.p);
+    if (static_cast<int>(pts.size()) < params.minInliers || pts.size() <= bestCount) continue;
+    const Eigen::Vector2d e0{c0.x, c0.y};
+    auto fit = [&](const std::vector<std::size_t>& s) -> std::optional<Circle> {
+      auto c = circleThrough(pts[s[0]], pts[s[1]], pts[s[2]]);
+      // A circle that cannot lie in the annulus is clutter, not the rim.
+      if (!c || std::abs(c->radius - params.radius) > params.width ||
+          (c->centre - e0).norm() > params.width)
+        return std::nullopt;
+      return c;
+    };
+    auto res = [&](const Circle& c, std::size_t i) { return std::abs(residual(c, pts[i])); };
+    auto found = ransac<Circle>(pts.size(), 3, fit, res, rp);
+    if (found && found->inliers.size() > bestCount) {
+      bestCount = found->inliers.size();
+      best = found->model;
+      bestPts = std::move(pts);
+    }
+  }
+  if (!best || static_cast<int>(bestCount) < params.minInliers)
+    return failed(m, CircleFailure::TooFewPoints,
+                  "no circle with at least " + std::to_string(params.minInliers) +
+                      " consistent edge points in the annulus");
+
+  // Geometric fit on the RANSAC inliers, then re-collect the inliers around the refined circle
+  // and refit with the robust weight.
+  Circle circle = *best;
+  std::vector<Eigen::Vector2d> in;
+  std::vector<double> w;
+  for (int round = 0; round < 2; ++round) {
+    in.clear();
+    for (const auto& p : bestPts)
+      if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
+    if (static_cast<int>(in.size()) < params.minInliers) break;
+    w.assign(in.size(), 1.0);
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 3;
+    for (int k = 0; k < irls; ++k) {
+      if (k > 0) {
+        std::vector<double> a;
+        a.reserve(in.size());
+        for (const auto& p : in) a.push_back(std::abs(residual(circle, p)));
+        std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+        const double sigma = std::max(1.4826 * a[a.size() / 2], 0.01);
+        for (std::size_t i = 0; i < in.size(); ++i)
+          w[i] = robustWeight(params.robustWeight, residual(circle, in[i]), sigma);
+      }
+      auto refined = fitGeometric(in, w, circle);
+      if (!refined)
+        return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
+      circle = *refined;
+    }
+  }
+  m.inliers = static_cast<int>(in.size());
+  m.inlierPoints.reserve(in.size());
+  double sum2 = 0, lo = 0, hi = 0;
+  for (const auto& p : in) {
+    const double r = residual(circle, p);
+    sum2 += r * r;
+    lo = std::min(lo, r);
+    hi = std::max(hi, r);
+    m.inlierPoints.emplace_back(p.x(), p.y());
+  }
+  m.rms = in.empty() ? 0.0 : std::sqrt(sum2 / static_cast<double>(in.size()));
+  m.roundness = hi - lo;
+  m.coverageDeg = coverageDeg(in, circle);
+  m.centre = {circle.centre.x(), circle.centre.y()};
+  m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
+  if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
+    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints)) {
+      m.centre = fine->centre;
+      m.radius = fine->radius;
+      m.blur = fine->blur;
+      m.greyRefined = true;
+    }
+  }
+  m.diameter = 2.0 * m.radius;
+
+  if (m.inliers < params.minInliers)
+    return failed(m, CircleFailure::TooFewPoints,
+                  std::to_string(m.inliers) + " inliers, fewer than the " +
+                      std::to_string(params.minInliers) + " required");
+  if (m.coverageDeg < params.minCoverageDeg)
+    return failed(m, CircleFailure::CoverageTooSmall,
+                  "the inliers cover " + std::to_string(m.coverageDeg) + " degrees, less than " +
+                      std::to_string(params.minCoverageDeg));
+  if (m.rms > params.maxRms)
+    return failed(
+        m, CircleFailure::FitTooPoor,
+        "the fit's rms " + std::to_string(m.rms) + " px exceeds " + std::to_string(params.maxRms));
+  if (std::abs(m.radius - params.radius) > params.width ||
+      std::hypot(m.centre.x - c0.x, m.centre.y - c0.y) > params.width)
+    return failed(m, CircleFailure::FitTooPoor, "the fitted circle leaves the search annulus");
+  return m;
+}
+
+}  // namespace facet

@@ -1,0 +1,130 @@
+#pragma once
+// CircleMeasure: robust subpixel measurement of one circle (hole, bore, round part) in an annulus
+// around its expected position.
+//
+// Pipeline (seed dissertation, part 2):
+//   1. annulus [radius - width, radius + width] around the expected centre;
+//   2. Canny inside the annulus, both hysteresis thresholds chosen from that annulus alone;
+//   3. subpixel Facet-model edge points (algorithms/edges), with the curvature bias corrected;
+//   4. outliers removed by gradient direction: near-radial within a tolerance, expected polarity;
+//   5. RANSAC circle, then a geometric (orthogonal distance) least-squares fit on the inliers by
+//      Levenberg-Marquardt, optionally with a robust Huber/Tukey weight (IRLS).
+//
+// Failures are reported as flags with a cause and a message, never as a bogus circle: when
+// `ok()` is false the centre, radius and diameter are NaN.
+//
+// Coordinates: x right, y down, centre of pixel (0,0) at (0,0). Lengths in pixels.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace facet {
+
+// Grey-value change when crossing the circle from its inside to its outside.
+enum class CirclePolarity {
+  DarkToLight,  // dark inside, light outside (a dark disc on a light background, a dark hole)
+  LightToDark,  // light inside, dark outside (a bright disc, a backlit hole)
+  Any,          // either, as long as all inliers agree with the circle (the fit decides)
+};
+
+// Weight of the final least-squares fit (iteratively reweighted).
+enum class CircleRobustWeight {
+  None,   // plain least squares
+  Huber,  // Huber weight, tuning constant 1.345 sigma
+  Tukey,  // Tukey biweight, tuning constant 4.685 sigma
+};
+
+struct CircleMeasureParams {
+  // Expected centre, image pixels (from a shape match or the recipe). No default: must be set.
+  cv::Point2d centre{-1.0, -1.0};
+  // Nominal radius, pixels (> 0). No default: must be set.
+  double radius = 0.0;
+  // Half-width of the search annulus, pixels: edges are searched at distances
+  // [radius - width, radius + width] from `centre`. It must cover the coarse position error plus
+  // the radius tolerance. Default 5.
+  double width = 5.0;
+  // Expected polarity of the rim. Default Any.
+  CirclePolarity polarity = CirclePolarity::Any;
+  // Maximum angle between an edge point's gradient and the radial direction from `centre`,
+  // degrees. Default 25 (a coarse centre off by 2 px tilts the normals of an r = 10 circle by
+  // about 12 degrees).
+  double directionToleranceDeg = 25.0;
+  // Hysteresis thresholds of Canny, grey levels per pixel (8-bit scale). Unset (default): both
+  // are chosen automatically from the annulus alone.
+  std::optional<double> cannyLow;
+  std::optional<double> cannyHigh;
+  // RANSAC inlier threshold on the orthogonal distance to the circle, pixels. Default 0.5.
+  double ransacThreshold = 0.5;
+  // Minimum number of inliers of the final fit. Default 12.
+  int minInliers = 12;
+  // Minimum angular coverage of the inliers, degrees (0..360). Partial arcs down to this extent
+  // are measured. Default 120 (a rim one third hidden still measures).
+  double minCoverageDeg = 120.0;
+  // Robust weight of the geometric fit. Default Tukey.
+  CircleRobustWeight robustWeight = CircleRobustWeight::Tukey;
+  // Largest acceptable RMS of the inliers' orthogonal residuals, pixels. Default 0.5.
+  double maxRms = 0.5;
+  // Final grey-value refinement (circle_profile_fit.hpp): fits a blurred-disc model to every
+  // pixel of a band around the rim where the inliers lie; reaches the Cramer-Rao bound of small
+  // circles and corrects the curvature bias from the fitted blur. Default on.
+  bool refineWithGreyValues = true;
+  // Without the grey-value refinement (or when it fails): correct the radial bias of
+  // second-derivative edges on a curved, blurred rim, which puts the fitted radius about
+  // radiusBiasK / radius pixels too small. Default on.
+  bool correctRadiusBias = true;
+  // Curvature-bias constant k of the edge-point fit, pixels^2 (bias = -k / r). The default was
+  // measured with the Facet 5x5 operator on discs blurred with a Gaussian PSF of sigma 1 px
+  // (bench_circle --no-grey-refinement --no-bias-correction prints it); it grows with the blur
+  // variance of the optics (about (sigma^2 + 1.2) / 2).
+  double radiusBiasK = 1.1;
+};
+
+// Failure causes; CircleMeasurement::failures is a bit set of these.
+enum class CircleFailure : std::uint32_t {
+  None = 0,
+  TooFewPoints = 1u << 0,         // fewer than minInliers edge points / inliers
+  CoverageTooSmall = 1u << 1,     // inliers cover less than minCoverageDeg
+  FitTooPoor = 1u << 2,           // RMS of the inliers above maxRms, or the fit did not converge
+  AnnulusOutsideImage = 1u << 3,  // the search annulus does not lie (enough) inside the image
+  BadInput = 1u << 4,             // empty image, wrong type, radius <= 0, width <= 0, NaN, ...
+};
+
+struct CircleMeasurement {
+  cv::Point2d centre{};       // pixels; NaN when !ok()
+  double radius = 0.0;        // pixels; NaN when !ok()
+  double diameter = 0.0;      // pixels; NaN when !ok()
+  double roundness = 0.0;     // max minus min signed radial deviation of the inliers, pixels
+  double rms = 0.0;           // RMS of the inliers' orthogonal residuals, pixels
+  int edgePoints = 0;         // subpixel edge points found in the annulus
+  int candidates = 0;         // edge points left after the gradient-direction test
+  int inliers = 0;            // inliers of the final fit
+  double coverageDeg = 0.0;   // angular extent covered by the inliers, degrees
+  bool greyRefined = false;   // centre and radius come from the grey-value refinement
+  double blur = 0.0;          // blur fitted by the grey-value refinement, pixels (0 without)
+  double lowThreshold = 0.0;  // Canny thresholds actually used
+  double highThreshold = 0.0;
+  std::vector<cv::Point2d> inlierPoints;  // subpixel edge points of the fit, for display
+
+  std::uint32_t failures = 0;  // bit set of CircleFailure
+  std::string message;         // human-readable cause when !ok()
+
+  [[nodiscard]] bool ok() const { return failures == 0; }
+  [[nodiscard]] bool has(CircleFailure f) const {
+    return (failures & static_cast<std::uint32_t>(f)) != 0;
+  }
+};
+
+// Machine-readable snake_case name of one failure cause ("too_few_points", ...).
+const char* circleFailureName(CircleFailure failure);
+// Name of the first (most fundamental) cause in a failure bit set; "" when there is none.
+std::string circleFailureCause(std::uint32_t failures);
+
+// Measures one circle in an 8-bit or 16-bit single-channel image. Never throws for bad input:
+// the result carries BadInput and a message instead.
+CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams& params);
+
+}  // namespace facet

@@ -1,0 +1,145 @@
+#include "algorithms/edges/canny.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+namespace facet {
+namespace {
+
+// 5x5 Sobel gain: binomial [1 4 6 4 1] sums to 16, the derivative [-1 -2 0 2 1] gives 8 per unit
+// slope, so a ramp of one grey level per pixel reads 128.
+constexpr double kSobelGain = 128.0;
+
+void requireGreyImage(const cv::Mat& image) {
+  if (image.empty()) throw std::invalid_argument("edges: the image is empty");
+  if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
+    throw std::invalid_argument("edges: expected an 8-bit or 16-bit single-channel image, got " +
+                                cv::typeToString(image.type()));
+}
+
+template <typename T>
+void magnitudeOf(const cv::Mat& gx, const cv::Mat& gy, float scale, cv::Mat& mag) {
+  mag.create(gx.size(), CV_32F);
+  for (int y = 0; y < gx.rows; ++y) {
+    const T* a = gx.ptr<T>(y);
+    const T* b = gy.ptr<T>(y);
+    float* m = mag.ptr<float>(y);
+    for (int x = 0; x < gx.cols; ++x) {
+      const float fa = static_cast<float>(a[x]), fb = static_cast<float>(b[x]);
+      m[x] = scale * std::sqrt(fa * fa + fb * fb);
+    }
+  }
+}
+
+// Non-maximum suppression along the image axis nearest to the gradient, then hysteresis.
+// Ties are broken towards the left/upper pixel so that a plateau of two equal magnitudes yields
+// one pixel. state: 0 = no, 1 = candidate, 2 = edge.
+template <typename T>
+void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask, cv::Rect area,
+              cv::Mat& state, std::vector<cv::Point>& strong) {
+  const size_t step = g.magnitude.step1();
+  for (int y = area.y; y < area.y + area.height; ++y) {
+    const float* m = g.magnitude.ptr<float>(y);
+    const T* gx = g.gx.ptr<T>(y);
+    const T* gy = g.gy.ptr<T>(y);
+    const uchar* k = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+    uchar* s = state.ptr<uchar>(y);
+    for (int x = area.x; x < area.x + area.width; ++x) {
+      const float v = m[x];
+      if (v < low || (k && !k[x])) continue;
+      const bool horizontal = std::abs(gx[x]) >= std::abs(gy[x]);
+      const float before = horizontal ? m[x - 1] : m[x - step];
+      const float after = horizontal ? m[x + 1] : m[x + step];
+      if (!(v > before && v >= after)) continue;
+      s[x] = 1;
+      if (v >= high) {
+        s[x] = 2;
+        strong.emplace_back(x, y);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+EdgeGradient computeEdgeGradient(const cv::Mat& image, cv::Rect area) {
+  requireGreyImage(image);
+  const cv::Rect full(0, 0, image.cols, image.rows);
+  area = area.empty() ? full : (area & full);
+  EdgeGradient g;
+  g.area = area;
+  if (area.empty()) return g;
+  // Take two pixels of context around the area so that its border gradients see real data.
+  const cv::Rect outer = cv::Rect(area.x - 2, area.y - 2, area.width + 4, area.height + 4) & full;
+  const cv::Rect inner(area.x - outer.x, area.y - outer.y, area.width, area.height);
+  const cv::Mat src = image(outer);
+  const bool eightBit = image.depth() == CV_8U;
+  g.scale = (eightBit ? 1.0 : 1.0 / 256.0) / kSobelGain;
+  cv::Mat dx, dy;
+  const int ddepth = eightBit ? CV_16S : CV_32F;
+  cv::Sobel(src, dx, ddepth, 1, 0, 5, 1, 0, cv::BORDER_REPLICATE);
+  cv::Sobel(src, dy, ddepth, 0, 1, 5, 1, 0, cv::BORDER_REPLICATE);
+  g.gx = dx(inner);
+  g.gy = dy(inner);
+  if (eightBit)
+    magnitudeOf<short>(g.gx, g.gy, static_cast<float>(g.scale), g.magnitude);
+  else
+    magnitudeOf<float>(g.gx, g.gy, static_cast<float>(g.scale), g.magnitude);
+  return g;
+}
+
+cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,
+                          const cv::Mat& mask, cv::Rect candidates) {
+  const cv::Size size = gradient.area.size();
+  cv::Mat state = cv::Mat::zeros(size, CV_8U);
+  if (size.empty()) return state;
+  if (!mask.empty() && (mask.size() != size || mask.type() != CV_8UC1))
+    throw std::invalid_argument("edges: the mask must be CV_8UC1 of the region's size");
+  const cv::Rect inside(1, 1, size.width - 2, size.height - 2);
+  candidates = candidates.empty() ? cv::Rect(2, 2, size.width - 4, size.height - 4) & inside
+                                  : candidates & inside;
+  const auto lowF = static_cast<float>(low);
+  const auto highF = static_cast<float>(std::max(low, high));
+
+  std::vector<cv::Point> stack;
+  if (gradient.gx.depth() == CV_16S)
+    suppress<short>(gradient, lowF, highF, mask, candidates, state, stack);
+  else
+    suppress<float>(gradient, lowF, highF, mask, candidates, state, stack);
+  // Hysteresis: grow the strong pixels through 8-connected candidates (state 0 at the border of
+  // `inside`, so the neighbours are always in the image).
+  while (!stack.empty()) {
+    const cv::Point p = stack.back();
+    stack.pop_back();
+    for (int dy = -1; dy <= 1; ++dy) {
+      auto* s = state.ptr<uchar>(p.y + dy);
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (s[p.x + dx] == 1) {
+          s[p.x + dx] = 2;
+          stack.emplace_back(p.x + dx, p.y + dy);
+        }
+      }
+    }
+  }
+  // 2 -> 255, everything else -> 0.
+  cv::compare(state, 2, state, cv::CMP_EQ);
+  return state;
+}
+
+cv::Mat cannyEdges(const cv::Mat& image, double low, double high, cv::Rect roi,
+                   const cv::Mat& mask) {
+  const EdgeGradient g = computeEdgeGradient(image, roi);
+  cv::Mat localMask;
+  if (!mask.empty()) {
+    if (mask.size() != image.size() || mask.type() != CV_8UC1)
+      throw std::invalid_argument("edges: the mask must be CV_8UC1 of the image's size");
+    localMask = mask(g.area);
+  }
+  return cannyFromGradient(g, low, high, localMask);
+}
+
+}  // namespace facet

@@ -1,0 +1,113 @@
+#include "algorithms/edges/subpixel_edges.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <stdexcept>
+
+#include "algorithms/edges/auto_thresholds.hpp"
+#include "algorithms/edges/canny.hpp"
+#include "algorithms/edges/curvature_bias.hpp"
+#include "algorithms/edges/edge_linking.hpp"
+#include "algorithms/edges/edge_profile_fit.hpp"
+#include "algorithms/edges/facet_model.hpp"
+
+namespace facet {
+namespace {
+
+// Keep a point when the edge line crosses the pixel's row (steep edges) or column (flat edges)
+// inside the pixel: one point per row or column crossing, never two on a diagonal.
+bool crossesInsidePixel(const EdgePoint& point, cv::Point pixel) {
+  const double rho = (point.position - cv::Point2d(pixel)).dot(point.normal);
+  const double axis = std::max(std::abs(point.normal.x), std::abs(point.normal.y));
+  return std::abs(rho) <= 0.5 * axis;
+}
+
+}  // namespace
+
+EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params) {
+  EdgeContours result;
+  if (image.empty()) return result;
+  if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
+    throw std::invalid_argument(
+        "detectSubpixelEdges: expected an 8-bit or 16-bit single-channel image, got " +
+        cv::typeToString(image.type()));
+  if (!params.mask.empty() && (params.mask.size() != image.size() || params.mask.type() != CV_8UC1))
+    throw std::invalid_argument(
+        "detectSubpixelEdges: the mask must be CV_8UC1 of the image's size");
+
+  const cv::Rect full(0, 0, image.cols, image.rows);
+  const cv::Rect roi = params.roi.empty() ? full : (params.roi & full);
+  if (roi.empty()) return result;
+
+  // The gradient covers the ROI plus one pixel for suppression; edge pixels need the facet's
+  // 5x5 window inside the image.
+  const cv::Rect area = cv::Rect(roi.x - 1, roi.y - 1, roi.width + 2, roi.height + 2) & full;
+  const EdgeGradient gradient = computeEdgeGradient(image, area);
+  const cv::Rect usable = cv::Rect(2, 2, image.cols - 4, image.rows - 4) & roi;
+  if (usable.empty()) return result;
+  const cv::Rect candidates = usable - area.tl();
+  const cv::Mat mask = params.mask.empty() ? cv::Mat() : params.mask(area);
+
+  if (params.low && params.high) {
+    result.lowThreshold = *params.low;
+    result.highThreshold = *params.high;
+  } else {
+    cv::Mat region = cv::Mat::zeros(area.size(), CV_8U);
+    region(candidates).setTo(255);
+    if (!mask.empty()) region &= mask;
+    const CannyThresholds t = autoCannyThresholds(gradient.magnitude, region);
+    result.lowThreshold = t.low;
+    result.highThreshold = t.high;
+  }
+  const cv::Mat edges =
+      cannyFromGradient(gradient, result.lowThreshold, result.highThreshold, mask, candidates);
+
+  // Facet zero crossings of every Canny pixel.
+  std::vector<EdgeSeed> seeds;
+  std::vector<double> magnitudes, curvatures;
+  for (int y = candidates.y; y < candidates.y + candidates.height; ++y) {
+    const auto* e = edges.ptr<uchar>(y);
+    for (int x = candidates.x; x < candidates.x + candidates.width; ++x) {
+      if (!e[x]) continue;
+      const cv::Point p = cv::Point(x, y) + area.tl();
+      const auto z = facetZeroCrossing(fitCubicFacet(image, p));
+      if (!z || std::abs(z->rho) > 1.0) continue;
+      seeds.push_back({p, z->normal, z->rho});
+      curvatures.push_back(z->curvature);
+      magnitudes.push_back(z->magnitude);
+    }
+  }
+
+  // Profile refinement where its window fits in the image, with one blur width per image.
+  EdgeProfileParams profile;
+  const int reach = edgeProfileReach(profile);
+  const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
+  if (params.fitProfile) profile.width = estimateEdgeWidth(image, seeds, profile);
+  std::vector<cv::Point> pixels;
+  result.points.reserve(seeds.size());
+  pixels.reserve(seeds.size());
+  for (size_t i = 0; i < seeds.size(); ++i) {
+    const EdgeSeed& s = seeds[i];
+    EdgePoint point{cv::Point2d(s.pixel) + s.offset * s.normal, s.normal, magnitudes[i]};
+    if (params.fitProfile && fitArea.contains(s.pixel)) {
+      EdgeProfileParams local = profile;
+      local.halfAlong = profileHalfAlong(curvatures[i], profile);
+      const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, local);
+      if (!refined) continue;
+      point = *refined;
+    }
+    if (!crossesInsidePixel(point, s.pixel)) continue;
+    result.points.push_back(point);
+    pixels.push_back(s.pixel);
+  }
+
+  if (params.linkContours || params.correctCurvatureBias) {
+    result.contours = linkEdgePoints(result.points, pixels);
+    if (params.correctCurvatureBias) correctCurvatureBias(result.points, result.contours);
+    if (!params.linkContours) result.contours.clear();
+  }
+  return result;
+}
+
+}  // namespace facet

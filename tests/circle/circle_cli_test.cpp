@@ -1,0 +1,113 @@
+// `facet circle` end to end: a generated scene written to disk, the real binary, its JSON.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/support/scene/scene.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exitCode = -1;
+  std::string out, err;
+};
+
+CliRun facet(const std::string& args) {
+  const fs::path errFile =
+      fs::temp_directory_path() / ("facet_circle_cli_err_" + std::to_string(::getpid()) + ".txt");
+  const std::string cmd = std::string(FACET_CLI) + " " + args + " 2>" + errFile.string();
+  CliRun r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.out.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(errFile);
+  r.err.assign(std::istreambuf_iterator<char>(in), {});
+  fs::remove(errFile);
+  return r;
+}
+
+class CircleCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("facet_circle_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    facet::scene::SceneSpec spec;
+    spec.size = {160, 140};
+    spec.background = 60;
+    spec.blurSigma = 1.0;
+    spec.noiseSigma = 2.0;
+    spec.subrows = 64;
+    facet::scene::Scene s(spec);
+    s.addDisc(centre_, 40.3, 170);
+    image_ = (dir_ / "disc.png").string();
+    s.write(image_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_;
+  std::string image_;
+  cv::Point2d centre_{80.4, 69.7};
+};
+
+TEST_F(CircleCli, PrintsOneJsonObjectWithTheCircle) {
+  const CliRun r = facet("circle --image " + image_ +
+                         " --center 81,69 --radius 40 --polarity light_to_dark --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j.at("x").get<double>(), centre_.x, 0.05);
+  EXPECT_NEAR(j.at("y").get<double>(), centre_.y, 0.05);
+  EXPECT_NEAR(j.at("radius").get<double>(), 40.3, 0.05);
+  EXPECT_GT(j.at("inliers").get<int>(), 100);
+  EXPECT_GT(j.at("coverage_deg").get<double>(), 350.0);
+  EXPECT_LT(j.at("rms").get<double>(), 0.2);
+  EXPECT_GE(j.at("roundness").get<double>(), 0.0);
+  EXPECT_GE(j.at("time_ms").get<double>(), 0.0);
+}
+
+TEST_F(CircleCli, MeasurementFailureIsAJsonErrorWithItsCause) {
+  // The disc is light inside: asking for a dark-to-light rim finds nothing.
+  const CliRun r = facet("circle --image " + image_ +
+                         " --center 81,69 --radius 40 --width 3 --polarity dark_to_light --json");
+  EXPECT_EQ(r.exitCode, 2);
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("error").at("cause"), "too_few_points");
+  EXPECT_NE(j.at("error").at("message").get<std::string>().find("disc.png"), std::string::npos);
+
+  const CliRun outside = facet("circle --image " + image_ + " --center 900,900 --radius 20 --json");
+  EXPECT_EQ(outside.exitCode, 2);
+  EXPECT_EQ(nlohmann::json::parse(outside.out).at("error").at("cause"), "annulus_outside_image");
+}
+
+TEST_F(CircleCli, BadInputNamesTheFileOrTheOption) {
+  const CliRun missing = facet("circle --image " + (dir_ / "nope.png").string() +
+                               " --center 81,69 --radius 40 --json");
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("nope.png"), std::string::npos) << missing.err;
+
+  const CliRun zero = facet("circle --image " + image_ + " --center 81,69 --radius 0 --json");
+  EXPECT_EQ(zero.exitCode, 1);
+  EXPECT_NE(zero.err.find("radius"), std::string::npos) << zero.err;
+
+  const CliRun centre = facet("circle --image " + image_ + " --center 81 --radius 40");
+  EXPECT_EQ(centre.exitCode, 1);
+  EXPECT_NE(centre.err.find("--center"), std::string::npos) << centre.err;
+
+  const CliRun polarity =
+      facet("circle --image " + image_ + " --center 81,69 --radius 40 --polarity up");
+  EXPECT_EQ(polarity.exitCode, 1);
+  EXPECT_NE(polarity.err.find("--polarity"), std::string::npos) << polarity.err;
+}
+
+}  // namespace

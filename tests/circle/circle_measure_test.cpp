@@ -1,0 +1,242 @@
+// CircleMeasure on generated scenes with exact ground truth: accuracy for both polarities, a ring
+// measured as two concentric circles, partial arcs, every failure flag and bad input.
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "algorithms/circle/circle_measure.hpp"
+#include "tests/support/scene/scene.hpp"
+
+namespace facet {
+namespace {
+
+using scene::Scene;
+using scene::SceneSpec;
+
+SceneSpec spec(int side, double background, int depth = CV_8U) {
+  SceneSpec s;
+  s.size = {side, side};
+  s.background = background;
+  s.blurSigma = 1.0;
+  s.noiseSigma = 2.0;
+  s.depth = depth;
+  s.subrows = 64;
+  return s;
+}
+
+CircleMeasureParams params(cv::Point2d centre, double radius, CirclePolarity polarity) {
+  CircleMeasureParams p;
+  p.centre = centre;
+  p.radius = radius;
+  p.polarity = polarity;
+  return p;
+}
+
+void expectCircle(const CircleMeasurement& m, cv::Point2d centre, double radius, double tol) {
+  ASSERT_TRUE(m.ok()) << m.message;
+  EXPECT_NEAR(m.centre.x, centre.x, tol);
+  EXPECT_NEAR(m.centre.y, centre.y, tol);
+  EXPECT_NEAR(m.radius, radius, tol);
+  EXPECT_NEAR(m.diameter, 2 * radius, 2 * tol);
+  EXPECT_LT(m.rms, 0.2);
+  EXPECT_GT(m.coverageDeg, 350.0);
+  EXPECT_EQ(static_cast<std::size_t>(m.inliers), m.inlierPoints.size());
+  EXPECT_GE(m.roundness, 0.0);
+  EXPECT_LT(m.roundness, 1.0);
+}
+
+TEST(CircleMeasure, LightDiscAtSubpixelCentresFromAnOffsetStart) {
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (double radius : {12.3, 37.8, 80.4}) {
+    const int side = static_cast<int>(2 * radius + 40);
+    Scene s(spec(side, 60));
+    const cv::Point2d c{side / 2.0 + u(rng), side / 2.0 - u(rng)};
+    s.addDisc(c, radius, 160);
+    const auto m = measureCircle(s.render(), params(c + cv::Point2d(1.5, -1.0), std::round(radius),
+                                                    CirclePolarity::LightToDark));
+    SCOPED_TRACE(radius);
+    expectCircle(m, c, radius, 0.05);
+  }
+}
+
+TEST(CircleMeasure, DarkHoleAndPolarityIsRespected) {
+  Scene s(spec(140, 170));
+  const cv::Point2d c{70.31, 68.77};
+  s.addDisc(c, 40.2, 60, "hole");
+  const cv::Mat image = s.render();
+  expectCircle(measureCircle(image, params({71, 68}, 40, CirclePolarity::DarkToLight)), c, 40.2,
+               0.05);
+  expectCircle(measureCircle(image, params({71, 68}, 40, CirclePolarity::Any)), c, 40.2, 0.05);
+  // The wrong polarity finds no rim: a flag, not a circle.
+  const auto wrong = measureCircle(image, params({71, 68}, 40, CirclePolarity::LightToDark));
+  EXPECT_FALSE(wrong.ok());
+  EXPECT_TRUE(wrong.has(CircleFailure::TooFewPoints)) << wrong.message;
+  EXPECT_TRUE(std::isnan(wrong.radius));
+  EXPECT_TRUE(std::isnan(wrong.centre.x));
+}
+
+TEST(CircleMeasure, RingIsTwoConcentricMeasurementsWithOppositePolarity) {
+  // A light washer (outer radius 50) with a dark bore (radius 25) on a dark background.
+  Scene s(spec(150, 50));
+  const cv::Point2d c{74.6, 75.2};
+  s.addDisc(c, 50.4, 180);
+  s.addDisc(c, 25.3, 50, "hole");
+  const cv::Mat image = s.render();
+  const auto outer = measureCircle(image, params({75, 75}, 50, CirclePolarity::LightToDark));
+  const auto inner = measureCircle(image, params({75, 75}, 25, CirclePolarity::DarkToLight));
+  expectCircle(outer, c, 50.4, 0.05);
+  expectCircle(inner, c, 25.3, 0.05);
+  EXPECT_NEAR(outer.centre.x, inner.centre.x, 0.05);
+  EXPECT_NEAR(outer.centre.y, inner.centre.y, 0.05);
+}
+
+TEST(CircleMeasure, SixteenBitImage) {
+  Scene s(spec(120, 60, CV_16U));
+  const cv::Point2d c{60.2, 59.6};
+  s.addDisc(c, 30.7, 160);
+  const cv::Mat image = s.render();
+  ASSERT_EQ(image.depth(), CV_16U);
+  expectCircle(measureCircle(image, params({61, 59}, 31, CirclePolarity::LightToDark)), c, 30.7,
+               0.05);
+}
+
+// A disc whose right part is cut away by a straight edge: only an arc of the rim remains.
+cv::Mat partialDisc(cv::Point2d c, double radius, double keepDeg) {
+  Scene s(spec(160, 60));
+  s.addDisc(c, radius, 160);
+  // The occluding half-plane starts where the kept arc ends (arc symmetric about the left).
+  const double x = c.x + radius * std::cos((180.0 - keepDeg / 2.0) * std::numbers::pi / 180.0);
+  s.addPolygon({{x, -10}, {200, -10}, {200, 200}, {x, 200}}, 60, "occluder");
+  return s.render();
+}
+
+TEST(CircleMeasure, PartialArcWithMinimumCoverage) {
+  const cv::Point2d c{90.4, 80.3};
+  const cv::Mat image = partialDisc(c, 50.2, 140);
+  auto p = params({90, 80}, 50, CirclePolarity::LightToDark);
+  p.minCoverageDeg = 100;
+  const auto m = measureCircle(image, p);
+  ASSERT_TRUE(m.ok()) << m.message;
+  EXPECT_NEAR(m.centre.x, c.x, 0.1);
+  EXPECT_NEAR(m.centre.y, c.y, 0.1);
+  EXPECT_NEAR(m.radius, 50.2, 0.1);
+  EXPECT_GT(m.coverageDeg, 115.0);
+  EXPECT_LT(m.coverageDeg, 150.0);
+}
+
+TEST(CircleMeasure, CoverageTooSmallIsAFlag) {
+  const cv::Mat image = partialDisc({90.4, 80.3}, 50.2, 100);
+  auto p = params({90, 80}, 50, CirclePolarity::LightToDark);
+  p.minCoverageDeg = 180;
+  const auto m = measureCircle(image, p);
+  EXPECT_FALSE(m.ok());
+  EXPECT_TRUE(m.has(CircleFailure::CoverageTooSmall)) << m.message;
+  EXPECT_EQ(circleFailureCause(m.failures), "coverage_too_small");
+  EXPECT_LT(m.coverageDeg, 180.0);
+  EXPECT_GT(m.coverageDeg, 60.0);
+  EXPECT_TRUE(std::isnan(m.radius));
+}
+
+TEST(CircleMeasure, TooFewPointsOnAFlatImage) {
+  Scene s(spec(100, 90));
+  const auto m = measureCircle(s.render(), params({50, 50}, 20, CirclePolarity::Any));
+  EXPECT_FALSE(m.ok());
+  EXPECT_TRUE(m.has(CircleFailure::TooFewPoints)) << m.message;
+  EXPECT_EQ(circleFailureCause(m.failures), "too_few_points");
+  EXPECT_TRUE(std::isnan(m.centre.x));
+}
+
+TEST(CircleMeasure, FitTooPoorOnAWavyRim) {
+  // A 12-sided rim with rounded-off detail: the edge points lie on a star, not a circle; with a
+  // tight rms limit the fit is rejected as too poor rather than reported.
+  Scene s(spec(140, 60));
+  std::vector<cv::Point2d> star;
+  const cv::Point2d c{70, 70};
+  for (int i = 0; i < 72; ++i) {
+    const double a = 2 * std::numbers::pi * i / 72;
+    const double r = 40 + 1.2 * std::sin(12 * a);
+    star.push_back({c.x + r * std::cos(a), c.y + r * std::sin(a)});
+  }
+  s.addPolygon(star, 170);
+  const cv::Mat image = s.render();
+  auto p = params(c, 40, CirclePolarity::LightToDark);
+  p.ransacThreshold = 2.0;  // accept the wavy rim as one circle ...
+  p.robustWeight = CircleRobustWeight::None;
+  p.maxRms = 0.3;  // ... but not its residuals
+  const auto m = measureCircle(image, p);
+  EXPECT_FALSE(m.ok());
+  EXPECT_TRUE(m.has(CircleFailure::FitTooPoor)) << m.message;
+  EXPECT_EQ(circleFailureCause(m.failures), "fit_too_poor");
+  EXPECT_GT(m.rms, 0.3);
+  EXPECT_GT(m.roundness, 1.5);  // the wave's peak to peak is 2.4 px
+  // A generous limit accepts the same rim and reports its roundness.
+  p.maxRms = 2.0;
+  const auto loose = measureCircle(image, p);
+  ASSERT_TRUE(loose.ok()) << loose.message;
+  EXPECT_GT(loose.roundness, 1.5);
+  EXPECT_LT(loose.roundness, 3.5);
+}
+
+TEST(CircleMeasure, BadInputIsAFlagWithAClearMessage) {
+  Scene s(spec(100, 60));
+  s.addDisc({50, 50}, 20, 160);
+  const cv::Mat image = s.render();
+  const auto p = params({50, 50}, 20, CirclePolarity::Any);
+
+  const auto empty = measureCircle(cv::Mat(), p);
+  EXPECT_TRUE(empty.has(CircleFailure::BadInput));
+  EXPECT_NE(empty.message.find("empty"), std::string::npos) << empty.message;
+
+  cv::Mat colour;
+  cv::Mat channels[] = {image, image, image};
+  cv::merge(channels, 3, colour);
+  const auto wrongType = measureCircle(colour, p);
+  EXPECT_TRUE(wrongType.has(CircleFailure::BadInput));
+  EXPECT_NE(wrongType.message.find("single-channel"), std::string::npos) << wrongType.message;
+  cv::Mat floating;
+  image.convertTo(floating, CV_32F);
+  EXPECT_TRUE(measureCircle(floating, p).has(CircleFailure::BadInput));
+
+  auto zero = p;
+  zero.radius = 0;
+  const auto r0 = measureCircle(image, zero);
+  EXPECT_TRUE(r0.has(CircleFailure::BadInput));
+  EXPECT_NE(r0.message.find("radius"), std::string::npos) << r0.message;
+  EXPECT_EQ(circleFailureCause(r0.failures), "bad_input");
+
+  auto nan = p;
+  nan.centre.x = std::nan("");
+  EXPECT_TRUE(measureCircle(image, nan).has(CircleFailure::BadInput));
+
+  auto outside = p;
+  outside.centre = {400, -300};
+  const auto out = measureCircle(image, outside);
+  EXPECT_TRUE(out.has(CircleFailure::AnnulusOutsideImage)) << out.message;
+  EXPECT_EQ(circleFailureCause(out.failures), "annulus_outside_image");
+  EXPECT_NE(out.message.find("outside"), std::string::npos) << out.message;
+  EXPECT_TRUE(std::isnan(out.radius));
+}
+
+TEST(CircleMeasure, ClutterAndOcclusionDoNotPullTheFit) {
+  SceneSpec sp = spec(200, 60);
+  sp.illuminationGradient = {0.2, -0.15};
+  Scene s(sp);
+  const cv::Point2d c{100.3, 99.6};
+  s.addDisc(c, 60.2, 170);
+  s.addDisc({c.x + 60, c.y}, 3, 250, "clutter");
+  s.addDisc({c.x, c.y - 59}, 2.5, 20, "clutter");
+  s.addOccluder({c.x - 60.2, c.y - 60.2, 120.4, 120.4}, 0.206, 120);
+  const auto m = measureCircle(s.render(), params({101, 98.5}, 60, CirclePolarity::LightToDark));
+  ASSERT_TRUE(m.ok()) << m.message;
+  EXPECT_NEAR(m.centre.x, c.x, 0.05);
+  EXPECT_NEAR(m.centre.y, c.y, 0.05);
+  EXPECT_NEAR(m.radius, 60.2, 0.05);
+  EXPECT_LT(m.coverageDeg, 290.0);
+  EXPECT_GT(m.coverageDeg, 200.0);
+}
+
+}  // namespace
+}  // namespace facet
