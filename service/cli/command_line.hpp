@@ -31,6 +31,7 @@ void printJson(const nlohmann::json& object);
 // Every subcommand is added by a function of this shape, one file per subcommand.
 // The subcommand's callback does the work; `json` tells whether --json was given anywhere.
 void addVersionCommand(CLI::App& app);
+void addPlcSimCommand(CLI::App& app);
 void addCircleCommand(CLI::App& app);
 void addScanMatchCommand(CLI::App& app);
 void addResultsCommand(CLI::App& app);

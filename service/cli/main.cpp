@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
   CLI::App app{"facet: machine-vision inspection tool", "facet"};
   app.require_subcommand(1);
   addVersionCommand(app);
+  addPlcSimCommand(app);
   addCircleCommand(app);
   addScanMatchCommand(app);
   addResultsCommand(app);
