@@ -34,5 +34,6 @@ void addVersionCommand(CLI::App& app);
 void addCircleCommand(CLI::App& app);
 void addScanMatchCommand(CLI::App& app);
 void addResultsCommand(CLI::App& app);
+void addRecipeCommand(CLI::App& app);
 
 }  // namespace facet::cli

@@ -20,6 +20,7 @@ int main(int argc, char** argv) {
   addCircleCommand(app);
   addScanMatchCommand(app);
   addResultsCommand(app);
+  addRecipeCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
