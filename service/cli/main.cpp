@@ -25,6 +25,7 @@ int main(int argc, char** argv) {
   addModelCommand(app);
   addMatchCommand(app);
   addRegisterCommand(app);
+  addRecipeCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
