@@ -254,13 +254,14 @@ bool solveSpd(std::array<std::array<double, N>, N>& a, std::array<double, N>& y)
   return true;
 }
 
-// The integer range of dx for which lo <= dx * k + c <= hi (all dx when k ~ 0 and c fits).
-void restrict(double k, double c, double lo, double hi, int& first, int& last) {
+// The integer range of dx for which lo <= dx * k + c <= hi, given invK = 1 / k (all dx when k ~ 0
+// and c fits).
+void restrict(double k, double invK, double c, double lo, double hi, int& first, int& last) {
   if (std::abs(k) < 1e-12) {
     if (c < lo || c > hi) last = first - 1;
     return;
   }
-  double x0 = (lo - c) / k, x1 = (hi - c) / k;
+  double x0 = (lo - c) * invK, x1 = (hi - c) * invK;
   if (x0 > x1) std::swap(x0, x1);
   first = std::max(first, static_cast<int>(std::ceil(x0 - 1e-9)));
   last = std::min(last, static_cast<int>(std::floor(x1 + 1e-9)));
@@ -271,24 +272,36 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
             const EdgeProfileParams& params, float scale, Samples& out) {
   const int reach = edgeProfileReach(params);
   out.count = 0;
-  double sum = 0;
+  float sum = 0;
+  const auto nx = static_cast<float>(n.x), ny = static_cast<float>(n.y);
+  const double invX = std::abs(n.x) < 1e-12 ? 0.0 : 1.0 / n.x;
+  const double invY = std::abs(n.y) < 1e-12 ? 0.0 : -1.0 / n.y;
   for (int dy = -reach; dy <= reach; ++dy) {
     int first = -reach, last = reach;
     // s = dx nx + dy ny within offset +- halfAcross; t = -dx ny + dy nx within +- halfAlong.
-    restrict(n.x, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first, last);
-    restrict(-n.y, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
+    restrict(n.x, invX, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first,
+             last);
+    restrict(-n.y, invY, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
+    last = std::min(last, first + (kCapacity - 4 - out.count) - 1);
     const T* row = image.ptr<T>(c.y + dy) + c.x;
-    for (int dx = first; dx <= last && out.count < kCapacity - 4; ++dx) {
-      const int i = out.count++;
-      out.s[i] = static_cast<float>(dx * n.x + dy * n.y);
-      out.t[i] = static_cast<float>(-dx * n.y + dy * n.x);
-      out.v[i] = static_cast<float>(row[dx]) * scale;
-      out.weight[i] = 1.0f;
-      sum += out.v[i];
+    const float sRow = static_cast<float>(dy) * ny, tRow = static_cast<float>(dy) * nx;
+    float* ps = &out.s[out.count];
+    float* pt = &out.t[out.count];
+    float* pv = &out.v[out.count];
+    float* pw = &out.weight[out.count];
+    for (int dx = first; dx <= last; ++dx) {
+      const auto fx = static_cast<float>(dx);
+      *ps++ = fx * nx + sRow;
+      *pt++ = tRow - fx * ny;
+      const float v = static_cast<float>(row[dx]) * scale;
+      *pv++ = v;
+      *pw++ = 1.0f;
+      sum += v;
     }
+    out.count += std::max(0, last - first + 1);
   }
   const int real = out.count;
-  out.mean = real ? static_cast<float>(sum / real) : 0.0f;
+  out.mean = real ? sum / static_cast<float>(real) : 0.0f;
   for (int i = 0; i < real; ++i) out.v[i] -= out.mean;
   while (out.count % 4) {
     const int i = out.count++;

@@ -1,0 +1,84 @@
+#pragma once
+// Feature-based registration of an image to a reference (seed dissertation, part 3):
+// Harris corners (or Harris-Affine regions) -> log-polar windows -> NCC matching over cyclic
+// angle shifts and log-radius shifts -> robust fit (RANSAC, then least squares on the inliers)
+// -> optionally warp the reference with the estimate and re-match around the prediction.
+//
+// The result H maps reference pixel coordinates to image pixel coordinates (homogeneous,
+// x right, y down, pixel centres at integers): q ~ H * (x, y, 1).
+
+#include <string>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "algorithms/registration/harris_corners.hpp"
+#include "algorithms/registration/log_polar_window.hpp"
+#include "algorithms/registration/ncc_matcher.hpp"
+#include "algorithms/registration/transform_fit.hpp"
+
+namespace facet {
+
+struct RegistrationParams {
+  TransformModel model = TransformModel::Homography;  // family of H that is fitted
+  // Harris-Affine regions (scale selection + affine shape adaptation) instead of plain
+  // multi-scale Harris corners: slower, needed for large viewpoint changes (> ~30 degrees).
+  bool affineRegions = false;
+  HarrisParams corners;          // detection of the points that are matched globally
+  LogPolarParams window;         // log-polar window sampled around each point
+  NccMatchParams matching;       // minimum NCC, shift ranges and the three accelerations
+  double inlierThreshold = 3.0;  // pixels; RANSAC reprojection threshold in the image
+  int minInliers = 8;            // fewer inliers than this -> failure "too_few_inliers"
+  // Per-match rotation/scale estimates prune matches that disagree with the dominant rotation
+  // (degrees) and log2-scale before RANSAC. <= 0 disables the pruning.
+  double pruneRotationDeg = 40.0;
+  double pruneLog2Scale = 1.0;
+  // Escalation for hard pairs (large viewpoint change): when the first global matching gives
+  // fewer than `escalateBelowInliers` inliers, it is repeated with `escalateCorners` corners per
+  // image and the minimum NCC lowered to `escalateMinScore`. escalateCorners <= maxCorners
+  // disables it.
+  int escalateCorners = 800;
+  double escalateMinScore = 0.7;
+  int escalateBelowInliers = 15;
+  // Iterative refinement: warp the reference with the current H, re-match Harris points spread
+  // on a grid (the strongest per `refineCell` x `refineCell` block) around their predicted
+  // positions (NCC of square patches within `refineSearchRadius` pixels), refit. 0 disables it.
+  int refineIterations = 2;
+  int refineCell = 10;          // pixels of the reference
+  int refineSearchRadius = 8;   // pixels, in the image
+  int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
+  double refineMinScore = 0.8;  // minimum NCC of a re-matched patch
+};
+
+// One correspondence between the reference and the image.
+struct FeatureMatch {
+  cv::Point2d ref;         // pixel in the reference
+  cv::Point2d image;       // pixel in the image
+  double score = 0;        // NCC in [-1, 1]
+  double rotationDeg = 0;  // rotation ref -> image estimated by this match alone (degrees)
+  double scale = 1;        // scale ref -> image estimated by this match alone
+};
+
+struct RegistrationResult {
+  bool ok = false;
+  // Machine-readable cause when !ok: "empty_image", "blank_image", "too_few_corners",
+  // "too_few_matches", "too_few_inliers", "degenerate_transform"; empty when ok.
+  std::string failureCause;
+  std::string message;                 // human-readable explanation
+  cv::Matx33d H = cv::Matx33d::eye();  // reference -> image, H(2,2) == 1
+  std::vector<FeatureMatch> matches;   // final putative matches
+  std::vector<int> inliers;            // indices into `matches` consistent with H
+  int refCorners = 0;                  // points detected in the reference / image
+  int imageCorners = 0;
+  // Inlier correspondences as (x_ref, y_ref, x_img, y_img).
+  [[nodiscard]] std::vector<cv::Vec4d> pairs() const;
+};
+
+// Registers `image` to `ref` (8-bit or 16-bit, 1 or 3 channels; converted to grey).
+RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
+                                  const RegistrationParams& params = {});
+
+// Maps a reference point through H.
+cv::Point2d mapPoint(const cv::Matx33d& H, cv::Point2d p);
+
+}  // namespace facet

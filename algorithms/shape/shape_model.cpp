@@ -1,0 +1,278 @@
+#include "algorithms/shape/shape_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/edges/subpixel_edges.hpp"
+#include "algorithms/shape/image_gradients.hpp"
+
+namespace facet {
+namespace {
+
+using shape_detail::sobelGradients;
+using shape_detail::toGreyFloat;
+
+constexpr int kMaxAutoLevels = 6;
+constexpr int kMaxUpperLevelPoints = 250;  // top-level sums are 16-bit: 250 * 127 < 32767
+constexpr int kMinModelPoints = 8;
+
+// The q-quantile of the gradient magnitude over the masked pixels.
+double magnitudeQuantile(const cv::Mat& magnitude, const cv::Mat& mask, double q) {
+  std::vector<float> values;
+  values.reserve(magnitude.total());
+  for (int y = 0; y < magnitude.rows; ++y)
+    for (int x = 0; x < magnitude.cols; ++x)
+      if (mask.empty() || mask.at<uchar>(y, x)) values.push_back(magnitude.at<float>(y, x));
+  if (values.empty()) return 0.0;
+  auto nth =
+      values.begin() + static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), nth, values.end());
+  return *nth;
+}
+
+struct Thresholds {
+  double low = 0.0;
+  double high = 0.0;
+};
+
+// Automatic thresholds: a fraction of the strong edges' magnitude, never below the noise floor
+// that the search ignores anyway.
+Thresholds chooseThresholds(const cv::Mat& magnitude, const cv::Mat& mask,
+                            const ShapeModelParams& params) {
+  Thresholds t;
+  const double strong = magnitudeQuantile(magnitude, mask, 0.99);
+  t.high = params.contrastHigh.value_or(std::max(0.4 * strong, 2.0 * params.minContrast));
+  t.low = params.contrastLow.value_or(std::max(0.5 * t.high, params.minContrast));
+  t.low = std::min(t.low, t.high);
+  return t;
+}
+
+// Thin edge pixels: non-maximum suppression across the edge, then hysteresis (8-connected).
+std::vector<cv::Point> edgePixels(const cv::Mat& gx, const cv::Mat& gy, const cv::Mat& magnitude,
+                                  const cv::Mat& mask, Thresholds t) {
+  const int w = gx.cols, h = gx.rows;
+  cv::Mat state(h, w, CV_8U, cv::Scalar(0));  // 1 = candidate, 2 = accepted
+  std::vector<cv::Point> stack;
+  for (int y = 1; y < h - 1; ++y) {
+    for (int x = 1; x < w - 1; ++x) {
+      const float m = magnitude.at<float>(y, x);
+      if (m < t.low || (!mask.empty() && !mask.at<uchar>(y, x))) continue;
+      const float ax = std::abs(gx.at<float>(y, x)), ay = std::abs(gy.at<float>(y, x));
+      int dx = 0, dy = 0;
+      if (ax > 2.414f * ay) {
+        dx = 1;
+      } else if (ay > 2.414f * ax) {
+        dy = 1;
+      } else {
+        dx = 1;
+        dy = (gx.at<float>(y, x) * gy.at<float>(y, x) > 0) ? 1 : -1;
+      }
+      if (m <= magnitude.at<float>(y - dy, x - dx) || m < magnitude.at<float>(y + dy, x + dx))
+        continue;
+      state.at<uchar>(y, x) = 1;
+      if (m >= t.high) {
+        state.at<uchar>(y, x) = 2;
+        stack.emplace_back(x, y);
+      }
+    }
+  }
+  std::vector<cv::Point> accepted = stack;
+  while (!stack.empty()) {
+    const cv::Point p = stack.back();
+    stack.pop_back();
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        uchar& s = state.at<uchar>(p.y + dy, p.x + dx);
+        if (s == 1) {
+          s = 2;
+          stack.emplace_back(p.x + dx, p.y + dy);
+          accepted.emplace_back(p.x + dx, p.y + dy);
+        }
+      }
+  }
+  // Raster order spreads thinning evenly over the whole model.
+  std::sort(accepted.begin(), accepted.end(),
+            [](cv::Point a, cv::Point b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
+  return accepted;
+}
+
+template <typename T>
+void thin(std::vector<T>& points, int maxPoints) {
+  if (maxPoints <= 0 || static_cast<int>(points.size()) <= maxPoints) return;
+  std::vector<T> kept;
+  kept.reserve(static_cast<std::size_t>(maxPoints));
+  const double stride = static_cast<double>(points.size()) / maxPoints;
+  for (int i = 0; i < maxPoints; ++i) kept.push_back(points[static_cast<std::size_t>(i * stride)]);
+  points.swap(kept);
+}
+
+struct LevelResult {
+  std::vector<ShapePoint> points;
+  Thresholds thresholds;
+  cv::Mat edgeMask;  // CV_8U, 255 on every edge pixel before thinning
+};
+
+LevelResult levelPoints(const cv::Mat& grey, const cv::Mat& mask, cv::Point2d reference,
+                        const ShapeModelParams& params, int maxPoints) {
+  cv::Mat gx, gy, magnitude;
+  sobelGradients(grey, gx, gy);
+  cv::magnitude(gx, gy, magnitude);
+  LevelResult result;
+  result.thresholds = chooseThresholds(magnitude, mask, params);
+  result.edgeMask = cv::Mat(grey.size(), CV_8U, cv::Scalar(0));
+  for (const cv::Point p : edgePixels(gx, gy, magnitude, mask, result.thresholds)) {
+    result.edgeMask.at<uchar>(p) = 255;
+    const float m = magnitude.at<float>(p);
+    result.points.push_back(
+        {cv::Point2f(static_cast<float>(p.x - reference.x), static_cast<float>(p.y - reference.y)),
+         cv::Point2f(gx.at<float>(p) / m, gy.at<float>(p) / m)});
+  }
+  thin(result.points, maxPoints);
+  // The search abandons a pose after a prefix of the points (greediness); a fixed pseudo-random
+  // order keeps an occluded side of the part from being that whole prefix.
+  std::mt19937 shuffle(12345);
+  std::shuffle(result.points.begin(), result.points.end(), shuffle);
+  return result;
+}
+
+double extentOf(const std::vector<ShapePoint>& points, cv::Size2d& box) {
+  float x0 = 1e30f, y0 = 1e30f, x1 = -1e30f, y1 = -1e30f;
+  double radius = 0.0;
+  for (const auto& p : points) {
+    x0 = std::min(x0, p.position.x), x1 = std::max(x1, p.position.x);
+    y0 = std::min(y0, p.position.y), y1 = std::max(y1, p.position.y);
+    radius = std::max(radius, std::hypot(double(p.position.x), double(p.position.y)));
+  }
+  box = {x1 - x0, y1 - y0};
+  return radius;
+}
+
+void checkParams(const cv::Mat& image, const ShapeModelParams& p) {
+  if (image.empty()) throw ShapeModelError("shape model: the template image is empty");
+  if (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U))
+    throw ShapeModelError("shape model: the template must be an 8-bit or 16-bit grey image");
+  if (!p.roi.empty() && (p.roi & cv::Rect(0, 0, image.cols, image.rows)) != p.roi)
+    throw ShapeModelError("shape model: the region lies outside the template image");
+  if (p.numLevels < 0 || p.numLevels > 10)
+    throw ShapeModelError("shape model: numLevels must be 0 (automatic) or 1..10");
+  if (!(p.angleExtent >= 0.0) || !(p.angleStep >= 0.0))
+    throw ShapeModelError("shape model: the angle extent and step must be >= 0");
+  if (!(p.scaleMin > 0.0) || !(p.scaleMax >= p.scaleMin) || !(p.scaleStep >= 0.0))
+    throw ShapeModelError("shape model: the scale range must satisfy 0 < min <= max");
+  if (!(p.minContrast >= 0.0)) throw ShapeModelError("shape model: minContrast must be >= 0");
+}
+
+}  // namespace
+
+double ShapeModel::radius() const {
+  cv::Size2d box;
+  return levels.empty() ? 0.0 : extentOf(levels.front().points, box);
+}
+
+ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams& params) {
+  checkParams(templateImage, params);
+  const cv::Rect region =
+      params.roi.empty() ? cv::Rect(0, 0, templateImage.cols, templateImage.rows) : params.roi;
+  cv::Mat mask;
+  if (!params.mask.empty()) {
+    if (params.mask.type() != CV_8UC1)
+      throw ShapeModelError("shape model: the mask must be an 8-bit single-channel image");
+    if (params.mask.size() == region.size())
+      mask = params.mask.clone();
+    else if (params.mask.size() == templateImage.size())
+      mask = params.mask(region).clone();
+    else
+      throw ShapeModelError("shape model: the mask must have the size of the template or region");
+  }
+
+  ShapeModel model;
+  model.templateSize = region.size();
+  model.referencePoint = params.referencePoint
+                             ? *params.referencePoint - cv::Point2d(region.tl())
+                             : cv::Point2d((region.width - 1) / 2.0, (region.height - 1) / 2.0);
+  model.angleStart = params.angleStart;
+  model.angleExtent = std::min(params.angleExtent, 2.0 * std::numbers::pi);
+  model.scaleMin = params.scaleMin;
+  model.scaleMax = params.scaleMax;
+  model.minContrast = params.minContrast;
+
+  cv::Mat grey = toGreyFloat(templateImage(region));
+  const int wanted = params.numLevels > 0 ? params.numLevels : kMaxAutoLevels;
+  double radius0 = 0.0;
+  cv::Mat modelEdges;  // level-0 edge pixels, widened by one pixel
+  for (int level = 0; level < wanted; ++level) {
+    if (level > 0) {
+      if (grey.cols < 4 || grey.rows < 4) break;
+      cv::pyrDown(grey, grey);
+      if (!mask.empty()) cv::resize(mask, mask, grey.size(), 0, 0, cv::INTER_NEAREST);
+    }
+    const double f = std::ldexp(1.0, -level);
+    LevelResult r = levelPoints(
+        grey, mask, model.referencePoint * f, params,
+        level == 0 ? params.maxPoints
+                   : (params.maxPoints > 0 ? std::min(params.maxPoints, kMaxUpperLevelPoints)
+                                           : kMaxUpperLevelPoints));
+    if (level == 0) {
+      if (static_cast<int>(r.points.size()) < kMinModelPoints)
+        throw ShapeModelError("shape model: the template has too few edges (" +
+                              std::to_string(r.points.size()) +
+                              " edge points above the contrast threshold " +
+                              std::to_string(r.thresholds.high) + " grey levels per pixel)");
+      model.contrastLow = r.thresholds.low;
+      model.contrastHigh = r.thresholds.high;
+      cv::dilate(r.edgeMask, modelEdges, cv::Mat());
+    }
+    cv::Size2d box;
+    const double radius = extentOf(r.points, box);
+    if (level == 0) radius0 = radius;
+    if (level > 0 && params.numLevels == 0 &&
+        (std::min(box.width, box.height) < 12.0 || r.points.size() < 16))
+      break;
+    if (level > 0 && r.points.size() < 4)
+      throw ShapeModelError("shape model: level " + std::to_string(level) +
+                            " has too few edge points; use fewer pyramid levels");
+    ShapeLevel shapeLevel;
+    shapeLevel.points = std::move(r.points);
+    const double levelRadius = std::max(radius0 * f, 1.0);
+    shapeLevel.angleStep =
+        params.angleStep > 0.0 ? params.angleStep / f : std::atan(1.0 / levelRadius);
+    shapeLevel.scaleStep = params.scaleMax > params.scaleMin
+                               ? (params.scaleStep > 0.0 ? params.scaleStep / f : 1.0 / levelRadius)
+                               : 0.0;
+    model.levels.push_back(std::move(shapeLevel));
+  }
+
+  // Subpixel edges of the template for the least-squares refinement: the Facet-model points on
+  // the model's own edge pixels. The edge detector's thresholds are kept loose (its gradient
+  // estimate differs from Sobel's); the model's edge pixels decide which points belong.
+  EdgeParams edgeParams;
+  edgeParams.low = 0.5 * model.contrastLow;
+  edgeParams.high = 0.5 * model.contrastHigh;
+  edgeParams.roi = region;
+  if (!mask.empty()) {
+    edgeParams.mask = cv::Mat(templateImage.size(), CV_8U, cv::Scalar(0));
+    cv::Mat regionMask = params.mask.size() == region.size() ? params.mask : params.mask(region);
+    regionMask.copyTo(edgeParams.mask(region));
+  }
+  const cv::Point2d origin = model.referencePoint + cv::Point2d(region.tl());
+  for (const EdgePoint& e : detectSubpixelEdges(templateImage, edgeParams).points) {
+    const cv::Point pixel(cvRound(e.position.x) - region.x, cvRound(e.position.y) - region.y);
+    if (!cv::Rect(0, 0, region.width, region.height).contains(pixel) ||
+        !modelEdges.at<uchar>(pixel))
+      continue;
+    const cv::Point2d p = e.position - origin;
+    model.finePoints.push_back(
+        {cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)),
+         cv::Point2f(static_cast<float>(e.normal.x), static_cast<float>(e.normal.y))});
+  }
+  thin(model.finePoints, params.maxPoints > 0 ? 2 * params.maxPoints : 0);
+  if (static_cast<int>(model.finePoints.size()) < kMinModelPoints)
+    throw ShapeModelError("shape model: the template has too few subpixel edge points");
+  return model;
+}
+
+}  // namespace facet

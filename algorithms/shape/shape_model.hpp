@@ -1,0 +1,105 @@
+#pragma once
+// A shape model: the edge points of a template, with their gradient directions, on every level of
+// an image pyramid (Steger 2002, "Occlusion, clutter, and illumination invariant object
+// recognition"). createShapeModel() trains it from a template image; findShapeModel()
+// (find_shape_model.hpp) searches it; shape_model_file.hpp saves and loads it.
+//
+// Model coordinates are pixels relative to the reference point, x right, y down. A match's pose
+// maps them into the image as q = t + s R(a) p (algorithms/geometry/pose2d.hpp).
+
+#include <numbers>
+#include <optional>
+#include <stdexcept>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+namespace facet {
+
+struct ShapeModelParams {
+  // Region of the template image that holds the part, image pixels; empty = the whole image.
+  cv::Rect roi;
+  // Optional 8-bit mask of the template's size (or of the roi's size when roi is set): only
+  // edges on non-zero pixels belong to the model. Empty = every pixel.
+  cv::Mat mask;
+  // Reference point in template pixels (the point whose image position a match reports).
+  // Default: the centre of the region, ((w-1)/2, (h-1)/2) of the roi or the whole template.
+  std::optional<cv::Point2d> referencePoint;
+
+  // Number of pyramid levels, >= 1. 0 = automatic: as many as keep the model at least about
+  // 12 pixels wide and 16 edge points on the top level (at most 6).
+  int numLevels = 0;
+
+  // Angle range searched, radians: [angleStart, angleStart + angleExtent]. Default: full circle.
+  // An extent >= 2 pi means "any angle".
+  double angleStart = -std::numbers::pi;
+  double angleExtent = 2.0 * std::numbers::pi;
+  // Angle step on level 0, radians. 0 = automatic, about atan(1 / R) for a model of radius R
+  // (the outermost point then moves by at most half a pixel between steps). Doubles per level.
+  double angleStep = 0.0;
+
+  // Scale range searched (unitless, 1 = template size): [scaleMin, scaleMax], 0 < min <= max.
+  double scaleMin = 1.0;
+  double scaleMax = 1.0;
+  // Scale step on level 0, unitless. 0 = automatic, about 1 / R. Doubles per level.
+  double scaleStep = 0.0;
+
+  // Hysteresis thresholds for the template's edges, grey levels per pixel (8-bit scale).
+  // Missing = automatic from the template's gradient histogram.
+  std::optional<double> contrastLow;
+  std::optional<double> contrastHigh;
+  // Image gradients weaker than this (grey levels per pixel, 8-bit scale) are treated as noise
+  // and contribute nothing to the score during the search. Default 5.
+  double minContrast = 5.0;
+  // Most points kept per pyramid level; larger models are thinned evenly along their edges.
+  // Default 800 (level 0), 0 = no thinning. Upper levels keep at most 250 (top-level SIMD sums).
+  int maxPoints = 800;
+};
+
+// One model point: position relative to the reference point (pixels of its pyramid level) and the
+// unit gradient direction (dark -> light) in model axes.
+struct ShapePoint {
+  cv::Point2f position;
+  cv::Point2f direction;
+};
+
+struct ShapeLevel {
+  std::vector<ShapePoint> points;
+  double angleStep = 0.0;  // radians, search step on this level
+  double scaleStep = 0.0;  // unitless, search step on this level (0 when the scale is fixed)
+};
+
+struct ShapeModel {
+  // Level 0 first; level l has the template downsampled by 2^l (cv::pyrDown).
+  std::vector<ShapeLevel> levels;
+  // Subpixel (Facet-model) edge points of the template on level 0, relative to the reference
+  // point; the least-squares refinement matches these against the image's subpixel edges.
+  std::vector<ShapePoint> finePoints;
+
+  cv::Size templateSize;                  // size of the trained region, pixels
+  cv::Point2d referencePoint;             // in the trained region's pixels
+  double angleStart = -std::numbers::pi;  // radians
+  double angleExtent = 2.0 * std::numbers::pi;
+  double scaleMin = 1.0;
+  double scaleMax = 1.0;
+  double minContrast = 5.0;  // grey levels per pixel
+  double contrastLow = 0.0;  // thresholds actually used for the template, grey levels per pixel
+  double contrastHigh = 0.0;
+
+  [[nodiscard]] bool empty() const { return levels.empty(); }
+  [[nodiscard]] int numLevels() const { return static_cast<int>(levels.size()); }
+  // Largest distance of a level-0 point from the reference point, pixels.
+  [[nodiscard]] double radius() const;
+};
+
+// Thrown for templates that give no usable model (no edges, empty image, bad parameters).
+struct ShapeModelError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Trains a shape model from an 8-bit or 16-bit single-channel template image.
+// Throws ShapeModelError when the template is empty, the parameters are out of range, or the
+// template has too few edges (fewer than 8 points on level 0).
+ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams& params = {});
+
+}  // namespace facet

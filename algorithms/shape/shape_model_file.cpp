@@ -1,0 +1,169 @@
+#include "algorithms/shape/shape_model_file.hpp"
+
+#include <array>
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+namespace facet {
+namespace {
+
+constexpr std::array<char, 8> kMagic = {'F', 'A', 'C', 'E', 'T', 'S', 'H', 'M'};
+constexpr std::size_t kHeaderSize = kMagic.size() + sizeof(std::uint32_t) + sizeof(std::uint64_t);
+constexpr std::uint32_t kMaxPoints = 10'000'000;  // far above any real model: guards bad counts
+constexpr std::uint32_t kMaxLevels = 16;
+
+std::uint64_t fnv1a(const char* data, std::size_t size) {
+  std::uint64_t h = 14695981039346656037ull;
+  for (std::size_t i = 0; i < size; ++i) {
+    h ^= static_cast<unsigned char>(data[i]);
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+// Little-endian on every machine we ship to (x86-64, aarch64); values are copied bytewise.
+class Writer {
+ public:
+  template <typename T>
+  void put(T value) {
+    const auto* p = reinterpret_cast<const char*>(&value);
+    bytes_.insert(bytes_.end(), p, p + sizeof(T));
+  }
+  void putPoints(const std::vector<ShapePoint>& points) {
+    put(static_cast<std::uint32_t>(points.size()));
+    for (const auto& p : points) {
+      put(p.position.x), put(p.position.y), put(p.direction.x), put(p.direction.y);
+    }
+  }
+  [[nodiscard]] const std::vector<char>& bytes() const { return bytes_; }
+
+ private:
+  std::vector<char> bytes_;
+};
+
+class Reader {
+ public:
+  Reader(const char* data, std::size_t size, const std::string& file)
+      : data_(data), size_(size), file_(file) {}
+  template <typename T>
+  T get() {
+    if (size_ - offset_ < sizeof(T)) fail("truncated model data");
+    T value;
+    std::memcpy(&value, data_ + offset_, sizeof(T));
+    offset_ += sizeof(T);
+    return value;
+  }
+  std::vector<ShapePoint> getPoints() {
+    const auto n = get<std::uint32_t>();
+    if (n > kMaxPoints || n * 16ull > size_ - offset_) fail("corrupt point count");
+    std::vector<ShapePoint> points(n);
+    for (auto& p : points) {
+      p.position.x = get<float>(), p.position.y = get<float>();
+      p.direction.x = get<float>(), p.direction.y = get<float>();
+    }
+    return points;
+  }
+  [[nodiscard]] bool atEnd() const { return offset_ == size_; }
+  [[noreturn]] void fail(const std::string& why) const {
+    throw ShapeModelFileError(file_ + ": " + why);
+  }
+
+ private:
+  const char* data_;
+  std::size_t size_;
+  std::size_t offset_ = 0;
+  std::string file_;
+};
+
+}  // namespace
+
+void saveShapeModel(const ShapeModel& model, const std::filesystem::path& path) {
+  if (model.empty()) throw ShapeModelFileError(path.string() + ": cannot save an empty model");
+  Writer w;
+  w.put<std::int32_t>(model.templateSize.width);
+  w.put<std::int32_t>(model.templateSize.height);
+  for (double v :
+       {model.referencePoint.x, model.referencePoint.y, model.angleStart, model.angleExtent,
+        model.scaleMin, model.scaleMax, model.minContrast, model.contrastLow, model.contrastHigh})
+    w.put(v);
+  w.put(static_cast<std::uint32_t>(model.levels.size()));
+  for (const auto& level : model.levels) {
+    w.put(level.angleStep);
+    w.put(level.scaleStep);
+    w.putPoints(level.points);
+  }
+  w.putPoints(model.finePoints);
+
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  if (!out) throw ShapeModelFileError(path.string() + ": cannot open for writing");
+  const auto& payload = w.bytes();
+  const std::uint64_t size = payload.size();
+  const std::uint64_t checksum = fnv1a(payload.data(), payload.size());
+  out.write(kMagic.data(), kMagic.size());
+  out.write(reinterpret_cast<const char*>(&kShapeModelFileVersion), sizeof(std::uint32_t));
+  out.write(reinterpret_cast<const char*>(&size), sizeof(size));
+  out.write(payload.data(), static_cast<std::streamsize>(payload.size()));
+  out.write(reinterpret_cast<const char*>(&checksum), sizeof(checksum));
+  if (!out.flush()) throw ShapeModelFileError(path.string() + ": write failed");
+}
+
+ShapeModel loadShapeModel(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ShapeModelFileError(name + ": cannot open shape model file");
+  const std::vector<char> file{std::istreambuf_iterator<char>(in),
+                               std::istreambuf_iterator<char>()};
+  if (file.size() < kMagic.size() || std::memcmp(file.data(), kMagic.data(), kMagic.size()) != 0)
+    throw ShapeModelFileError(name + ": not a facet shape model file (bad magic)");
+  if (file.size() < kHeaderSize)
+    throw ShapeModelFileError(name + ": truncated shape model file (incomplete header)");
+  std::uint32_t version = 0;
+  std::uint64_t size = 0;
+  std::memcpy(&version, file.data() + kMagic.size(), sizeof(version));
+  std::memcpy(&size, file.data() + kMagic.size() + sizeof(version), sizeof(size));
+  if (version != kShapeModelFileVersion)
+    throw ShapeModelFileError(name + ": unsupported shape model file version " +
+                              std::to_string(version) + " (this build reads version " +
+                              std::to_string(kShapeModelFileVersion) + ")");
+  if (file.size() - kHeaderSize < sizeof(std::uint64_t) ||
+      size > file.size() - kHeaderSize - sizeof(std::uint64_t))
+    throw ShapeModelFileError(name + ": truncated shape model file (" +
+                              std::to_string(file.size()) + " bytes, header announces " +
+                              std::to_string(kHeaderSize + size + 8) + ")");
+  if (file.size() != kHeaderSize + size + sizeof(std::uint64_t))
+    throw ShapeModelFileError(name + ": corrupt shape model file (trailing bytes)");
+  const char* payload = file.data() + kHeaderSize;
+  std::uint64_t checksum = 0;
+  std::memcpy(&checksum, payload + size, sizeof(checksum));
+  if (checksum != fnv1a(payload, size))
+    throw ShapeModelFileError(name + ": corrupt shape model file (checksum mismatch)");
+
+  Reader r(payload, size, name);
+  ShapeModel model;
+  model.templateSize.width = r.get<std::int32_t>();
+  model.templateSize.height = r.get<std::int32_t>();
+  for (double* v : {&model.referencePoint.x, &model.referencePoint.y, &model.angleStart,
+                    &model.angleExtent, &model.scaleMin, &model.scaleMax, &model.minContrast,
+                    &model.contrastLow, &model.contrastHigh})
+    *v = r.get<double>();
+  const auto levels = r.get<std::uint32_t>();
+  if (levels == 0 || levels > kMaxLevels) r.fail("corrupt level count");
+  for (std::uint32_t i = 0; i < levels; ++i) {
+    ShapeLevel level;
+    level.angleStep = r.get<double>();
+    level.scaleStep = r.get<double>();
+    level.points = r.getPoints();
+    model.levels.push_back(std::move(level));
+  }
+  model.finePoints = r.getPoints();
+  if (!r.atEnd()) r.fail("corrupt shape model file (unexpected data after the model)");
+  if (!(model.scaleMin > 0.0) || !(model.scaleMax >= model.scaleMin) ||
+      model.levels.front().points.empty() || model.finePoints.empty())
+    r.fail("corrupt shape model file (invalid values)");
+  return model;
+}
+
+}  // namespace facet

@@ -1,0 +1,29 @@
+#pragma once
+// Shape model files: a versioned binary format.
+//
+// Layout (little-endian): magic "FACETSHM", uint32 format version, uint64 payload size, payload,
+// uint64 FNV-1a checksum of the payload. A file that is truncated, has a wrong magic, an unknown
+// version or a checksum mismatch is refused with ShapeModelFileError naming the file.
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+
+#include "algorithms/shape/shape_model.hpp"
+
+namespace facet {
+
+inline constexpr std::uint32_t kShapeModelFileVersion = 1;
+
+struct ShapeModelFileError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Writes `model` to `path` (overwriting it). Throws ShapeModelFileError when it cannot write.
+void saveShapeModel(const ShapeModel& model, const std::filesystem::path& path);
+
+// Reads a model written by saveShapeModel. Throws ShapeModelFileError ("<path>: <reason>") for a
+// missing, truncated, corrupt or wrong-version file.
+ShapeModel loadShapeModel(const std::filesystem::path& path);
+
+}  // namespace facet

@@ -1,0 +1,496 @@
+#include "camera/aravis_camera.hpp"
+
+#include <algorithm>
+#include <optional>
+#include <thread>
+
+#include <arv.h>
+#include <spdlog/spdlog.h>
+#include <opencv2/core.hpp>
+
+#include "camera/sensor_image.hpp"
+
+namespace facet {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// How long a free-running stream may stay silent before we ask the control channel whether
+// the camera is still there.
+constexpr auto kSilenceBeforeProbe = std::chrono::milliseconds(1000);
+
+// Owns a GError and turns it into a message.
+struct ErrorSlot {
+  GError* error = nullptr;
+  ~ErrorSlot() { g_clear_error(&error); }
+  GError** operator&() { return &error; }
+  explicit operator bool() const { return error != nullptr; }
+  std::string message() const { return error ? error->message : std::string(); }
+};
+
+std::optional<SensorLayout> layoutOf(ArvPixelFormat format) {
+  switch (format) {
+    case ARV_PIXEL_FORMAT_MONO_8:
+      return SensorLayout::Mono8;
+    case ARV_PIXEL_FORMAT_MONO_16:
+      return SensorLayout::Mono16;
+    case ARV_PIXEL_FORMAT_RGB_8_PACKED:
+      return SensorLayout::Rgb8;
+    case ARV_PIXEL_FORMAT_BGR_8_PACKED:
+      return SensorLayout::Bgr8;
+    case ARV_PIXEL_FORMAT_BAYER_RG_8:
+      return SensorLayout::BayerRG8;
+    case ARV_PIXEL_FORMAT_BAYER_GR_8:
+      return SensorLayout::BayerGR8;
+    case ARV_PIXEL_FORMAT_BAYER_GB_8:
+      return SensorLayout::BayerGB8;
+    case ARV_PIXEL_FORMAT_BAYER_BG_8:
+      return SensorLayout::BayerBG8;
+    default:
+      return std::nullopt;
+  }
+}
+
+int cvTypeOf(SensorLayout layout) {
+  switch (layout) {
+    case SensorLayout::Mono16:
+      return CV_16UC1;
+    case SensorLayout::Rgb8:
+    case SensorLayout::Bgr8:
+      return CV_8UC3;
+    case SensorLayout::Yuyv:
+      return CV_8UC2;
+    default:
+      return CV_8UC1;
+  }
+}
+
+bool supportedPixelFormatName(const std::string& name) {
+  static const char* names[] = {"Mono8",    "Mono16",   "RGB8",     "BGR8",
+                                "BayerRG8", "BayerGR8", "BayerGB8", "BayerBG8"};
+  return std::find(std::begin(names), std::end(names), name) != std::end(names);
+}
+
+// Finds the Aravis device id of the camera with this serial number (needs discovery).
+std::string deviceIdForSerial(const std::string& serial) {
+  arv_update_device_list();
+  for (unsigned i = 0; i < arv_get_n_devices(); ++i) {
+    const char* s = arv_get_device_serial_nbr(i);
+    if (s && serial == s) return arv_get_device_id(i);
+  }
+  return {};
+}
+
+bool isLoopbackCamera(ArvCamera* camera) {
+  if (!arv_camera_is_gv_device(camera)) return false;
+  GSocketAddress* address =
+      arv_gv_device_get_device_address(ARV_GV_DEVICE(arv_camera_get_device(camera)));
+  if (!G_IS_INET_SOCKET_ADDRESS(address)) return false;
+  return g_inet_address_get_is_loopback(
+             g_inet_socket_address_get_address(G_INET_SOCKET_ADDRESS(address))) != FALSE;
+}
+
+}  // namespace
+
+AravisCamera::AravisCamera(AravisSettings settings) : settings_(std::move(settings)) {
+  if (!settings_.address.empty())
+    label_ = settings_.address;
+  else if (!settings_.serial.empty())
+    label_ = "serial " + settings_.serial;
+  else if (!settings_.device_id.empty())
+    label_ = settings_.device_id;
+  else
+    label_ = "first camera";
+  if (!supportedPixelFormatName(settings_.pixel_format))
+    throw CameraError("aravis camera " + label_ + ": unsupported pixel format \"" +
+                      settings_.pixel_format +
+                      "\" (use Mono8, Mono16, RGB8, BGR8 or Bayer{RG,GR,GB,BG}8)");
+  if (settings_.buffer_count < 2)
+    throw CameraError("aravis camera " + label_ + ": buffer_count must be >= 2");
+  if (settings_.reconnect_initial_ms <= 0 ||
+      settings_.reconnect_max_ms < settings_.reconnect_initial_ms)
+    throw CameraError("aravis camera " + label_ + ": invalid reconnect backoff");
+}
+
+AravisCamera::~AravisCamera() {
+  close();
+}
+
+void AravisCamera::onControlLost(void* /*device*/, void* self) {
+  // Called from Aravis' heartbeat thread: only flag it, grab() does the rest.
+  static_cast<AravisCamera*>(self)->control_lost_ = true;
+}
+
+void AravisCamera::connect() {
+  std::string id;
+  if (!settings_.address.empty())
+    id = settings_.address;
+  else if (!settings_.serial.empty()) {
+    id = deviceIdForSerial(settings_.serial);
+    if (id.empty()) throw CameraError("aravis camera " + label_ + ": not found");
+  } else if (!settings_.device_id.empty())
+    id = settings_.device_id;
+
+  ErrorSlot error;
+  ArvCamera* camera = arv_camera_new(id.empty() ? nullptr : id.c_str(), &error);
+  if (!camera) throw CameraError("aravis camera " + label_ + ": cannot open: " + error.message());
+
+  // Apply every setting; the first refusal aborts with the setting's name.
+  auto check = [&](const char* what) {
+    if (error) {
+      std::string message =
+          "aravis camera " + label_ + ": cannot set " + what + ": " + error.message();
+      g_object_unref(camera);
+      throw CameraError(message);
+    }
+  };
+  const auto& s = settings_;
+  arv_camera_set_acquisition_mode(camera, ARV_ACQUISITION_MODE_CONTINUOUS, &error);
+  check("AcquisitionMode");
+  arv_camera_set_pixel_format_from_string(camera, s.pixel_format.c_str(), &error);
+  check("PixelFormat");
+  if (s.region.width > 0 && s.region.height > 0) {
+    arv_camera_set_region(camera, s.region.x, s.region.y, s.region.width, s.region.height, &error);
+    check("region");
+  }
+  if (s.exposure_us) {
+    arv_camera_set_exposure_time(camera, *s.exposure_us, &error);
+    check("ExposureTime");
+  }
+  if (s.gain_db) {
+    arv_camera_set_gain(camera, *s.gain_db, &error);
+    check("Gain");
+  }
+  if (s.frame_rate_hz) {
+    arv_camera_set_frame_rate(camera, *s.frame_rate_hz, &error);
+    check("AcquisitionFrameRate");
+  }
+  switch (s.trigger) {
+    case TriggerMode::FreeRun:
+      arv_camera_clear_triggers(camera, &error);
+      break;
+    case TriggerMode::Software:
+      arv_camera_set_trigger(camera, "Software", &error);
+      break;
+    case TriggerMode::Hardware:
+      arv_camera_set_trigger(camera, s.trigger_line.c_str(), &error);
+  }
+  check("trigger");
+  if (arv_camera_is_gv_device(camera)) {
+    if (s.packet_size > 0) {
+      arv_camera_gv_set_packet_size(camera, s.packet_size, &error);
+      check("GevSCPSPacketSize");
+    } else {
+      arv_camera_gv_auto_packet_size(camera, &error);
+      if (error) {  // not every camera can fire test packets; its default packet size works
+        spdlog::warn("aravis camera {}: automatic packet size failed: {}", label_, error.message());
+        g_clear_error(&error.error);
+      }
+    }
+    if (isLoopbackCamera(camera))
+      arv_camera_gv_set_stream_options(camera, ARV_GV_STREAM_OPTION_PACKET_SOCKET_DISABLED);
+  }
+  g_signal_connect(arv_camera_get_device(camera), "control-lost", G_CALLBACK(&onControlLost), this);
+  const char* device_id = arv_camera_get_device_id(camera, nullptr);
+  {
+    std::lock_guard lock(device_mutex_);
+    camera_ = camera;
+    device_id_ = device_id ? device_id : id;
+  }
+  control_lost_ = false;
+}
+
+void AravisCamera::startStream() {
+  ErrorSlot error;
+  ArvCamera* camera = nullptr;
+  {
+    std::lock_guard lock(device_mutex_);
+    camera = camera_;
+  }
+  ArvStream* stream = arv_camera_create_stream(camera, nullptr, nullptr, &error);
+  if (!stream)
+    throw CameraError("aravis camera " + label_ + ": cannot create stream: " + error.message());
+  if (ARV_IS_GV_STREAM(stream))
+    g_object_set(stream, "socket-buffer", ARV_GV_STREAM_SOCKET_BUFFER_AUTO, "socket-buffer-size", 0,
+                 nullptr);
+  const guint payload = arv_camera_get_payload(camera, &error);
+  if (error) {
+    g_object_unref(stream);
+    throw CameraError("aravis camera " + label_ + ": cannot read payload size: " + error.message());
+  }
+  for (int i = 0; i < settings_.buffer_count; ++i)
+    arv_stream_push_buffer(stream, arv_buffer_new_allocate(payload));
+  arv_camera_start_acquisition(camera, &error);
+  if (error) {
+    g_object_unref(stream);
+    throw CameraError("aravis camera " + label_ + ": cannot start acquisition: " + error.message());
+  }
+  std::lock_guard lock(device_mutex_);
+  stream_ = stream;
+  last_frame_ = Clock::now();
+}
+
+void AravisCamera::releaseDevice(bool device_alive) {
+  std::lock_guard lock(device_mutex_);
+  if (camera_ && stream_ && device_alive) arv_camera_stop_acquisition(camera_, nullptr);
+  if (stream_) {
+    arv_stream_set_emit_signals(stream_, FALSE);
+    g_object_unref(stream_);  // stops the receiving thread and frees its buffers
+    stream_ = nullptr;
+  }
+  if (camera_) {
+    g_signal_handlers_disconnect_by_data(arv_camera_get_device(camera_), this);
+    g_object_unref(camera_);
+    camera_ = nullptr;
+  }
+}
+
+void AravisCamera::open() {
+  if (camera_) return;
+  connect();
+  std::lock_guard lock(health_mutex_);
+  health_.connected = true;
+  spdlog::info("aravis camera {} opened as {}", label_, device_id_);
+}
+
+void AravisCamera::start() {
+  if (!camera_ && lost_) {  // stopped while the camera was gone: try once more now
+    connect();
+    lost_ = false;
+    std::lock_guard lock(health_mutex_);
+    health_.connected = true;
+  }
+  if (!camera_) throw CameraError("aravis camera " + label_ + ": start() before open()");
+  if (streaming_) return;
+  ids_.restart();
+  startStream();
+  streaming_ = true;
+  std::lock_guard lock(health_mutex_);
+  health_.streaming = true;
+}
+
+void AravisCamera::stop() {
+  if (!streaming_) return;
+  streaming_ = false;
+  if (lost_) {
+    stopReconnecting();
+    bool reconnected = false;
+    {
+      std::lock_guard lock(device_mutex_);
+      reconnected = reconnected_;
+    }
+    if (reconnected) finishReconnect();
+  }
+  {
+    std::lock_guard lock(device_mutex_);
+    if (camera_ && stream_ && !lost_) arv_camera_stop_acquisition(camera_, nullptr);
+    if (stream_) {
+      g_object_unref(stream_);
+      stream_ = nullptr;
+    }
+  }
+  std::lock_guard lock(health_mutex_);
+  health_.streaming = false;
+}
+
+void AravisCamera::close() {
+  stop();
+  stopReconnecting();
+  releaseDevice(!lost_);
+  lost_ = false;
+  std::lock_guard lock(health_mutex_);
+  health_.connected = false;
+}
+
+void AravisCamera::softwareTrigger() {
+  if (settings_.trigger != TriggerMode::Software) return;
+  std::lock_guard lock(device_mutex_);
+  if (!camera_ || lost_) return;
+  ErrorSlot error;
+  arv_camera_software_trigger(camera_, &error);
+  if (error) {
+    spdlog::warn("aravis camera {}: software trigger failed: {}", label_, error.message());
+    std::lock_guard health_lock(health_mutex_);
+    health_.last_error = "software trigger failed: " + error.message();
+  }
+}
+
+bool AravisCamera::controlChannelAlive() {
+  // A register read through GVCP; Aravis retries internally, so a failure means the camera does
+  // not answer at all.
+  std::lock_guard lock(device_mutex_);
+  if (!camera_) return false;
+  ErrorSlot error;
+  guint32 value = 0;
+  arv_device_read_register(arv_camera_get_device(camera_), 0x0000 /* GVBS version */, &value,
+                           &error);
+  return !error;
+}
+
+void AravisCamera::markLost(const std::string& why) {
+  spdlog::error("aravis camera {} lost: {}; reconnecting with backoff", label_, why);
+  lost_ = true;
+  ArvCamera* dead_camera = nullptr;
+  ArvStream* dead_stream = nullptr;
+  {
+    std::lock_guard lock(device_mutex_);
+    if (camera_) g_signal_handlers_disconnect_by_data(arv_camera_get_device(camera_), this);
+    std::swap(dead_camera, camera_);
+    std::swap(dead_stream, stream_);
+    reconnected_ = false;
+    stop_reconnecting_ = false;
+  }
+  {
+    std::lock_guard lock(health_mutex_);
+    health_.connected = false;
+    health_.last_error = "camera lost: " + why;
+  }
+  if (reconnect_thread_.joinable()) reconnect_thread_.join();
+  reconnect_thread_ = std::thread(&AravisCamera::reconnectLoop, this, dead_camera, dead_stream);
+}
+
+void AravisCamera::reconnectLoop(ArvCamera* dead_camera, ArvStream* dead_stream) {
+  // Releasing a device that does not answer blocks in Aravis (it says goodbye with retries).
+  if (dead_stream) g_object_unref(dead_stream);
+  if (dead_camera) g_object_unref(dead_camera);
+  auto backoff = std::chrono::milliseconds(settings_.reconnect_initial_ms);
+  std::unique_lock lock(device_mutex_);
+  while (!stop_reconnecting_) {
+    if (reconnect_cv_.wait_for(lock, backoff, [&] { return stop_reconnecting_; })) break;
+    lock.unlock();
+    std::string error;
+    try {
+      connect();
+      startStream();
+    } catch (const CameraError& e) {
+      error = e.what();
+      releaseDevice(false);
+    }
+    lock.lock();
+    if (error.empty()) {
+      reconnected_ = true;
+      reconnect_cv_.notify_all();
+      return;
+    }
+    std::lock_guard health_lock(health_mutex_);
+    health_.last_error = error;
+    backoff = std::min(backoff * 2, std::chrono::milliseconds(settings_.reconnect_max_ms));
+  }
+}
+
+void AravisCamera::stopReconnecting() {
+  {
+    std::lock_guard lock(device_mutex_);
+    stop_reconnecting_ = true;
+  }
+  reconnect_cv_.notify_all();
+  if (reconnect_thread_.joinable()) reconnect_thread_.join();
+}
+
+GrabResult AravisCamera::waitForReconnect(Clock::time_point deadline) {
+  {
+    std::unique_lock lock(device_mutex_);
+    if (!reconnect_cv_.wait_until(lock, deadline, [&] { return reconnected_; }))
+      return {GrabStatus::Disconnected, {}, "aravis camera " + label_ + " is disconnected"};
+  }
+  finishReconnect();
+  return {GrabStatus::Ok, {}, {}};
+}
+
+void AravisCamera::finishReconnect() {
+  if (reconnect_thread_.joinable()) reconnect_thread_.join();
+  lost_ = false;
+  reconnected_ = false;
+  ids_.restart();
+  spdlog::info("aravis camera {} reconnected", label_);
+  std::lock_guard lock(health_mutex_);
+  health_.connected = true;
+  ++health_.reconnects;
+}
+
+GrabResult AravisCamera::grab(std::chrono::milliseconds timeout) {
+  const auto deadline = Clock::now() + timeout;
+  if (!streaming_) return {GrabStatus::NotStarted, {}, name() + ": not started"};
+  if (lost_) {
+    GrabResult r = waitForReconnect(deadline);
+    if (lost_) return r;
+  }
+  if (control_lost_) {
+    markLost("control channel lost (heartbeat)");
+    return {GrabStatus::Disconnected, {}, "aravis camera " + label_ + " lost"};
+  }
+
+  const auto remaining = std::max<std::int64_t>(
+      0, std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count());
+  ArvBuffer* buffer = arv_stream_timeout_pop_buffer(stream_, static_cast<guint64>(remaining));
+  if (!buffer) {
+    const bool expect_frames = settings_.trigger == TriggerMode::FreeRun;
+    if (control_lost_ || (expect_frames && Clock::now() - last_frame_ > kSilenceBeforeProbe &&
+                          !controlChannelAlive())) {
+      markLost(control_lost_ ? "control channel lost (heartbeat)" : "no answer on control channel");
+      return {GrabStatus::Disconnected, {}, "aravis camera " + label_ + " lost"};
+    }
+    std::lock_guard lock(health_mutex_);
+    ++health_.timeouts;
+    return {GrabStatus::Timeout, {}, "no frame within timeout"};
+  }
+  last_frame_ = Clock::now();
+
+  Frame frame;
+  frame.timestamp = std::chrono::system_clock::now();
+  frame.device_timestamp_ns = arv_buffer_get_timestamp(buffer);
+  frame.source = device_id_;
+  const std::uint64_t raw_id = arv_buffer_get_frame_id(buffer);
+  if (raw_id > 0xFFFF && !extended_ids_) {  // GigE Vision 2 extended ids: 64 bits, no wrap
+    extended_ids_ = true;
+    ids_ = FrameIdUnwrapper(64, false);
+  }
+  const auto step = ids_.next(raw_id);
+  frame.id = step.id;
+
+  const ArvBufferStatus status = arv_buffer_get_status(buffer);
+  GrabResult result;
+  if (status != ARV_BUFFER_STATUS_SUCCESS ||
+      arv_buffer_get_payload_type(buffer) != ARV_BUFFER_PAYLOAD_TYPE_IMAGE) {
+    frame.complete = false;
+    result = {GrabStatus::Incomplete, std::move(frame),
+              "incomplete frame (Aravis buffer status " + std::to_string(status) + ")"};
+  } else {
+    const auto layout = layoutOf(arv_buffer_get_image_pixel_format(buffer));
+    size_t size = 0;
+    const void* data = arv_buffer_get_image_data(buffer, &size);
+    const int width = arv_buffer_get_image_width(buffer);
+    const int height = arv_buffer_get_image_height(buffer);
+    if (!layout || !data) {
+      result = {GrabStatus::Error, {}, "unsupported pixel format or empty image in stream"};
+    } else {
+      // The view wraps Aravis' buffer; convertSensorImage makes the one copy we allow.
+      const cv::Mat view(height, width, cvTypeOf(*layout), const_cast<void*>(data));
+      if (view.total() * view.elemSize() > size) {
+        frame.complete = false;
+        result = {GrabStatus::Incomplete, std::move(frame), "short image buffer"};
+      } else {
+        frame.image = convertSensorImage(view, *layout, settings_.colour, frame.format);
+        result = {GrabStatus::Ok, std::move(frame), {}};
+      }
+    }
+  }
+  arv_stream_push_buffer(stream_, buffer);
+
+  std::lock_guard lock(health_mutex_);
+  health_.lost_frames += step.lost;
+  if (result.status == GrabStatus::Ok) ++health_.frames;
+  if (result.status == GrabStatus::Incomplete) ++health_.incomplete_frames;
+  return result;
+}
+
+CameraHealth AravisCamera::health() const {
+  std::lock_guard lock(health_mutex_);
+  return health_;
+}
+
+std::string AravisCamera::name() const {
+  return "aravis:" + label_;
+}
+
+}  // namespace facet

@@ -1,0 +1,85 @@
+#pragma once
+// AravisCamera: a GigE Vision / USB3 Vision camera through Aravis 0.8.
+//
+// - Opened by address (GigE, no discovery needed), serial number, Aravis device id, or the
+//   first camera found, in that order of preference.
+// - The stream uses Aravis' automatic socket buffer. The packet-socket fast path is turned off
+//   for cameras on a loopback address (it cannot capture there, e.g. the fake camera as root).
+// - A frame with missing packets is returned as GrabStatus::Incomplete without pixels and is
+//   counted; it is never handed out as a good frame.
+// - When the camera is lost (control-lost signal, or its control channel stops answering after
+//   a silent free-running stream), grab() reports Disconnected while a background thread
+//   releases the dead device (Aravis blocks for seconds on it) and reconnects with exponential
+//   backoff. grab() overruns its timeout only once, by the probe (about 2.5 s).
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <mutex>
+#include <string>
+#include <thread>
+
+#include "camera/camera.hpp"
+#include "camera/camera_settings.hpp"
+#include "camera/frame_id_unwrapper.hpp"
+
+typedef struct _ArvCamera ArvCamera;
+typedef struct _ArvStream ArvStream;
+
+namespace facet {
+
+class AravisCamera final : public Camera {
+ public:
+  explicit AravisCamera(AravisSettings settings);
+  ~AravisCamera() override;
+  AravisCamera(const AravisCamera&) = delete;
+  AravisCamera& operator=(const AravisCamera&) = delete;
+
+  // Finds and configures the camera; throws CameraError naming it when it cannot be found or a
+  // setting is refused.
+  void open() override;
+  void start() override;
+  GrabResult grab(std::chrono::milliseconds timeout) override;
+  void softwareTrigger() override;
+  void stop() override;
+  void close() override;
+  CameraHealth health() const override;
+  std::string name() const override;
+
+ private:
+  void connect();  // open + configure; throws CameraError
+  void startStream();
+  void releaseDevice(bool device_alive);
+  void markLost(const std::string& why);
+  void reconnectLoop(ArvCamera* dead_camera, ArvStream* dead_stream);
+  void stopReconnecting();
+  void finishReconnect();
+  GrabResult waitForReconnect(std::chrono::steady_clock::time_point deadline);
+  bool controlChannelAlive();
+  static void onControlLost(void* device, void* self);
+
+  AravisSettings settings_;
+  std::string label_;  // what we were asked to open, for messages
+
+  mutable std::mutex device_mutex_;  // guards camera_/stream_ against softwareTrigger()
+  ArvCamera* camera_ = nullptr;
+  ArvStream* stream_ = nullptr;
+  std::string device_id_;
+  bool streaming_ = false;
+  std::atomic<bool> lost_{false};
+  std::atomic<bool> control_lost_{false};
+
+  // Reconnection runs on its own thread; grab() waits on `reconnect_cv_` for it.
+  std::thread reconnect_thread_;
+  std::condition_variable reconnect_cv_;
+  bool reconnected_ = false;        // guarded by device_mutex_
+  bool stop_reconnecting_ = false;  // guarded by device_mutex_
+  std::chrono::steady_clock::time_point last_frame_{};
+  FrameIdUnwrapper ids_{16, true};
+  bool extended_ids_ = false;
+
+  mutable std::mutex health_mutex_;
+  CameraHealth health_;
+};
+
+}  // namespace facet

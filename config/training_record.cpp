@@ -1,0 +1,78 @@
+#include "config/training_record.hpp"
+
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <nlohmann/json.hpp>
+
+#include "config/content_hash.hpp"
+#include "config/recipe.hpp"
+#include "config/yaml_validation.hpp"
+
+namespace facet::config {
+namespace {
+
+std::string rectText(const std::optional<cv::Rect2d>& r) {
+  if (!r) return "all";
+  return formatNumber(r->x) + "," + formatNumber(r->y) + "," + formatNumber(r->width) + "," +
+         formatNumber(r->height);
+}
+
+std::string rangeText(const AngleRange& a) {
+  return formatNumber(a.low) + "," + formatNumber(a.high);
+}
+
+}  // namespace
+
+std::filesystem::path trainingRecordPath(const std::filesystem::path& model) {
+  return model.string() + ".train.json";
+}
+
+std::string trainingParameters(const Step& step) {
+  if (const auto* a = std::get_if<AlignStep>(&step.params))
+    return "shape;region=" + rectText(a->region) + ";angle=" + rangeText(a->angleRange);
+  if (const auto* s = std::get_if<ShapeStep>(&step.params))
+    return "shape;region=" + rectText(s->region) + ";angle=" + rangeText(s->angleRange);
+  return {};
+}
+
+ModelStatus modelStatus(const std::filesystem::path& model, const std::filesystem::path& source,
+                        const std::string& parameters) {
+  if (!std::filesystem::is_regular_file(model)) return {ModelState::Missing, "does not exist"};
+  std::ifstream in(trainingRecordPath(model));
+  nlohmann::json record;
+  try {
+    in >> record;
+  } catch (const nlohmann::json::exception&) {
+    return {ModelState::Untracked,
+            "has no readable training record " + trainingRecordPath(model).filename().string()};
+  }
+  const auto sourceHash = fileHash(source);
+  const auto modelHash = fileHash(model);
+  if (record.value("source_hash", "") != sourceHash.value_or("?"))
+    return {ModelState::Stale, "was trained from a different " + source.filename().string()};
+  if (record.value("parameters", "") != parameters)
+    return {ModelState::Stale, "was trained with other parameters (" +
+                                   record.value("parameters", "") + ", now " + parameters + ")"};
+  if (record.value("model_hash", "") != modelHash.value_or("?"))
+    return {ModelState::Stale, "changed after training"};
+  return {ModelState::Fresh, {}};
+}
+
+void writeTrainingRecord(const std::filesystem::path& model, const std::filesystem::path& source,
+                         const std::string& parameters) {
+  const auto sourceHash = fileHash(source);
+  const auto modelHash = fileHash(model);
+  if (!sourceHash) throw std::runtime_error(source.string() + ": cannot read");
+  if (!modelHash) throw std::runtime_error(model.string() + ": cannot read");
+  const nlohmann::json record{{"source", source.filename().string()},
+                              {"source_hash", *sourceHash},
+                              {"parameters", parameters},
+                              {"model_hash", *modelHash}};
+  std::ofstream out(trainingRecordPath(model));
+  out << record.dump(2) << "\n";
+  if (!out) throw std::runtime_error(trainingRecordPath(model).string() + ": cannot write");
+}
+
+}  // namespace facet::config

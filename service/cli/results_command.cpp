@@ -1,0 +1,71 @@
+// facet results export: reads a station's results store.
+#include <chrono>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "service/cli/command_line.hpp"
+#include "service/daemon/results_store.hpp"
+
+namespace facet::cli {
+namespace {
+
+// Accepts an ISO date or date-time in UTC ("2026-11-21", "2026-11-21T08:00:00") or a duration
+// back from now ("8h", "30m", "2d").
+std::chrono::system_clock::time_point parseSince(const std::string& text) {
+  using namespace std::chrono;
+  if (text.empty()) return system_clock::time_point{};
+  const char unit = text.back();
+  if (unit == 'h' || unit == 'm' || unit == 'd' || unit == 's') {
+    try {
+      const double n = std::stod(text.substr(0, text.size() - 1));
+      const double secs = n * (unit == 'd' ? 86400 : unit == 'h' ? 3600 : unit == 'm' ? 60 : 1);
+      return system_clock::now() - duration_cast<system_clock::duration>(duration<double>(secs));
+    } catch (const std::exception&) {
+      throw InputError("--since: cannot read '" + text + "'");
+    }
+  }
+  std::tm tm{};
+  std::istringstream in(text);
+  in >> std::get_time(&tm, text.size() > 10 ? "%Y-%m-%dT%H:%M:%S" : "%Y-%m-%d");
+  if (in.fail())
+    throw InputError("--since: expected YYYY-MM-DD[THH:MM:SS] (UTC) or a duration like 8h, got '" +
+                     text + "'");
+  return system_clock::from_time_t(timegm(&tm));
+}
+
+}  // namespace
+
+void addResultsCommand(CLI::App& app) {
+  auto* results = app.add_subcommand("results", "Read a station's results store");
+  results->require_subcommand(1);
+  auto* exportCmd = results->add_subcommand("export", "Export stored parts as CSV or JSON");
+  struct Options {
+    std::string db;
+    std::string since;
+    bool csv = false;
+    bool json = false;
+    std::size_t limit = 0;
+  };
+  auto opt = std::make_shared<Options>();
+  exportCmd->add_option("--db", opt->db, "Results database (SQLite file)")->required();
+  exportCmd->add_option("--since", opt->since,
+                        "Only parts at or after: YYYY-MM-DD[THH:MM:SS] UTC, or 8h / 30m / 2d ago");
+  exportCmd->add_option("--limit", opt->limit, "At most this many parts (0 = all)");
+  auto* csv = exportCmd->add_flag("--csv", opt->csv, "CSV, one column per measured value");
+  exportCmd->add_flag("--json", opt->json, "One JSON object {\"parts\": [...]}")->excludes(csv);
+  exportCmd->callback([opt] {
+    if (!std::filesystem::exists(opt->db)) throw InputError(opt->db + ": no such results database");
+    const service::ResultsStore store(opt->db);
+    const auto parts = store.query(parseSince(opt->since), opt->limit);
+    if (opt->csv) {
+      std::cout << service::toCsv(parts);
+      return;
+    }
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& p : parts) list.push_back(service::toJson(p));
+    printJson({{"parts", list}, {"count", parts.size()}});
+  });
+}
+
+}  // namespace facet::cli

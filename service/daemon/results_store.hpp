@@ -1,0 +1,66 @@
+#pragma once
+// The station's results store: one SQLite file, one row per part (and one row per measured value),
+// in WAL mode so that a crash or SIGKILL leaves a consistent database.
+
+#include <chrono>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "service/daemon/part_result.hpp"
+
+struct sqlite3;
+struct sqlite3_stmt;
+
+namespace facet::service {
+
+struct RetentionPolicy {
+  std::optional<std::chrono::hours> maxAge;  // parts older than this are deleted (none = keep)
+  std::optional<std::int64_t> maxParts;      // keep at most this many newest parts (none = all)
+};
+
+class ResultsStore {
+ public:
+  // Opens (creating when missing) the database file. Throws std::runtime_error naming the file.
+  explicit ResultsStore(const std::filesystem::path& file, RetentionPolicy retention = {});
+  ~ResultsStore();
+  ResultsStore(const ResultsStore&) = delete;
+  ResultsStore& operator=(const ResultsStore&) = delete;
+
+  // Stores one part in one transaction. Throws on failure (the caller counts and logs it).
+  void store(const PartResult& part);
+
+  // Applies the retention policy; returns the number of parts deleted.
+  std::int64_t applyRetention(std::chrono::system_clock::time_point now);
+
+  [[nodiscard]] std::int64_t partCount() const;
+  // The highest stored part id (0 when empty): a restarted daemon continues after it.
+  [[nodiscard]] std::uint64_t lastPartId() const;
+
+  // Parts at or after `since` (oldest first), at most `limit` (0 = all).
+  [[nodiscard]] std::vector<PartResult> query(std::chrono::system_clock::time_point since,
+                                              std::size_t limit = 0) const;
+  // The `count` newest parts, newest last.
+  [[nodiscard]] std::vector<PartResult> latest(std::size_t count) const;
+
+  // "ok" when PRAGMA integrity_check passes, otherwise its first message.
+  [[nodiscard]] std::string integrityCheck() const;
+
+  [[nodiscard]] const std::filesystem::path& file() const { return file_; }
+
+ private:
+  std::vector<PartResult> select(const std::string& where, const std::string& order,
+                                 std::int64_t bind, std::size_t limit) const;
+  std::filesystem::path file_;
+  RetentionPolicy retention_;
+  sqlite3* db_ = nullptr;
+};
+
+nlohmann::json toJson(const PartResult& part);
+// CSV with a header row; one column per distinct measurement name across `parts`.
+std::string toCsv(const std::vector<PartResult>& parts);
+
+}  // namespace facet::service

@@ -1,0 +1,77 @@
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "service/daemon/image_archive.hpp"
+#include "service/daemon/metrics.hpp"
+
+namespace facet::service {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(Metrics, ExpositionFormat) {
+  MetricsRegistry m;
+  m.counter("facet_parts_total", "Parts inspected", "verdict=\"pass\"").increment();
+  m.counter("facet_parts_total", "Parts inspected", "verdict=\"pass\"").increment(2);
+  m.gauge("facet_queue_depth", "Frames waiting", "queue=\"inspect\"").set(4);
+  auto& h = m.histogram("facet_stage_ms", "Stage latency", {1, 10}, "stage=\"inspect\"");
+  h.observe(0.5);
+  h.observe(5);
+  h.observe(50);
+  const std::string text = m.exposition();
+  EXPECT_NE(text.find("# TYPE facet_parts_total counter"), std::string::npos);
+  EXPECT_NE(text.find("facet_parts_total{verdict=\"pass\"} 3"), std::string::npos) << text;
+  EXPECT_NE(text.find("facet_queue_depth{queue=\"inspect\"} 4"), std::string::npos);
+  EXPECT_NE(text.find("facet_stage_ms_bucket{stage=\"inspect\",le=\"1\"} 1"), std::string::npos);
+  EXPECT_NE(text.find("facet_stage_ms_bucket{stage=\"inspect\",le=\"10\"} 2"), std::string::npos);
+  EXPECT_NE(text.find("facet_stage_ms_bucket{stage=\"inspect\",le=\"+Inf\"} 3"), std::string::npos);
+  EXPECT_NE(text.find("facet_stage_ms_count{stage=\"inspect\"} 3"), std::string::npos);
+  EXPECT_THROW(m.gauge("facet_parts_total", "x"), std::logic_error);
+}
+
+PartResult partWith(std::uint64_t id, Verdict v) {
+  PartResult p;
+  p.partId = id;
+  p.verdict = v;
+  p.time = std::chrono::system_clock::now();
+  return p;
+}
+
+TEST(ImageArchive, KeepsFailedPartsAndSampleOfGoodOnesUnderQuota) {
+  const fs::path dir = fs::temp_directory_path() / ("facet-archive-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  cv::Mat noise(200, 200, CV_8U);
+  cv::randu(noise, 0, 255);  // incompressible: ~40 KB per PNG
+  ImageArchive archive({.folder = dir, .quotaBytes = 200'000, .failed = true, .goodEvery = 2});
+  EXPECT_FALSE(archive.archive(partWith(1, Verdict::Pass), noise, noise));  // 1st good: skipped
+  EXPECT_TRUE(archive.archive(partWith(2, Verdict::Pass), noise, noise));   // 2nd good: kept
+  for (std::uint64_t i = 3; i < 10; ++i) {
+    const auto saved = archive.archive(partWith(i, Verdict::Fail), noise, noise);
+    ASSERT_TRUE(saved);
+    EXPECT_TRUE(fs::exists(saved->raw));
+    EXPECT_TRUE(fs::exists(saved->overlay));
+  }
+  EXPECT_LE(archive.bytesUsed(), 200'000u);
+  EXPECT_GT(archive.filesRemoved(), 0u);
+  std::uint64_t onDisk = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) onDisk += e.file_size();
+  EXPECT_EQ(onDisk, archive.bytesUsed());
+  EXPECT_FALSE(archive.degraded());
+  // A restarted archive counts the files already there.
+  ImageArchive again({.folder = dir, .quotaBytes = 200'000});
+  EXPECT_EQ(again.bytesUsed(), onDisk);
+  fs::remove_all(dir);
+}
+
+TEST(ImageArchive, UnwritableFolderIsDegradedNotFatal) {
+  cv::Mat img(10, 10, CV_8U, cv::Scalar(1));
+  ImageArchive archive({.folder = "/proc/facet-archive"});
+  EXPECT_FALSE(archive.archive(partWith(1, Verdict::Fail), img, img));
+  EXPECT_TRUE(archive.degraded());
+  EXPECT_FALSE(archive.lastError().empty());
+}
+
+}  // namespace
+}  // namespace facet::service

@@ -1,0 +1,104 @@
+#include <filesystem>
+
+#include <gtest/gtest.h>
+
+#include "service/daemon/results_store.hpp"
+
+namespace facet::service {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path freshFile(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("facet-store-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const fs::path f = dir / name;
+  fs::remove(f);
+  fs::remove(f.string() + "-wal");
+  fs::remove(f.string() + "-shm");
+  return f;
+}
+
+PartResult part(std::uint64_t id, Verdict v, double diameter) {
+  PartResult p;
+  p.partId = id;
+  p.time = std::chrono::system_clock::now();
+  p.recipeId = 3;
+  p.recipeName = "bracket";
+  p.recipeVersion = "abc123";
+  p.frameId = 100 + id;
+  p.serial = "SN" + std::to_string(id);
+  p.verdict = v;
+  p.measurements.push_back(
+      {"bore.diameter", diameter, "mm", 10.0, 0.05, 0.05, true, std::abs(diameter - 10.0) <= 0.05});
+  p.measurements.push_back({"align.score", 0.93, "score", {}, {}, {}, false, true});
+  p.timings.push_back({"bore", 0.8});
+  if (v == Verdict::Fail) p.failedChecks.push_back("bore.diameter");
+  return p;
+}
+
+TEST(ResultsStore, StoresAndReadsBackEveryField) {
+  const fs::path file = freshFile("a.sqlite");
+  ResultsStore store(file);
+  store.store(part(1, Verdict::Pass, 10.01));
+  store.store(part(2, Verdict::Fail, 10.2));
+  EXPECT_EQ(store.partCount(), 2);
+  EXPECT_EQ(store.lastPartId(), 2u);
+  const auto parts = store.latest(10);
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[1].verdict, Verdict::Fail);
+  EXPECT_EQ(parts[1].serial, "SN2");
+  EXPECT_EQ(parts[1].failedChecks, std::vector<std::string>{"bore.diameter"});
+  ASSERT_EQ(parts[1].measurements.size(), 2u);
+  EXPECT_DOUBLE_EQ(parts[1].measurements[0].value, 10.2);
+  EXPECT_FALSE(parts[1].measurements[0].pass);
+  EXPECT_FALSE(parts[1].measurements[1].nominal.has_value());
+  EXPECT_EQ(parts[0].timings.at(0).step, "bore");
+  EXPECT_EQ(store.integrityCheck(), "ok");
+}
+
+TEST(ResultsStore, DuplicatePartIdIsRefusedAndNothingHalfWritten) {
+  const fs::path file = freshFile("b.sqlite");
+  ResultsStore store(file);
+  store.store(part(1, Verdict::Pass, 10.0));
+  EXPECT_THROW(store.store(part(1, Verdict::Fail, 11.0)), std::runtime_error);
+  EXPECT_EQ(store.partCount(), 1);
+  EXPECT_EQ(store.latest(1).at(0).measurements.at(0).value, 10.0);
+}
+
+TEST(ResultsStore, RetentionKeepsNewestParts) {
+  const fs::path file = freshFile("c.sqlite");
+  ResultsStore store(file, {.maxAge = std::nullopt, .maxParts = 3});
+  for (std::uint64_t i = 1; i <= 5; ++i) store.store(part(i, Verdict::Pass, 10.0));
+  EXPECT_EQ(store.applyRetention(std::chrono::system_clock::now()), 2);
+  EXPECT_EQ(store.partCount(), 3);
+  EXPECT_EQ(store.latest(10).front().partId, 3u);
+}
+
+TEST(ResultsStore, ReopenContinuesAfterLastPart) {
+  const fs::path file = freshFile("d.sqlite");
+  { ResultsStore(file).store(part(41, Verdict::Pass, 10.0)); }
+  ResultsStore again(file);
+  EXPECT_EQ(again.lastPartId(), 41u);
+}
+
+TEST(ResultsStore, UnwritableLocationNamesTheFile) {
+  try {
+    ResultsStore store("/proc/facet-no-such/results.sqlite");
+    FAIL() << "expected an error";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("/proc/facet-no-such"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ResultsExport, CsvHasOneColumnPerMeasurement) {
+  const std::string csv = toCsv({part(1, Verdict::Pass, 10.01), part(2, Verdict::Fail, 10.2)});
+  EXPECT_NE(csv.find("bore.diameter,align.score"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",fail,bore.diameter,"), std::string::npos) << csv;
+  const auto j = toJson(part(2, Verdict::Fail, 10.2));
+  EXPECT_EQ(j["verdict"], "fail");
+  EXPECT_EQ(j["values"]["bore.diameter"]["nominal"], 10.0);
+}
+
+}  // namespace
+}  // namespace facet::service
