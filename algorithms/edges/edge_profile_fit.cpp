@@ -474,6 +474,19 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
     }
     if (!ok) return std::nullopt;
   }
+  // A seed normal off by more than a degree or two (noise, a corner nearby) needs more turn
+  // steps: the linearisation in phi is only good for small turns. Give up when they do not
+  // settle.
+  if (!fitWidth && std::abs(phi) > 0.03) {
+    const ProfileView view = aperture->view(normal);
+    double previous = phi;
+    for (int extra = 0; extra < 3; ++extra) {
+      if (!step<Extra::Turn>(smp, view, a, b, e, w, phi)) return std::nullopt;
+      if (std::abs(phi - previous) < 0.003) break;
+      previous = phi;
+    }
+    if (std::abs(phi - previous) >= 0.003) return std::nullopt;
+  }
   if (std::abs(e - offset) > 1.0) return std::nullopt;  // wandered off: not a clean edge
   if (fittedWidth) *fittedWidth = w;
 

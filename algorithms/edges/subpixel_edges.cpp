@@ -102,12 +102,15 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   // Profile refinement where its window fits in the image, with one blur width per image.
   EdgeProfileParams profile;
-  const int reach = edgeProfileReach(profile);
-  const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
   if (params.fitProfile) {
     profile.width = estimateEdgeWidth(image, seeds, profile);
     result.blurSigma = std::sqrt(std::max(profile.width * profile.width - 1.0 / 12, 0.0));
+    // What separates the offset from the background level is the plateau on either side; keep
+    // about 4 widths of it in the window when the blur is wide.
+    profile.halfAcross = std::clamp(3.9 * profile.width, profile.halfAcross, 6.5);
   }
+  const int reach = edgeProfileReach(profile);
+  const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
   std::vector<cv::Point> pixels;
   std::vector<double> windowBias;  // per point: kappa coefficient of the fit's window bias
   result.points.reserve(seeds.size());
