@@ -64,25 +64,28 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   // The gradient covers the ROI plus one pixel for suppression; edge pixels need the facet's
   // 5x5 window inside the image.
   const cv::Rect area = cv::Rect(roi.x - 1, roi.y - 1, roi.width + 2, roi.height + 2) & full;
-  const EdgeGradient gradient = computeEdgeGradient(image, area);
   const cv::Rect usable = cv::Rect(2, 2, image.cols - 4, image.rows - 4) & roi;
   if (usable.empty()) return result;
   const cv::Rect candidates = usable - area.tl();
   const cv::Mat mask = params.mask.empty() ? cv::Mat() : params.mask(area);
 
+  cv::Mat edges;
   if (params.low && params.high) {
     result.lowThreshold = *params.low;
     result.highThreshold = *params.high;
+    edges = cannyInStrips(image, area, result.lowThreshold, result.highThreshold, mask, candidates);
   } else {
+    // Automatic thresholds need the whole region's magnitudes first.
+    const EdgeGradient gradient = computeEdgeGradient(image, area);
     cv::Mat region = cv::Mat::zeros(area.size(), CV_8U);
     region(candidates).setTo(255);
     if (!mask.empty()) region &= mask;
     const CannyThresholds t = autoCannyThresholds(gradient.magnitude, region);
     result.lowThreshold = t.low;
     result.highThreshold = t.high;
+    edges =
+        cannyFromGradient(gradient, result.lowThreshold, result.highThreshold, mask, candidates);
   }
-  const cv::Mat edges =
-      cannyFromGradient(gradient, result.lowThreshold, result.highThreshold, mask, candidates);
 
   // Facet zero crossings of every Canny pixel.
   std::vector<EdgeSeed> seeds;
