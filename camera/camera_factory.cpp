@@ -2,6 +2,7 @@
 
 #include "camera/aravis_camera.hpp"
 #include "camera/replay_camera.hpp"
+#include "camera/v4l2_camera.hpp"
 
 namespace facet {
 

@@ -8,8 +8,8 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "algorithms/circle/annulus_edges.hpp"
 #include "algorithms/circle/circle_profile_fit.hpp"
-#include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/geometry/ransac.hpp"
 
 namespace facet {
@@ -65,11 +65,14 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
   double lambda = 1e-6;
   auto cost = [&](const Circle& k) {
     double s = 0;
-    for (std::size_t i = 0; i < pts.size(); ++i) s += w[i] * std::pow(residual(k, pts[i]), 2);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double r = residual(k, pts[i]);
+      s += w[i] * r * r;
+    }
     return s;
   };
   double current = cost(c);
-  for (int it = 0; it < 30; ++it) {
+  for (int it = 0; it < 20; ++it) {
     Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
     Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -91,7 +94,7 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
       const double nextCost = cost(next);
       if (nextCost <= current) {
         improved = true;
-        const bool converged = step.norm() < 1e-9;
+        const bool converged = step.norm() < 1e-6;  // pixels: far below the accuracy sought
         c = next;
         current = nextCost;
         lambda = std::max(lambda * 0.1, 1e-12);
@@ -197,42 +200,16 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   const double rOut = params.radius + params.width;
   const cv::Point2d c0 = params.centre;
 
-  // The annulus' bounding box plus the Facet window's margin, clipped to the image.
-  constexpr int kMargin = 4;
-  const cv::Rect box(static_cast<int>(std::floor(c0.x - rOut)) - kMargin,
-                     static_cast<int>(std::floor(c0.y - rOut)) - kMargin,
-                     static_cast<int>(2 * rOut) + 2 * kMargin + 3,
-                     static_cast<int>(2 * rOut) + 2 * kMargin + 3);
-  const cv::Rect crop = box & cv::Rect(0, 0, image.cols, image.rows);
-  // Only pixels at least 2 px from the image border carry a full 5x5 Facet window.
-  const cv::Rect usable = cv::Rect(2, 2, image.cols - 4, image.rows - 4);
-  cv::Mat mask = cv::Mat::zeros(crop.size(), CV_8U);
-  int annulusPixels = 0;
-  const double rIn2 = rIn * rIn, rOut2 = rOut * rOut;
-  for (int y = 0; y < crop.height; ++y) {
-    auto* row = mask.ptr<std::uint8_t>(y);
-    const double dy = crop.y + y - c0.y;
-    for (int x = 0; x < crop.width; ++x) {
-      const double dx = crop.x + x - c0.x;
-      const double d2 = dx * dx + dy * dy;
-      if (d2 >= rIn2 && d2 <= rOut2 && usable.contains({crop.x + x, crop.y + y})) {
-        row[x] = 255;
-        ++annulusPixels;
-      }
-    }
-  }
-  if (annulusPixels == 0)
+  // Canny thresholds from the annulus alone, then Facet subpixel points (annulus_edges.hpp).
+  const AnnulusEdges edges =
+      detectAnnulusEdges(image, c0, rIn, rOut, params.cannyLow, params.cannyHigh);
+  if (edges.annulusPixels == 0)
     return failed(m, CircleFailure::AnnulusOutsideImage,
                   "the search annulus around (" + std::to_string(c0.x) + ", " +
                       std::to_string(c0.y) + ") with radius " + std::to_string(params.radius) +
                       " +- " + std::to_string(params.width) + " lies outside the " +
                       std::to_string(image.cols) + "x" + std::to_string(image.rows) + " image");
 
-  EdgeParams ep;
-  ep.low = params.cannyLow;
-  ep.high = params.cannyHigh;
-  ep.mask = mask;  // thresholds come from the annulus alone
-  const EdgeContours edges = detectSubpixelEdges(image(crop), ep);
   m.lowThreshold = edges.lowThreshold;
   m.highThreshold = edges.highThreshold;
   m.edgePoints = static_cast<int>(edges.points.size());
@@ -242,7 +219,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::vector<Candidate> candidates;
   candidates.reserve(edges.points.size());
   for (const EdgePoint& e : edges.points) {
-    const Eigen::Vector2d p{e.position.x + crop.x, e.position.y + crop.y};
+    const Eigen::Vector2d p{e.position.x, e.position.y};
     const Eigen::Vector2d radial = p - Eigen::Vector2d{c0.x, c0.y};
     const double d = radial.norm();
     if (d < rIn || d > rOut || d == 0.0) continue;
@@ -306,7 +283,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
       if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
     if (static_cast<int>(in.size()) < params.minInliers) break;
     w.assign(in.size(), 1.0);
-    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 4;
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 3;
     for (int k = 0; k < irls; ++k) {
       if (k > 0) {
         std::vector<double> a;

@@ -62,8 +62,8 @@ struct CircleMeasureParams {
   // Minimum number of inliers of the final fit. Default 12.
   int minInliers = 12;
   // Minimum angular coverage of the inliers, degrees (0..360). Partial arcs down to this extent
-  // are measured. Default 180.
-  double minCoverageDeg = 180.0;
+  // are measured. Default 120 (a rim one third hidden still measures).
+  double minCoverageDeg = 120.0;
   // Robust weight of the geometric fit. Default Tukey.
   CircleRobustWeight robustWeight = CircleRobustWeight::Tukey;
   // Largest acceptable RMS of the inliers' orthogonal residuals, pixels. Default 0.5.

@@ -1,5 +1,7 @@
 #include "algorithms/edges/curvature_bias.hpp"
 
+#include "algorithms/edges/edge_profile_fit.hpp"
+
 #include <cmath>
 
 namespace facet {
@@ -33,7 +35,9 @@ void correctCurvatureBias(std::vector<EdgePoint>& points,
       const double d2 = dp.dot(dp);
       if (d2 < 1e-6) continue;
       const double kappa = dp.dot(pb.normal - pa.normal) / d2;
-      shifts[i] = params.coefficient * kappa * points[contour[i]].normal;
+      double shift = params.coefficient * kappa;
+      if (params.profileFitted) shift += std::copysign(profileCurvatureBias(kappa), kappa);
+      shifts[i] = shift * points[contour[i]].normal;
     }
     for (int i = 0; i < n; ++i) points[contour[i]].position += shifts[i];
   }

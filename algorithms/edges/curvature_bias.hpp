@@ -1,14 +1,17 @@
 #pragma once
-// Correction of the radial bias of second-derivative edges on curved contours.
+// Correction of the radial bias of the edge points on curved contours.
 //
-// On a blurred curved edge the slope maximum along the gradient moves towards the centre of
-// curvature: for a Gaussian-blurred disc of radius r the shift is about sigma^2 / (2 r), and the
-// facet window adds its own smoothing. Measured on rendered discs (bench_edges prints the table)
-// the points lie about `coefficient / r` pixels inside the true contour. The correction estimates
-// the signed curvature from the turn of the normals along the linked contour,
+// Two effects move the points towards the centre of curvature on a contour of radius r:
+// - the blur: on a blurred disc the slope maximum lies about sigma^2 / (2 r) inside the true
+//   edge; with the profile fit it is `coefficient / r` (calibrated by bench_edges on rendered
+//   discs, blur 0.8-1.5);
+// - the straight-line profile fit averages the arc over its window along the edge:
+//   profileCurvatureBias(kappa) (edge_profile_fit.hpp), about kappa L (L + 1) / 6.
+// The correction estimates the signed curvature from the turn of the normals along the linked
+// contour,
 //   kappa_n = (p_b - p_a) . (n_b - n_a) / |p_b - p_a|^2   (positive: centre on the -n side),
-// over neighbours `halfWindow` points either side, and moves each point by coefficient * kappa_n
-// along its normal, i.e. away from the centre of curvature.
+// over neighbours `halfWindow` points either side, and moves each point away from the centre
+// of curvature by the sum of both.
 
 #include <vector>
 
@@ -17,8 +20,9 @@
 namespace facet {
 
 struct CurvatureBiasParams {
-  double coefficient = 1.3;  // pixels^2: bias = coefficient / radius
-  int halfWindow = 4;        // points either side used for the curvature estimate
+  double coefficient = 0.5;   // pixels^2: blur part of the bias = coefficient / radius
+  bool profileFitted = true;  // add the profile fit's window bias (points from fitEdgeProfile)
+  int halfWindow = 4;         // points either side used for the curvature estimate
 };
 
 // Corrects `points` in place along each contour of `contours` (index lists into `points`).

@@ -3,7 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <memory>
+#include <mutex>
 #include <numbers>
+#include <vector>
 
 namespace facet {
 namespace {
@@ -16,19 +20,20 @@ constexpr int kTableSize = static_cast<int>(2 * kRange * kPerUnit) + 2;
 
 struct NormalTable {
   std::array<float, kTableSize> cdf{}, pdf{};
+  // The same, packed per interval for the vectorised fit: value and slope of CDF and PDF.
+  struct alignas(16) Interval {
+    float cdf, cdfSlope, pdf, pdfSlope;
+  };
+  std::array<Interval, kTableSize> packed{};
   NormalTable() {
     for (int i = 0; i < kTableSize; ++i) {
       const double z = -kRange + static_cast<double>(i) / kPerUnit;
       cdf[i] = static_cast<float>(0.5 * std::erfc(-z / std::numbers::sqrt2));
       pdf[i] = static_cast<float>(std::exp(-0.5 * z * z) / std::sqrt(2 * std::numbers::pi));
     }
-  }
-  void lookup(float z, float& c, float& p) const {
-    const float f = std::clamp((z + kRange) * kPerUnit, 0.0f, kTableSize - 1.001f);
-    const int i = static_cast<int>(f);
-    const float r = f - static_cast<float>(i);
-    c = cdf[i] + r * (cdf[i + 1] - cdf[i]);
-    p = pdf[i] + r * (pdf[i + 1] - pdf[i]);
+    for (int i = 0; i + 1 < kTableSize; ++i)
+      packed[i] = {cdf[i], cdf[i + 1] - cdf[i], pdf[i], pdf[i + 1] - pdf[i]};
+    packed[kTableSize - 1] = {cdf[kTableSize - 1], 0, pdf[kTableSize - 1], 0};
   }
 };
 
@@ -37,13 +42,173 @@ const NormalTable& normalTable() {
   return table;
 }
 
+// A tabulated edge profile: value P and derivative D per interval (value and slope), looked up
+// at table coordinate (u * coordScale + range) * perUnit for the distance u to the edge line.
+struct ProfileView {
+  const NormalTable::Interval* data = nullptr;
+  int size = 0;
+  float coordScale = 1, range = 0, perUnit = 1;
+  double derivScale = 1;  // D * derivScale = dP/du * (1 / coordScale) convention, see step()
+};
+
+// Profiles of a blurred step seen through the pixel aperture, for one PSF sigma and normal
+// angles 0..45 degrees (1 degree steps; the profile depends only on {|cos|, |sin|}).
+// For the unit pixel square the aperture projected on the normal is box(c) * box(s) with
+// c = |cos|, s = |sin|, so with G(x) = x Phi(x) + phi(x) and H(x) = ((x^2 + 1) Phi(x) + x phi(x))/2
+// (the first and second antiderivatives of Phi):
+//   P(u)  = sigma^2 / (c s) [H((u+p)/sigma) - H((u+m)/sigma) - H((u-m)/sigma) + H((u-p)/sigma)]
+//   P'(u) = sigma   / (c s) [G(...)         - G(...)         - G(...)         + G(...)]
+// with p = (c + s)/2, m = (c - s)/2; for s -> 0 the single box gives
+//   P(u) = sigma / c [G((u+c/2)/sigma) - G((u-c/2)/sigma)],  P'(u) = [Phi(..) - Phi(..)] / c.
+constexpr float kApertureRange = 7.5f;  // pixels either side of the edge
+constexpr int kAperturePerPixel = 16;
+constexpr int kApertureSize = static_cast<int>(2 * kApertureRange * kAperturePerPixel) + 2;
+constexpr int kApertureAngles = 46;
+
+struct ApertureProfiles {
+  double sigma = 0;
+  bool gridBlur = false;
+  std::vector<NormalTable::Interval> rows;  // kApertureAngles x kApertureSize
+
+  ApertureProfiles(double psfSigma, bool blurOnGrid) : sigma(psfSigma), gridBlur(blurOnGrid) {
+    rows.resize(static_cast<size_t>(kApertureAngles) * kApertureSize);
+    std::vector<double> value(kApertureSize), slope(kApertureSize);
+    for (int k = 0; k < kApertureAngles; ++k) {
+      const double angle = k * std::numbers::pi / 180.0;
+      const double c = std::cos(angle), sn = std::sin(angle);
+      for (int i = 0; i < kApertureSize; ++i) {
+        const double u = -kApertureRange + static_cast<double>(i) / kAperturePerPixel;
+        if (gridBlur)
+          gridProfile(u, c, sn, value[i], slope[i]);
+        else
+          profile(u, c, sn, value[i], slope[i]);
+      }
+      NormalTable::Interval* row = &rows[static_cast<size_t>(k) * kApertureSize];
+      for (int i = 0; i < kApertureSize; ++i) {
+        const int j = std::min(i + 1, kApertureSize - 1);
+        row[i] = {static_cast<float>(value[i]), static_cast<float>(value[j] - value[i]),
+                  static_cast<float>(slope[i]), static_cast<float>(slope[j] - slope[i])};
+      }
+    }
+  }
+
+  ProfileView view(cv::Point2d normal) const {
+    const double lo = std::min(std::abs(normal.x), std::abs(normal.y));
+    const double hi = std::max(std::abs(normal.x), std::abs(normal.y));
+    const int k =
+        std::clamp(static_cast<int>(std::lround(std::atan2(lo, hi) * 180 / std::numbers::pi)), 0,
+                   kApertureAngles - 1);
+    return {&rows[static_cast<size_t>(k) * kApertureSize],
+            kApertureSize,
+            1.0f,
+            kApertureRange,
+            static_cast<float>(kAperturePerPixel),
+            1.0};
+  }
+
+ private:
+  static double cdf(double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }
+  static double pdf(double x) { return std::exp(-0.5 * x * x) / std::sqrt(2 * std::numbers::pi); }
+  static double g(double x) { return x * cdf(x) + pdf(x); }
+  static double h(double x) { return 0.5 * ((x * x + 1) * cdf(x) + x * pdf(x)); }
+
+  // The sharp step integrated over the pixel square: the CDF and density of the aperture
+  // box(c) * box(s) at x.
+  static void sharpStep(double x, double c, double s, double& value, double& slope) {
+    if (s < 1e-6) {
+      value = std::clamp((x + c / 2) / c, 0.0, 1.0);
+      slope = std::abs(x) < c / 2 ? 1 / c : 0.0;
+      return;
+    }
+    const double p = (c + s) / 2, m = (c - s) / 2;
+    if (x <= -p) {
+      value = 0, slope = 0;
+    } else if (x <= -m) {
+      value = (x + p) * (x + p) / (2 * c * s), slope = (x + p) / (c * s);
+    } else if (x <= m) {
+      value = s / (2 * c) + (x + m) / c, slope = 1 / c;
+    } else if (x < p) {
+      value = 1 - (p - x) * (p - x) / (2 * c * s), slope = (p - x) / (c * s);
+    } else {
+      value = 1, slope = 0;
+    }
+  }
+
+  // Blur on the pixel grid: the pixel-integrated sharp step convolved with the sampled Gaussian
+  // kernel (truncated at 4 sigma, normalised), as a blur applied to the sampled image does:
+  //   P(u) = sum_k g(kx) g(ky) sharpStep(u - kx c - ky s).
+  void gridProfile(double u, double c, double s, double& value, double& slope) const {
+    const int r = static_cast<int>(std::ceil(4 * sigma));
+    thread_local std::vector<double> kernel;
+    kernel.assign(2 * r + 1, 0.0);
+    double sum = 0;
+    for (int k = -r; k <= r; ++k) sum += kernel[k + r] = std::exp(-0.5 * k * k / (sigma * sigma));
+    value = slope = 0;
+    for (int ky = -r; ky <= r; ++ky)
+      for (int kx = -r; kx <= r; ++kx) {
+        double v, d;
+        sharpStep(u - kx * c - ky * s, c, s, v, d);
+        const double weight = kernel[kx + r] * kernel[ky + r] / (sum * sum);
+        value += weight * v;
+        slope += weight * d;
+      }
+  }
+
+  void profile(double u, double c, double s, double& value, double& slope) const {
+    const double sg = sigma;
+    if (s < 1e-3) {
+      value = sg / c * (g((u + c / 2) / sg) - g((u - c / 2) / sg));
+      slope = (cdf((u + c / 2) / sg) - cdf((u - c / 2) / sg)) / c;
+      return;
+    }
+    const double p = (c + s) / 2, m = (c - s) / 2;
+    value =
+        sg * sg / (c * s) * (h((u + p) / sg) - h((u + m) / sg) - h((u - m) / sg) + h((u - p) / sg));
+    slope = sg / (c * s) * (g((u + p) / sg) - g((u + m) / sg) - g((u - m) / sg) + g((u - p) / sg));
+  }
+};
+
+// Profiles are pure functions of sigma; keep the last few so that a camera's images (whose blur
+// estimate varies little) build them once.
+std::shared_ptr<const ApertureProfiles> apertureProfiles(double sigma, bool gridBlur) {
+  static std::mutex mutex;
+  static std::vector<std::shared_ptr<const ApertureProfiles>> cache;
+  const double key = std::round(sigma * 50) / 50;
+  std::lock_guard lock(mutex);
+  for (const auto& p : cache)
+    if (p->sigma == key && p->gridBlur == gridBlur) return p;
+  auto made = std::make_shared<const ApertureProfiles>(key, gridBlur);
+  if (cache.size() >= 8) cache.erase(cache.begin());
+  cache.push_back(made);
+  return made;
+}
+
+ProfileView erfView(double w) {
+  const auto& t = normalTable();
+  return {t.packed.data(),
+          kTableSize,
+          static_cast<float>(1.0 / w),
+          kRange,
+          static_cast<float>(kPerUnit),
+          w};
+}
+
 constexpr int kCapacity = 512;
 
+// Four float lanes (GCC/Clang vector extension; SSE on x86, NEON on ARM).
+using Lanes = float __attribute__((vector_size(16)));
+using IntLanes = int __attribute__((vector_size(16)));
+
 struct Samples {
-  int count = 0;
+  int count = 0;  // padded to a multiple of 4 with zero-weight samples
   float mean = 0;
-  std::array<float, kCapacity> s, t, v;  // across, along, grey value minus mean
+  // across, along, grey value minus mean, weight (1, or 0 for padding)
+  alignas(16) std::array<float, kCapacity> s, t, v, weight;
 };
+
+float horizontalSum(Lanes x) {
+  return (x[0] + x[1]) + (x[2] + x[3]);
+}
 
 // Solves the symmetric positive definite n x n system A x = y by Cholesky; false if singular.
 template <int N>
@@ -96,16 +261,22 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
     restrict(n.x, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first, last);
     restrict(-n.y, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
     const T* row = image.ptr<T>(c.y + dy) + c.x;
-    for (int dx = first; dx <= last && out.count < kCapacity; ++dx) {
+    for (int dx = first; dx <= last && out.count < kCapacity - 4; ++dx) {
       const int i = out.count++;
       out.s[i] = static_cast<float>(dx * n.x + dy * n.y);
       out.t[i] = static_cast<float>(-dx * n.y + dy * n.x);
       out.v[i] = static_cast<float>(row[dx]) * scale;
+      out.weight[i] = 1.0f;
       sum += out.v[i];
     }
   }
-  out.mean = out.count ? static_cast<float>(sum / out.count) : 0.0f;
-  for (int i = 0; i < out.count; ++i) out.v[i] -= out.mean;
+  const int real = out.count;
+  out.mean = real ? static_cast<float>(sum / real) : 0.0f;
+  for (int i = 0; i < real; ++i) out.v[i] -= out.mean;
+  while (out.count % 4) {
+    const int i = out.count++;
+    out.s[i] = out.t[i] = out.v[i] = out.weight[i] = 0.0f;
+  }
 }
 
 // One Gauss-Newton step of the model v = a + b Phi(z), z = (s + phi t - e) / w, for (a, b, e)
@@ -114,42 +285,75 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
 enum class Extra { None, Width, Turn };
 
 template <Extra X>
-bool step(const Samples& smp, double& a, double& b, double& e, double& w, double& phi) {
+bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, double& e,
+          double& w, double& phi) {
   constexpr int N = X == Extra::None ? 3 : 4;
-  const NormalTable& table = normalTable();
-  const float invW = static_cast<float>(1.0 / w), ef = static_cast<float>(e);
-  const float phiF = static_cast<float>(phi);
-  float acc[N][N + 1] = {};
-  for (int i = 0; i < smp.count; ++i) {
-    const float z = (smp.s[i] + phiF * smp.t[i] - ef) * invW;
-    float cdf, pdf;
-    table.lookup(z, cdf, pdf);
-    float basis[4] = {1.0f, cdf, pdf, 0.0f};
+  const NormalTable::Interval* packed = profile.data;
+  const Lanes vScale = Lanes{} + profile.coordScale, vE = Lanes{} + static_cast<float>(e),
+              vPhi = Lanes{} + static_cast<float>(phi);
+  const Lanes vLow = Lanes{}, vHigh = Lanes{} + (static_cast<float>(profile.size) - 1.001f);
+  Lanes acc[N][N + 1] = {};
+  for (int i = 0; i < smp.count; i += 4) {
+    Lanes ss, tt, vv, ww;
+    std::memcpy(&ss, &smp.s[i], sizeof ss);
+    std::memcpy(&tt, &smp.t[i], sizeof tt);
+    std::memcpy(&vv, &smp.v[i], sizeof vv);
+    std::memcpy(&ww, &smp.weight[i], sizeof ww);
+    const Lanes z = (ss + vPhi * tt - vE) * vScale;
+    Lanes f = (z + profile.range) * profile.perUnit;
+    f = f < vLow ? vLow : f;
+    f = f > vHigh ? vHigh : f;
+    const IntLanes idx = __builtin_convertvector(f, IntLanes);
+    const Lanes r = f - __builtin_convertvector(idx, Lanes);
+    const auto& q0 = packed[idx[0]];
+    const auto& q1 = packed[idx[1]];
+    const auto& q2 = packed[idx[2]];
+    const auto& q3 = packed[idx[3]];
+    const Lanes cdf = Lanes{q0.cdf, q1.cdf, q2.cdf, q3.cdf} +
+                      r * Lanes{q0.cdfSlope, q1.cdfSlope, q2.cdfSlope, q3.cdfSlope};
+    const Lanes pdf = (Lanes{q0.pdf, q1.pdf, q2.pdf, q3.pdf} +
+                       r * Lanes{q0.pdfSlope, q1.pdfSlope, q2.pdfSlope, q3.pdfSlope}) *
+                      ww;
+    Lanes basis[4] = {ww, cdf * ww, pdf, Lanes{}};
     if constexpr (X == Extra::Width) basis[3] = z * pdf;
-    if constexpr (X == Extra::Turn) basis[3] = smp.t[i] * pdf;
-    for (int r = 0; r < N; ++r) {
-      acc[r][N] += basis[r] * smp.v[i];
-      for (int k = 0; k <= r; ++k) acc[r][k] += basis[r] * basis[k];
+    if constexpr (X == Extra::Turn) basis[3] = tt * pdf;
+    for (int row = 0; row < N; ++row) {
+      acc[row][N] += basis[row] * vv;
+      for (int k = 0; k <= row; ++k) acc[row][k] += basis[row] * basis[k];
     }
   }
   std::array<std::array<double, N>, N> m{};
   std::array<double, N> y{};
   for (int r = 0; r < N; ++r) {
-    y[r] = acc[r][N];
-    for (int k = 0; k <= r; ++k) m[r][k] = acc[r][k];
+    y[r] = horizontalSum(acc[r][N]);
+    for (int k = 0; k <= r; ++k) m[r][k] = horizontalSum(acc[r][k]);
   }
   if (!solveSpd<N>(m, y)) return false;
   a = y[0];
   b = y[1];
   if (b <= 1e-6) return false;
-  // d/de = -b pdf / w, d/dw = -b z pdf / w, d/dphi = b t pdf / w.
-  e += std::clamp(-y[2] * w / b, -0.5, 0.5);
+  // With D the tabulated derivative and k = derivScale (w for the erf, 1 for pixel units):
+  // d/de = -b D / k, d/dw = -b z D / w (erf only), d/dphi = b t D / k.
+  const double k = profile.derivScale;
+  e += std::clamp(-y[2] * k / b, -0.5, 0.5);
   if constexpr (X == Extra::Width) w = std::clamp(w - y[3] * w / b, 0.3, 5.0);
-  if constexpr (X == Extra::Turn) phi += std::clamp(y[3] * w / b, -0.2, 0.2);
+  if constexpr (X == Extra::Turn) phi += std::clamp(y[3] * k / b, -0.2, 0.2);
   return true;
 }
 
 }  // namespace
+
+double profileHalfAlong(double curvature, const EdgeProfileParams& params) {
+  const double k = std::abs(curvature);
+  if (k * params.halfAlong * params.halfAlong <= 6 * params.maxCurvatureBias)
+    return params.halfAlong;
+  return std::clamp(std::sqrt(6 * params.maxCurvatureBias / k), params.minAlong, params.halfAlong);
+}
+
+double profileCurvatureBias(double curvature, const EdgeProfileParams& params) {
+  const double l = std::floor(profileHalfAlong(curvature, params));
+  return std::abs(curvature) * l * (l + 1) / 6;
+}
 
 int edgeProfileReach(const EdgeProfileParams& params) {
   return static_cast<int>(std::ceil(std::hypot(params.halfAcross + 1.5, params.halfAlong)));
@@ -168,16 +372,25 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   // With a known width: (a, b, e) steps, the last one also turning the normal. Otherwise the
   // steps fit the width, and a final step the turn.
   const bool fitWidth = params.width <= 0;
+  // A known width w is the erf width of the blur and the pixel aperture together; the aperture's
+  // variance along any normal is (cos^2 + sin^2) / 12 = 1/12, the rest is the PSF.
+  std::shared_ptr<const ApertureProfiles> aperture;
+  if (!fitWidth)
+    aperture = apertureProfiles(std::sqrt(std::max(params.width * params.width - 1.0 / 12, 0.04)),
+                                params.blurOnPixelGrid);
   double a = 0, b = 0, e = offset, w = fitWidth ? params.initialWidth : params.width, phi = 0;
   const int iterations = std::max(1, params.iterations);
   for (int it = 0; it < iterations; ++it) {
     const bool last = it == iterations - 1;
     bool ok = true;
-    if (fitWidth)
-      ok = step<Extra::Width>(smp, a, b, e, w, phi) &&
-           (!last || step<Extra::Turn>(smp, a, b, e, w, phi));
-    else
-      ok = last ? step<Extra::Turn>(smp, a, b, e, w, phi) : step<Extra::None>(smp, a, b, e, w, phi);
+    if (fitWidth) {
+      ok = step<Extra::Width>(smp, erfView(w), a, b, e, w, phi) &&
+           (!last || step<Extra::Turn>(smp, erfView(w), a, b, e, w, phi));
+    } else {
+      const ProfileView view = aperture->view(normal);
+      ok = last ? step<Extra::Turn>(smp, view, a, b, e, w, phi)
+                : step<Extra::None>(smp, view, a, b, e, w, phi);
+    }
     if (!ok) return std::nullopt;
   }
   if (std::abs(e - offset) > 1.0) return std::nullopt;  // wandered off: not a clean edge

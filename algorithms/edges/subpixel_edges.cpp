@@ -26,7 +26,8 @@ bool crossesInsidePixel(const EdgePoint& point, cv::Point pixel) {
 }  // namespace
 
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params) {
-  if (image.empty()) throw std::invalid_argument("detectSubpixelEdges: the image is empty");
+  EdgeContours result;
+  if (image.empty()) return result;
   if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
     throw std::invalid_argument(
         "detectSubpixelEdges: expected an 8-bit or 16-bit single-channel image, got " +
@@ -37,7 +38,6 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   const cv::Rect full(0, 0, image.cols, image.rows);
   const cv::Rect roi = params.roi.empty() ? full : (params.roi & full);
-  EdgeContours result;
   if (roi.empty()) return result;
 
   // The gradient covers the ROI plus one pixel for suppression; edge pixels need the facet's
@@ -65,7 +65,7 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   // Facet zero crossings of every Canny pixel.
   std::vector<EdgeSeed> seeds;
-  std::vector<double> magnitudes;
+  std::vector<double> magnitudes, curvatures;
   for (int y = candidates.y; y < candidates.y + candidates.height; ++y) {
     const auto* e = edges.ptr<uchar>(y);
     for (int x = candidates.x; x < candidates.x + candidates.width; ++x) {
@@ -74,6 +74,7 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
       const auto z = facetZeroCrossing(fitCubicFacet(image, p));
       if (!z || std::abs(z->rho) > 1.0) continue;
       seeds.push_back({p, z->normal, z->rho});
+      curvatures.push_back(z->curvature);
       magnitudes.push_back(z->magnitude);
     }
   }
@@ -90,7 +91,9 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
     const EdgeSeed& s = seeds[i];
     EdgePoint point{cv::Point2d(s.pixel) + s.offset * s.normal, s.normal, magnitudes[i]};
     if (params.fitProfile && fitArea.contains(s.pixel)) {
-      const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, profile);
+      EdgeProfileParams local = profile;
+      local.halfAlong = profileHalfAlong(curvatures[i], profile);
+      const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, local);
       if (!refined) continue;
       point = *refined;
     }

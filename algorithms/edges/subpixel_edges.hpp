@@ -52,7 +52,9 @@ struct EdgeContours {
   double highThreshold = 0;
 };
 
-// Subpixel edges of an 8-bit or 16-bit single-channel image.
+// Subpixel edges of an 8-bit or 16-bit single-channel image. An empty image gives no points;
+// any other type (colour, float, ...) or a mask of the wrong size/type throws
+// std::invalid_argument.
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params = {});
 
 }  // namespace facet

@@ -26,6 +26,9 @@ struct HarrisParams {
   double relativeThreshold = 1e-3;
   // Minimum absolute response (on images scaled to [0, 1]): flat images yield no corners.
   double absoluteThreshold = 1e-8;
+  // Harris-Laplace: keep a corner only at scales where |Laplacian| is not smaller than at the
+  // neighbouring scales (one characteristic scale per structure). Off: every scale's corners.
+  bool selectScale = true;
   int border = 16;              // pixels at the level; corners closer to the edge are dropped
   double anmsRobustness = 0.9;  // a neighbour suppresses when response * this > own response
 };

@@ -33,8 +33,10 @@ struct ScanMatchParams {
   ScanMatchMethod method = ScanMatchMethod::IdcpBoc;
   ScanMetric dualMetric = ScanMetric::PointToLine;  // error used by Dcp and IdcpBoc
 
-  int maxIterations = 100;     // total over both IDCP phases
-  double initialGate = 1.5;    // metres; pairs farther apart are unused in the first iteration
+  int maxIterations = 100;  // total over both IDCP phases
+  // metres; pairs farther apart are unused in the first iteration. Wide on purpose: the gate
+  // then follows the residual down, and a narrow first gate loses large displacements.
+  double initialGate = 4.0;
   double minGate = 0.15;       // metres; the gate never shrinks below this
   double gateFactor = 3.0;     // next gate = gateFactor * rms, clamped to [minGate, last gate]
   double trimFraction = 0.9;   // share of gated pairs kept (the closest ones); 1 = no trimming

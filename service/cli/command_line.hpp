@@ -34,5 +34,8 @@ void addVersionCommand(CLI::App& app);
 void addCircleCommand(CLI::App& app);
 void addScanMatchCommand(CLI::App& app);
 void addResultsCommand(CLI::App& app);
+void addEdgesCommand(CLI::App& app);
+void addModelCommand(CLI::App& app);
+void addMatchCommand(CLI::App& app);
 
 }  // namespace facet::cli

@@ -20,6 +20,9 @@ int main(int argc, char** argv) {
   addCircleCommand(app);
   addScanMatchCommand(app);
   addResultsCommand(app);
+  addEdgesCommand(app);
+  addModelCommand(app);
+  addMatchCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";

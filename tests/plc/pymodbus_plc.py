@@ -14,8 +14,8 @@ plc.json (wire addresses, i.e. zero-based as sent on the wire):
                   "factor": 1.0}],
      "auto_ack": true, "mode": "triggered"}   (mode "free_run": report each new counter)
 
-stdin commands, one per line: "trigger" (raise the trigger; cleared when busy rises or after
-0.5 s), "quit". stdout: one JSON object per line: {"event": "listening", "port": P}, then
+stdin commands, one per line: "trigger" (raise the trigger; cleared when busy or result valid
+rises, or after 0.5 s), "quit". stdout: one JSON object per line: {"event": "listening", "port": P}, then
 {"event": "result", ...} per result valid rising edge (decoded here with struct, independently
 of facet's encoder, plus the raw words), {"event": "missed_trigger"} per rising edge.
 """
@@ -123,12 +123,14 @@ class Plc:
                 self.last["counter"] = counter
                 emit(self.read_result())
             return
+        # The trigger is held until the daemon answers: busy rises, or (when the inspection was
+        # quicker than this scan) a result arrives; or 0.5 s pass.
         busy_rising, _ = self.edge("busy")
-        if self.trigger_since is not None and (busy_rising or
+        valid_rising, valid_falling = self.edge("result_valid")
+        if self.trigger_since is not None and (busy_rising or valid_rising or
                                                time.monotonic() - self.trigger_since > 0.5):
             self.set_flag("trigger", False)
             self.trigger_since = None
-        valid_rising, valid_falling = self.edge("result_valid")
         if valid_rising:
             emit(self.read_result())
             if self.config.get("auto_ack", True):
