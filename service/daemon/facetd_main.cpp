@@ -5,8 +5,8 @@
 #include <fstream>
 #include <iostream>
 
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
+#include <CLI/CLI.hpp>
 
 #include "service/daemon/http_server.hpp"
 #include "service/daemon/station.hpp"
@@ -46,17 +46,20 @@ int main(int argc, char** argv) {
   app.add_option("--config", configFile, "Station config (YAML)")->required();
   app.add_option("--recipe", recipe, "Recipe id to start with (default: the lowest)");
   app.add_option("--max-parts", maxParts, "Stop after this many parts (0 = run until stopped)");
-  app.add_flag("--exit-at-end", exitAtEnd, "Replay without loop: exit once every file is inspected");
+  app.add_flag("--exit-at-end", exitAtEnd,
+               "Replay without loop: exit once every file is inspected");
   app.add_flag("--print-parts", printParts, "Print one line per part on stdout, and a summary");
   app.add_flag("--no-plc", noPlc, "Run without the PLC link");
-  app.add_flag("--block-when-behind", blockWhenBehind,
-               "Hold the trigger back instead of dropping the oldest frame when inspection falls behind");
+  app.add_flag(
+      "--block-when-behind", blockWhenBehind,
+      "Hold the trigger back instead of dropping the oldest frame when inspection falls behind");
   app.add_option("--http-port-file", portFile, "Write the HTTP port here once listening");
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error");
   CLI11_PARSE(app, argc, argv);
   spdlog::set_level(spdlog::level::from_str(logLevel));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ facetd %v");
-  if (printParts) spdlog::set_level(std::max(spdlog::level::warn, spdlog::level::from_str(logLevel)));
+  if (printParts)
+    spdlog::set_level(std::max(spdlog::level::warn, spdlog::level::from_str(logLevel)));
 
   // Signals are taken synchronously by the main thread; every other thread has them blocked.
   sigset_t signals;
@@ -78,11 +81,13 @@ int main(int argc, char** argv) {
   options.maxParts = maxParts;
   options.stopAtEndOfStream = exitAtEnd;
   options.usePlc = !noPlc;
-  options.overflow = blockWhenBehind ? service::OverflowPolicy::Block : service::OverflowPolicy::DropOldest;
+  options.overflow =
+      blockWhenBehind ? service::OverflowPolicy::Block : service::OverflowPolicy::DropOldest;
   if (printParts) {
     options.onPart = [&](const service::PartResult& p) {
       ++counts[service::verdictName(p.verdict)];
-      if (!p.expectedVerdict.empty() && p.expectedVerdict != service::verdictName(p.verdict)) ++unexpected;
+      if (!p.expectedVerdict.empty() && p.expectedVerdict != service::verdictName(p.verdict))
+        ++unexpected;
       std::cout << partLine(p) << std::endl;
     };
   }
@@ -117,7 +122,8 @@ int main(int argc, char** argv) {
       }
       // A hung inspection or acquisition loop stops the pings, and systemd restarts us.
       if (station.loopsAlive(std::max<std::chrono::milliseconds>(
-              5000ms, std::chrono::duration_cast<std::chrono::milliseconds>(systemd.watchdogInterval()))))
+              5000ms,
+              std::chrono::duration_cast<std::chrono::milliseconds>(systemd.watchdogInterval()))))
         systemd.watchdog();
       if (std::chrono::steady_clock::now() - lastChangeCheck > 1s) {
         lastChangeCheck = std::chrono::steady_clock::now();

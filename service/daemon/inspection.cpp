@@ -62,7 +62,9 @@ cv::Mat readGrey(const std::filesystem::path& file) {
   return toGrey(image);
 }
 
-cv::Matx33d translation(cv::Point2d t) { return {1, 0, t.x, 0, 1, t.y, 0, 0, 1}; }
+cv::Matx33d translation(cv::Point2d t) {
+  return {1, 0, t.x, 0, 1, t.y, 0, 0, 1};
+}
 
 // The homography of a pose (q = t + s R(a) p) applied to p = r - home.
 cv::Matx33d poseMap(const Pose2D& pose, cv::Point2d home) {
@@ -71,7 +73,9 @@ cv::Matx33d poseMap(const Pose2D& pose, cv::Point2d home) {
   return m * translation(-home);
 }
 
-cv::Point2d apply(const cv::Matx33d& H, cv::Point2d p) { return mapPoint(H, p); }
+cv::Point2d apply(const cv::Matx33d& H, cv::Point2d p) {
+  return mapPoint(H, p);
+}
 
 // Rotation (degrees, counter-clockwise on screen) of a near-similarity map at point p.
 double rotationDeg(const cv::Matx33d& H, cv::Point2d p) {
@@ -105,7 +109,8 @@ cv::Matx33d relativeMap(const std::optional<std::string>& relativeTo,
 }
 
 // Least-squares similarity (Umeyama in 2D) taking `from` onto `to`.
-cv::Matx33d fitSimilarity(const std::vector<cv::Point2d>& from, const std::vector<cv::Point2d>& to) {
+cv::Matx33d fitSimilarity(const std::vector<cv::Point2d>& from,
+                          const std::vector<cv::Point2d>& to) {
   cv::Point2d mf, mt;
   for (std::size_t i = 0; i < from.size(); ++i) mf += from[i], mt += to[i];
   mf *= 1.0 / from.size();
@@ -119,7 +124,8 @@ cv::Matx33d fitSimilarity(const std::vector<cv::Point2d>& from, const std::vecto
   }
   const double c = sxx / var, s = sxy / var;  // scale * cos, scale * sin (maths orientation)
   const cv::Matx22d M{c, -s, s, c};
-  const cv::Point2d t = mt - cv::Point2d(M(0, 0) * mf.x + M(0, 1) * mf.y, M(1, 0) * mf.x + M(1, 1) * mf.y);
+  const cv::Point2d t =
+      mt - cv::Point2d(M(0, 0) * mf.x + M(0, 1) * mf.y, M(1, 0) * mf.x + M(1, 1) * mf.y);
   return {M(0, 0), M(0, 1), t.x, M(1, 0), M(1, 1), t.y, 0, 0, 1};
 }
 
@@ -127,7 +133,11 @@ class StepRunner {
  public:
   StepRunner(const config::Recipe& recipe, const RecipeInspection::Resources& res,
              double mmPerPixel, const InspectionInput& input, Overlay& overlay)
-      : recipe_(recipe), res_(res), mmPerPixel_(mmPerPixel), input_(input), grey_(toGrey(input.image)),
+      : recipe_(recipe),
+        res_(res),
+        mmPerPixel_(mmPerPixel),
+        input_(input),
+        grey_(toGrey(input.image)),
         overlay_(overlay) {}
 
   StepResult run(const Step& step, const std::map<std::string, StepResult>& done) {
@@ -158,9 +168,11 @@ class StepRunner {
     StepResult r;
     if (a.method == config::AlignStep::Method::Shape) {
       const auto& model = res_.models.at(step.id);
-      const auto matches = findShapeModel(live, model, findParams(a.minScore, 1, 0.5, a.angleRange));
-      if (matches.empty()) return failed("part not found (no match above min score " +
-                                         std::to_string(a.minScore) + ")");
+      const auto matches =
+          findShapeModel(live, model, findParams(a.minScore, 1, 0.5, a.angleRange));
+      if (matches.empty())
+        return failed("part not found (no match above min score " + std::to_string(a.minScore) +
+                      ")");
       Pose2D pose = matches[0].pose();
       pose.x += search.x, pose.y += search.y;
       const cv::Point2d home = res_.modelHomes.at(step.id);
@@ -175,7 +187,8 @@ class StepRunner {
     params.model = TransformModel::Similarity;
     const RegistrationResult reg = registerImages(ref(region), live, params);
     if (!reg.ok) return failed("alignment failed: " + reg.failureCause);
-    r.refToImage = translation(cv::Point2d(search.tl())) * reg.H * translation(-cv::Point2d(region.tl()));
+    r.refToImage =
+        translation(cv::Point2d(search.tl())) * reg.H * translation(-cv::Point2d(region.tl()));
     r.values["score"] =
         reg.matches.empty() ? 0.0 : static_cast<double>(reg.inliers.size()) / reg.matches.size();
     std::vector<cv::Point2d> outline;
@@ -184,7 +197,8 @@ class StepRunner {
     if (r.values["score"] < a.minScore)
       return failed("alignment score " + std::to_string(r.values["score"]) + " below " +
                     std::to_string(a.minScore));
-    const cv::Point2d home(region.x + (region.width - 1) / 2.0, region.y + (region.height - 1) / 2.0);
+    const cv::Point2d home(region.x + (region.width - 1) / 2.0,
+                           region.y + (region.height - 1) / 2.0);
     return withPoseValues(std::move(r), home);
   }
 
@@ -241,8 +255,8 @@ class StepRunner {
     if (search.empty()) return failed("search region outside the image");
     overlay_.polygon(corners(search), true, true);
     const auto& model = res_.models.at(step.id);
-    const auto matches = findShapeModel(grey_(search), model,
-                                        findParams(s.minScore, s.numMatches, s.maxOverlap, s.angleRange));
+    const auto matches = findShapeModel(
+        grey_(search), model, findParams(s.minScore, s.numMatches, s.maxOverlap, s.angleRange));
     StepResult r;
     r.values["count"] = static_cast<double>(matches.size());
     for (const auto& m : matches) drawContour(m.contour, search.tl(), true);
@@ -322,7 +336,8 @@ class StepRunner {
     const auto& s = step.as<config::ScanAlignStep>();
     if (!input_.scan) return failed("no live range scan for this frame");
     scan::ScanMatchParams p;
-    p.method = s.method == config::ScanAlignStep::Method::Icp ? scan::ScanMatchMethod::IcpPointToLine
+    p.method = s.method == config::ScanAlignStep::Method::Icp
+                   ? scan::ScanMatchMethod::IcpPointToLine
                : s.method == config::ScanAlignStep::Method::Dcp ? scan::ScanMatchMethod::Dcp
                                                                 : scan::ScanMatchMethod::IdcpBoc;
     p.maxIterations = s.maxIterations;
@@ -417,19 +432,23 @@ RecipeInspection::RecipeInspection(std::shared_ptr<const config::Recipe> recipe,
                        const std::optional<cv::Rect2d>& region) {
     try {
       ShapeModel m = loadShapeModel(model);
-      const cv::Rect r = region ? cv::Rect(cvRound(region->x), cvRound(region->y), 0, 0) : cv::Rect();
+      const cv::Rect r =
+          region ? cv::Rect(cvRound(region->x), cvRound(region->y), 0, 0) : cv::Rect();
       res->modelHomes[step.id] = m.referencePoint + cv::Point2d(r.x, r.y);
       res->models[step.id] = std::move(m);
     } catch (const std::exception& e) {
       throw InspectionSetupError(recipe_->file.string() + ": step '" + step.id + "': " + e.what() +
-                                 " (train it with: facet recipe train " + recipe_->file.string() + ")");
+                                 " (train it with: facet recipe train " + recipe_->file.string() +
+                                 ")");
     }
   };
   for (const Step& step : recipe_->steps) {
     if (step.kind == config::StepKind::Align) {
       const auto& a = step.as<config::AlignStep>();
       if (a.method == config::AlignStep::Method::Shape) {
-        if (!a.model) throw InspectionSetupError(recipe_->file.string() + ": step '" + step.id + "' has no model");
+        if (!a.model)
+          throw InspectionSetupError(recipe_->file.string() + ": step '" + step.id +
+                                     "' has no model");
         loadModel(step, *a.model, a.region);
       } else {
         res->references[step.id] = readGrey(a.reference);
@@ -505,7 +524,8 @@ InspectionOutcome RecipeInspection::inspect(const InspectionInput& input) const 
         for (std::size_t i = firstOfStep; i < out.measurements.size(); ++i)
           if (const auto& m = out.measurements[i]; std::isfinite(m.value)) {
             char buf[64];
-            std::snprintf(buf, sizeof buf, " %s=%.3f", m.name.substr(step.id.size() + 1).c_str(), m.value);
+            std::snprintf(buf, sizeof buf, " %s=%.3f", m.name.substr(step.id.size() + 1).c_str(),
+                          m.value);
             text += buf;
           }
         out.overlay.label(*result.point + cv::Point2d(8, -8), text, stepPass);

@@ -55,8 +55,8 @@ cv::Mat drawOverlay(const cv::Mat& image, const Overlay& overlay, const std::str
         std::vector<cv::Point> pts;
         for (const auto& p : s.points) pts.push_back(fixedPoint(p));
         if (pts.size() >= 2)
-          cv::polylines(out, pts, s.kind == OverlayShape::Kind::Polygon, colour, width,
-                        cv::LINE_AA, kShift);
+          cv::polylines(out, pts, s.kind == OverlayShape::Kind::Polygon, colour, width, cv::LINE_AA,
+                        kShift);
         else if (pts.size() == 1)
           cv::circle(out, pts[0], 1 << kShift, colour, cv::FILLED, cv::LINE_AA, kShift);
         break;
@@ -67,10 +67,10 @@ cv::Mat drawOverlay(const cv::Mat& image, const Overlay& overlay, const std::str
         break;
       case OverlayShape::Kind::Cross: {
         const auto c = s.points[0];
-        cv::line(out, fixedPoint(c - cv::Point2d(s.radius, 0)), fixedPoint(c + cv::Point2d(s.radius, 0)),
-                 colour, width, cv::LINE_AA, kShift);
-        cv::line(out, fixedPoint(c - cv::Point2d(0, s.radius)), fixedPoint(c + cv::Point2d(0, s.radius)),
-                 colour, width, cv::LINE_AA, kShift);
+        cv::line(out, fixedPoint(c - cv::Point2d(s.radius, 0)),
+                 fixedPoint(c + cv::Point2d(s.radius, 0)), colour, width, cv::LINE_AA, kShift);
+        cv::line(out, fixedPoint(c - cv::Point2d(0, s.radius)),
+                 fixedPoint(c + cv::Point2d(0, s.radius)), colour, width, cv::LINE_AA, kShift);
         break;
       }
       case OverlayShape::Kind::Label:

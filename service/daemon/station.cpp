@@ -25,7 +25,9 @@ struct Station::Job {
 
 namespace {
 
-std::int64_t nowTicks() { return Clock::now().time_since_epoch().count(); }
+std::int64_t nowTicks() {
+  return Clock::now().time_since_epoch().count();
+}
 
 double msSince(Clock::time_point t) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
@@ -41,11 +43,13 @@ ArchivePolicy archivePolicy(const config::ArchiveSettings& a) {
 }
 
 // The station's register map plus every recipe's outputs.
-plc::RegisterMap fullRegisterMap(const config::StationConfig& station,
-                                 const std::vector<std::shared_ptr<const config::Recipe>>& recipes) {
+plc::RegisterMap fullRegisterMap(
+    const config::StationConfig& station,
+    const std::vector<std::shared_ptr<const config::Recipe>>& recipes) {
   plc::RegisterMap map = station.registerMap;
   for (const auto& recipe : recipes)
-    for (const auto& [check, step] : recipe->plcOutputs()) map.results.push_back(check->plc->output);
+    for (const auto& [check, step] : recipe->plcOutputs())
+      map.results.push_back(check->plc->output);
   return map;
 }
 
@@ -63,8 +67,7 @@ Station::Station(config::StationConfig config, StationOptions options)
     archive_ = std::make_unique<ImageArchive>(archivePolicy(config_.archive));
 
   const auto report = library_.reload();
-  for (const auto& d : report.diagnostics.items())
-    spdlog::error("recipe: {}", config::format(d));
+  for (const auto& d : report.diagnostics.items()) spdlog::error("recipe: {}", config::format(d));
   const auto recipes = library_.recipes();
   if (recipes.empty())
     throw std::runtime_error("no usable recipe in " + config_.recipesFolder.string() +
@@ -126,7 +129,9 @@ void Station::start() {
                plc_ ? config_.plc.host + ":" + std::to_string(config_.plc.port) : "none");
 }
 
-void Station::requestStop() { stopRequested_ = true; }
+void Station::requestStop() {
+  stopRequested_ = true;
+}
 
 void Station::join() {
   if (acquisition_.joinable()) acquisition_.join();
@@ -231,7 +236,8 @@ void Station::acquisitionLoop() {
         publishNotInspected(std::move(*job), "no frame within 2 s of the trigger");
         continue;
       case GrabStatus::Incomplete:
-        metrics_.counter("facet_incomplete_frames_total", "Frames with missing pixel data").increment();
+        metrics_.counter("facet_incomplete_frames_total", "Frames with missing pixel data")
+            .increment();
         job->partId = nextPartId_++;
         ++partsTaken_;
         job->frame = std::move(grab.frame);
@@ -250,8 +256,8 @@ void Station::acquisitionLoop() {
           job->partId = nextPartId_++;
           ++partsTaken_;
           job->inspection = recipeForPart(nullptr, &*trigger);
-          publishNotInspected(std::move(*job), std::string("camera ") + toString(grab.status) +
-                                                   ": " + grab.message);
+          publishNotInspected(std::move(*job),
+                              std::string("camera ") + toString(grab.status) + ": " + grab.message);
         }
         std::this_thread::sleep_for(100ms);
         continue;
@@ -308,7 +314,8 @@ void Station::inspectionLoop() {
     p.timings = outcome.timings;
     p.inspectionMs = outcome.totalMs;
     j.overlay = outcome.overlay;
-    metrics_.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"inspect\"")
+    metrics_
+        .histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"inspect\"")
         .observe(outcome.totalMs);
     publishQueue_.push(std::move(*job));
   }
@@ -341,7 +348,8 @@ void Station::publishingLoop() {
     }
     p.frameId = j.frame.id;
     p.source = j.frame.source;
-    if (auto it = j.frame.metadata.find("serial"); it != j.frame.metadata.end()) p.serial = it->second;
+    if (auto it = j.frame.metadata.find("serial"); it != j.frame.metadata.end())
+      p.serial = it->second;
     if (auto it = j.frame.metadata.find("expected_verdict"); it != j.frame.metadata.end())
       p.expectedVerdict = it->second;
     const auto t0 = Clock::now();
@@ -369,12 +377,14 @@ void Station::publishingLoop() {
     }
     publish(p, j.frame.image, j.overlay);
     const double publishMs = msSince(t0);
-    metrics_.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"publish\"")
+    metrics_
+        .histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"publish\"")
         .observe(publishMs);
     metrics_.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"total\"")
         .observe(msSince(j.acquiredAt));
-    metrics_.counter("facet_parts_total", "Parts by verdict",
-                     std::string("verdict=\"") + verdictName(p.verdict) + "\"")
+    metrics_
+        .counter("facet_parts_total", "Parts by verdict",
+                 std::string("verdict=\"") + verdictName(p.verdict) + "\"")
         .increment();
     metrics_.gauge("facet_queue_depth", "Items waiting per queue", "queue=\"publish\"")
         .set(static_cast<double>(publishQueue_.size()));
@@ -421,17 +431,23 @@ config::ReloadReport Station::reloadRecipes() {
 nlohmann::json Station::health() const {
   nlohmann::json h;
   const CameraHealth cam = camera_->health();
-  h["camera"] = {{"name", camera_->name()},         {"connected", cam.connected},
-                 {"streaming", cam.streaming},      {"frames", cam.frames},
+  h["camera"] = {{"name", camera_->name()},
+                 {"connected", cam.connected},
+                 {"streaming", cam.streaming},
+                 {"frames", cam.frames},
                  {"incomplete_frames", cam.incomplete_frames},
-                 {"reconnects", cam.reconnects},    {"skipped_files", cam.skipped_files},
+                 {"reconnects", cam.reconnects},
+                 {"skipped_files", cam.skipped_files},
                  {"last_error", cam.last_error}};
   bool degraded = false;
   if (plc_) {
     const auto s = plc_->stats();
-    h["plc"] = {{"connected", s.connected},   {"queue_depth", s.queueDepth},
-                {"dropped", s.dropped},       {"missed_triggers", s.missedTriggers},
-                {"connection_losses", s.connectionLosses}, {"modbus_errors", s.modbusErrors}};
+    h["plc"] = {{"connected", s.connected},
+                {"queue_depth", s.queueDepth},
+                {"dropped", s.dropped},
+                {"missed_triggers", s.missedTriggers},
+                {"connection_losses", s.connectionLosses},
+                {"modbus_errors", s.modbusErrors}};
     degraded = degraded || !s.connected;
   } else {
     h["plc"] = {{"configured", false}};
@@ -439,8 +455,10 @@ nlohmann::json Station::health() const {
   {
     std::lock_guard lock(recipeMutex_);
     nlohmann::json problems = nlohmann::json::array();
-    for (const auto& d : library_.problems().items()) problems.push_back(config::format(d));
-    for (const auto& [id, e] : recipeErrors_) problems.push_back("recipe " + std::to_string(id) + ": " + e);
+    const config::Diagnostics rejected = library_.problems();
+    for (const auto& d : rejected.items()) problems.push_back(config::format(d));
+    for (const auto& [id, e] : recipeErrors_)
+      problems.push_back("recipe " + std::to_string(id) + ": " + e);
     h["recipe"] = {{"id", active_->recipe().id},
                    {"name", active_->recipe().name},
                    {"version", active_->recipe().contentHash},
@@ -467,15 +485,21 @@ std::string Station::metricsText() const {
   auto& m = const_cast<MetricsRegistry&>(metrics_);
   const CameraHealth cam = camera_->health();
   m.gauge("facet_camera_connected", "1 while the camera is connected").set(cam.connected ? 1 : 0);
-  m.gauge("facet_camera_reconnects", "Camera reconnections since start").set(static_cast<double>(cam.reconnects));
-  m.gauge("facet_camera_skipped_files", "Replay files refused").set(static_cast<double>(cam.skipped_files));
+  m.gauge("facet_camera_reconnects", "Camera reconnections since start")
+      .set(static_cast<double>(cam.reconnects));
+  m.gauge("facet_camera_skipped_files", "Replay files refused")
+      .set(static_cast<double>(cam.skipped_files));
   if (plc_) {
     const auto s = plc_->stats();
     m.gauge("facet_plc_connected", "1 while the PLC link is up").set(s.connected ? 1 : 0);
-    m.gauge("facet_plc_reconnects", "PLC connects since start").set(static_cast<double>(s.connects));
-    m.gauge("facet_plc_dropped_results", "Results the PLC queue dropped").set(static_cast<double>(s.dropped));
-    m.gauge("facet_plc_missed_triggers", "Triggers raised while busy").set(static_cast<double>(s.missedTriggers));
-    m.gauge("facet_queue_depth", "Items waiting per queue", "queue=\"plc\"").set(static_cast<double>(s.queueDepth));
+    m.gauge("facet_plc_reconnects", "PLC connects since start")
+        .set(static_cast<double>(s.connects));
+    m.gauge("facet_plc_dropped_results", "Results the PLC queue dropped")
+        .set(static_cast<double>(s.dropped));
+    m.gauge("facet_plc_missed_triggers", "Triggers raised while busy")
+        .set(static_cast<double>(s.missedTriggers));
+    m.gauge("facet_queue_depth", "Items waiting per queue", "queue=\"plc\"")
+        .set(static_cast<double>(s.queueDepth));
   }
   return m.exposition();
 }

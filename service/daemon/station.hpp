@@ -40,10 +40,10 @@ struct StationOptions {
   OverflowPolicy overflow = OverflowPolicy::DropOldest;  // when inspection falls behind
   std::size_t inspectQueue = 4;                          // frames waiting for inspection
   std::size_t publishQueue = 64;                         // results waiting for publishing
-  std::optional<int> recipe;          // recipe to start with (default: the lowest id)
-  std::uint64_t maxParts = 0;         // stop after this many parts (0 = run until stopped)
-  bool stopAtEndOfStream = false;     // replay without loop: stop once every file was inspected
-  bool usePlc = true;                 // false: no PLC link even if configured
+  std::optional<int> recipe;       // recipe to start with (default: the lowest id)
+  std::uint64_t maxParts = 0;      // stop after this many parts (0 = run until stopped)
+  bool stopAtEndOfStream = false;  // replay without loop: stop once every file was inspected
+  bool usePlc = true;              // false: no PLC link even if configured
   std::function<void(const PartResult&)> onPart;  // called by the publishing stage, per part
 };
 
@@ -109,7 +109,7 @@ class Station : public StationView {
 
   mutable std::mutex recipeMutex_;
   std::map<int, std::shared_ptr<const RecipeInspection>> inspections_;  // prepared recipes by id
-  std::map<int, std::string> recipeErrors_;                              // setup errors by id
+  std::map<int, std::string> recipeErrors_;                             // setup errors by id
   std::shared_ptr<const RecipeInspection> active_;
   std::optional<int> requestedRecipe_;  // from HTTP, applied before the next part
 

@@ -71,7 +71,8 @@ class InspectionTest : public ::testing::Test {
     config::Step d;
     d.id = "pitch";
     d.kind = config::StepKind::Distance;
-    d.params = config::DistanceStep{config::DistanceStep::Measure::CentreToCentre, "big_hole", "small_hole"};
+    d.params = config::DistanceStep{config::DistanceStep::Measure::CentreToCentre, "big_hole",
+                                    "small_hole"};
     d.checks.push_back(check("distance", config::Quantity::Length, 80.006 * kMmPerPixel, 0.01,
                              config::Unit::Millimetre));
     recipe->steps.push_back(d);
@@ -105,7 +106,8 @@ class InspectionTest : public ::testing::Test {
 
 TEST_F(InspectionTest, GoodPartPassesWithValuesInMillimetres) {
   const auto out = inspection_->inspect({part({320.3, 240.7, radians(37), 1.0}, 10), {}});
-  ASSERT_EQ(out.verdict, Verdict::Pass) << (out.failedChecks.empty() ? out.error : out.failedChecks[0]);
+  ASSERT_EQ(out.verdict, Verdict::Pass)
+      << (out.failedChecks.empty() ? out.error : out.failedChecks[0]);
   EXPECT_NEAR(value(out, "big_hole.diameter").value, 1.0, 0.005);
   EXPECT_NEAR(value(out, "small_hole.diameter").value, 0.7, 0.005);
   EXPECT_NEAR(value(out, "pitch.distance").value, 80.006 * kMmPerPixel, 0.005);
