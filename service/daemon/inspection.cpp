@@ -472,7 +472,10 @@ InspectionOutcome RecipeInspection::inspect(const InspectionInput& input) const 
   InspectionOutcome out;
   const auto start = Clock::now();
   try {
-    if (input.image.empty()) throw std::invalid_argument("empty image");
+    const bool needsImage = std::any_of(recipe_->steps.begin(), recipe_->steps.end(), [](const Step& s) {
+      return s.kind != config::StepKind::ScanAlign;
+    });
+    if (needsImage && input.image.empty()) throw std::invalid_argument("empty image");
     StepRunner runner(*recipe_, *resources_, mmPerPixel_, input, out.overlay);
     std::map<std::string, StepResult> done;
     bool allPass = true;

@@ -6,6 +6,7 @@
 
 #include "algorithms/scan/scan_file.hpp"
 #include "camera/camera_factory.hpp"
+#include "camera/sidecar_metadata.hpp"
 
 namespace facet::service {
 
@@ -16,6 +17,7 @@ struct Station::Job {
   std::uint64_t partId = 0;
   Frame frame;
   std::optional<plc::TriggerEvent> trigger;
+  std::optional<scan::Scan> scan;  // scan recipes
   std::shared_ptr<const RecipeInspection> inspection;
   Clock::time_point acquiredAt;
   Clock::time_point inspectedAt;
@@ -53,6 +55,13 @@ plc::RegisterMap fullRegisterMap(
   return map;
 }
 
+// A recipe whose every step works on range scans needs no camera frame.
+bool scanOnly(const config::Recipe& recipe) {
+  return !recipe.steps.empty() &&
+         std::all_of(recipe.steps.begin(), recipe.steps.end(),
+                     [](const auto& s) { return s.kind == config::StepKind::ScanAlign; });
+}
+
 }  // namespace
 
 Station::Station(config::StationConfig config, StationOptions options)
@@ -78,6 +87,7 @@ Station::Station(config::StationConfig config, StationOptions options)
   if (!active_) throw std::runtime_error("recipe " + std::to_string(first) + ": " + error);
 
   camera_ = makeCamera(config_.camera);
+  if (!config_.camera.scans.folder.empty()) scans_ = makeScanReplay(config_.camera.scans);
   if (options_.usePlc)
     plc_ = std::make_unique<plc::PlcLink>(fullRegisterMap(config_, recipes), config_.plc);
   metrics_.gauge("facet_up", "1 while facetd runs").set(1);
@@ -221,10 +231,29 @@ void Station::acquisitionLoop() {
       camera_->softwareTrigger();
     }
     const auto t0 = Clock::now();
-    GrabResult grab = camera_->grab(triggered ? 2000ms : 200ms);
     auto job = std::make_unique<Job>();
     job->trigger = trigger;
     job->acquiredAt = t0;
+    if (scans_ && scanOnly(recipeForPart(nullptr, trigger ? &*trigger : nullptr)->recipe())) {
+      if (!acquireScan(*job)) {
+        if (trigger) {
+          job->partId = nextPartId_++;
+          ++partsTaken_;
+          job->inspection = recipeForPart(nullptr, &*trigger);
+          publishNotInspected(std::move(*job), "no range scan for the trigger");
+          continue;
+        }
+        if (options_.stopAtEndOfStream) break;
+        std::this_thread::sleep_for(50ms);
+        continue;
+      }
+      job->partId = nextPartId_++;
+      ++partsTaken_;
+      job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
+      inspectQueue_.push(std::move(job));
+      continue;
+    }
+    GrabResult grab = camera_->grab(triggered ? 2000ms : 200ms);
     switch (grab.status) {
       case GrabStatus::Ok:
         break;
@@ -284,6 +313,34 @@ void Station::acquisitionLoop() {
   inspectQueue_.close();
 }
 
+bool Station::acquireScan(Job& job) {
+  ScanResult next = scans_->next();
+  if (next.status == GrabStatus::EndOfStream) return false;
+  if (!next) {
+    spdlog::error("scan replay: {}", next.message);
+    return false;
+  }
+  job.frame.id = next.scan.id;
+  job.frame.source = next.scan.source;
+  job.frame.metadata = next.scan.metadata;
+  // Serial and expected verdict come from the scan file's sidecar, as for images.
+  // CARMEN scans are named "file:line"; CSV scans by their file.
+  std::string source = next.scan.source;
+  if (const auto colon = source.rfind(':');
+      colon != std::string::npos && colon + 1 < source.size() &&
+      source.find_first_not_of("0123456789", colon + 1) == std::string::npos)
+    source.resize(colon);
+  const std::filesystem::path file = source;
+  try {
+    for (auto& [key, value] : SidecarMetadata::loadFolder(file.parent_path()).forImage(file))
+      job.frame.metadata.emplace(key, value);
+  } catch (const std::exception& e) {
+    spdlog::warn("{}: {}", file.string(), e.what());
+  }
+  job.scan = std::move(next.scan.scan);
+  return true;
+}
+
 void Station::inspectionLoop() {
   while (true) {
     inspectionBeat_ = nowTicks();
@@ -295,7 +352,8 @@ void Station::inspectionLoop() {
     Job& j = **job;
     InspectionInput input;
     input.image = j.frame.image;
-    if (auto it = j.frame.metadata.find("scan"); it != j.frame.metadata.end()) {
+    input.scan = j.scan;
+    if (auto it = j.frame.metadata.find("scan"); !input.scan && it != j.frame.metadata.end()) {
       // A recorded frame may carry the range scan taken with it (scan recipes).
       const auto path = std::filesystem::path(j.frame.source).parent_path() / it->second;
       try {

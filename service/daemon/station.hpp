@@ -24,6 +24,7 @@
 #include <opencv2/core.hpp>
 
 #include "camera/camera.hpp"
+#include "camera/scan_source.hpp"
 #include "config/recipe_library.hpp"
 #include "config/station_config.hpp"
 #include "plc/plc_link.hpp"
@@ -95,6 +96,8 @@ class Station : public StationView {
   std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
                                                         const plc::TriggerEvent* trigger);
   void publishNotInspected(Job job, const std::string& cause);
+  // A scan recipe's part: the next recorded scan instead of a camera frame. False at the end.
+  bool acquireScan(Job& job);
   void publish(PartResult part, const cv::Mat& image, const Overlay& overlay);
 
   config::StationConfig config_;
@@ -105,6 +108,7 @@ class Station : public StationView {
   std::unique_ptr<ImageArchive> archive_;
   config::RecipeLibrary library_;
   std::unique_ptr<Camera> camera_;
+  std::unique_ptr<ScanSource> scans_;  // recorded range scans for scan recipes (may be null)
   std::unique_ptr<plc::PlcLink> plc_;
 
   mutable std::mutex recipeMutex_;
