@@ -515,6 +515,8 @@ PlcLink::PlcLink(RegisterMap map, PlcSettings settings) : state_(std::make_uniqu
     RegisterServerOptions options;
     options.host = state_->settings.host;
     options.port = state_->settings.port;
+    options.coils = 65536;  // the whole address space: any valid map fits
+    options.holdingRegisters = 65536;
     state_->server = std::make_unique<RegisterServer>(options);
     state_->bus = makeServerBus(*state_->server);
   } else {

@@ -94,7 +94,7 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
       const double nextCost = cost(next);
       if (nextCost <= current) {
         improved = true;
-        const bool converged = step.norm() < 1e-6;  // pixels: far below the accuracy sought
+        const bool converged = step.norm() < 1e-5;  // pixels: far below the accuracy sought
         c = next;
         current = nextCost;
         lambda = std::max(lambda * 0.1, 1e-12);
@@ -145,6 +145,11 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
     return "the nominal radius must be positive (got " + std::to_string(p.radius) + ")";
   if (!(p.width > 0.0) || !std::isfinite(p.width))
     return "the search width must be positive (got " + std::to_string(p.width) + ")";
+  if (p.radius + p.width > 1e5)
+    return "the annulus (radius + width = " + std::to_string(p.radius + p.width) +
+           " px) is larger than any image";
+  if (std::abs(p.centre.x) > 1e7 || std::abs(p.centre.y) > 1e7)
+    return "the expected centre lies absurdly far outside the image";
   if (!(p.directionToleranceDeg > 0.0 && p.directionToleranceDeg <= 90.0))
     return "the direction tolerance must be in (0, 90] degrees";
   if (!(p.ransacThreshold > 0.0)) return "the RANSAC threshold must be positive";
@@ -245,6 +250,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::optional<Circle> best;
   std::vector<Eigen::Vector2d> bestPts;
   std::size_t bestCount = 0;
+  int rimSign = +1;  // +1: gradient points outwards (dark inside), -1: inwards
   for (int sign : {+1, -1}) {
     std::vector<Eigen::Vector2d> pts;
     for (const Candidate& c : candidates)
@@ -263,6 +269,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     auto found = ransac<Circle>(pts.size(), 3, fit, res, rp);
     if (found && found->inliers.size() > bestCount) {
       bestCount = found->inliers.size();
+      rimSign = sign;
       best = found->model;
       bestPts = std::move(pts);
     }
@@ -283,7 +290,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
       if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
     if (static_cast<int>(in.size()) < params.minInliers) break;
     w.assign(in.size(), 1.0);
-    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 3;
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 2;
     for (int k = 0; k < irls; ++k) {
       if (k > 0) {
         std::vector<double> a;
@@ -316,7 +323,21 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
   if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
-    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints)) {
+    // Strong edge points that are not the rim: off the circle, or not radial with its polarity.
+    std::vector<cv::Point2d> foreign;
+    for (const EdgePoint& e : edges.points) {
+      const Eigen::Vector2d p{e.position.x, e.position.y};
+      const Eigen::Vector2d radial = p - circle.centre;
+      const double d = radial.norm();
+      if (d == 0.0) continue;
+      const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
+      // Weak points (below the high threshold) are mostly noise; they must not punch holes.
+      if (e.magnitude >= edges.highThreshold &&
+          (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
+        foreign.push_back(e.position);
+    }
+    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints, foreign,
+                                     edges.noiseSigma)) {
       m.centre = fine->centre;
       m.radius = fine->radius;
       m.blur = fine->blur;

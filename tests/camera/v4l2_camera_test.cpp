@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "camera/camera_factory.hpp"
 #include "camera/v4l2_camera.hpp"
 #include "scripted_v4l2_device.hpp"
 
@@ -269,6 +270,20 @@ TEST(V4l2Camera, SurvivesTheDeviceDisappearingAndComingBack) {
   EXPECT_EQ(health.reconnects, 1u);
   EXPECT_EQ(device->live_mappings(), 3);
   EXPECT_GE(device->open_count, 2);
+}
+
+TEST(V4l2Camera, FactoryBuildsAKernelBackedCameraThatNamesAMissingDevice) {
+  CameraSettings settings;
+  settings.backend = CameraBackend::V4l2;
+  settings.v4l2.device = "/dev/facet-no-such-video-device";
+  auto camera = makeCamera(settings);
+  EXPECT_EQ(camera->name(), "v4l2:/dev/facet-no-such-video-device");
+  try {
+    camera->open();
+    FAIL() << "open() should throw";
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/facet-no-such-video-device"), std::string::npos);
+  }
 }
 
 }  // namespace

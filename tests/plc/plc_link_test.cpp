@@ -394,3 +394,59 @@ TEST(PlcLinkWithPymodbus, ModbusExceptionIsLoggedWithTheRegister) {
 
 }  // namespace
 }  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// Server role: the daemon serves the registers and a pymodbus client (the PLC) polls them.
+TEST(PlcLinkWithPymodbus, ServerRoleLetsThePlcPollTheDaemon) {
+  const RegisterMap map = fullMap();
+  PlcSettings settings = fastSettings(0);
+  settings.role = LinkRole::Server;
+  PlcLink link(map, settings);
+  link.start();
+  ASSERT_GT(link.serverPort(), 0);
+  PymodbusPlc plc(test::writePeerConfig(map, false), link.serverPort(), /*clientMode=*/true);
+  plc.start();
+  for (int round = 0; round < 2; ++round) {
+    plc.command("trigger");
+    const auto trigger = link.waitTrigger(5s);
+    ASSERT_TRUE(trigger) << "round " << round;
+    const InspectionResult sent = sampleResult(map, round, "served-" + std::to_string(round));
+    ASSERT_TRUE(link.publish(sent));
+    ASSERT_TRUE(plc.waitFor(
+        [&](const auto& all) { return countIn(all, "result") == std::size_t(round + 1); }, 5s));
+    expectDelivered(map, sent, plc.events("result").back(), round + 1);
+    ASSERT_TRUE(
+        waitUntil([&] { return link.stats().acknowledged == std::uint64_t(round + 1); }, 5s));
+  }
+}
+
+}  // namespace
+}  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// control.enable = 0: the line is not running; triggers are ignored (neither accepted nor missed).
+TEST(PlcLinkWithPymodbus, TriggersAreIgnoredWhileNotEnabled) {
+  RegisterMap map = fullMap();
+  map.control.enable = reg(6);
+  const int port = test::freeTcpPort();
+  PymodbusPlc plc(test::writePeerConfig(map, false), port);
+  plc.start();
+  PlcLink link(map, fastSettings(port));
+  link.start();
+  ASSERT_TRUE(waitUntil([&] { return link.stats().connected; }, 5s));
+  plc.command("trigger");
+  EXPECT_FALSE(link.waitTrigger(300ms));
+  EXPECT_EQ(link.stats().triggers, 0u);
+  EXPECT_EQ(link.stats().missedTriggers, 0u);
+  std::this_thread::sleep_for(300ms);  // the peer drops the unanswered pulse after 0.5 s
+  plc.command("set_register 6 1");
+  plc.command("trigger");
+  EXPECT_TRUE(link.waitTrigger(5s));
+}
+
+}  // namespace
+}  // namespace facet::plc
