@@ -236,6 +236,17 @@ void Station::acquisitionLoop() {
     job->acquiredAt = t0;
     if (scans_ && scanOnly(recipeForPart(nullptr, trigger ? &*trigger : nullptr)->recipe())) {
       if (!acquireScan(*job)) {
+        if (options_.stopAtEndOfStream && scansEnded_) {
+          // The recorded scans are all used: a trigger now gets a not-inspected answer, and the
+          // replay ends.
+          if (trigger) {
+            job->partId = nextPartId_++;
+            ++partsTaken_;
+            job->inspection = recipeForPart(nullptr, &*trigger);
+            publishNotInspected(std::move(*job), "no range scan left for the trigger");
+          }
+          break;
+        }
         if (trigger) {
           job->partId = nextPartId_++;
           ++partsTaken_;
@@ -253,6 +264,9 @@ void Station::acquisitionLoop() {
       inspectQueue_.push(std::move(job));
       continue;
     }
+    // Free run: a camera set to software trigger is triggered by the station itself, one frame
+    // per part (ignored by free-running cameras).
+    if (!triggered) camera_->softwareTrigger();
     GrabResult grab = camera_->grab(triggered ? 2000ms : 200ms);
     switch (grab.status) {
       case GrabStatus::Ok:
@@ -315,7 +329,10 @@ void Station::acquisitionLoop() {
 
 bool Station::acquireScan(Job& job) {
   ScanResult next = scans_->next();
-  if (next.status == GrabStatus::EndOfStream) return false;
+  if (next.status == GrabStatus::EndOfStream) {
+    scansEnded_ = true;
+    return false;
+  }
   if (!next) {
     spdlog::error("scan replay: {}", next.message);
     return false;
@@ -416,6 +433,9 @@ void Station::publishingLoop() {
       plc::InspectionResult r;
       r.partId = std::to_string(p.partId);
       r.pass = p.verdict == Verdict::Pass;
+      // Outputs of the other recipes in the map are written as NaN (0 for integers): the PLC
+      // reads the registers of the recipe it selected.
+      for (const auto& out : plc_->registerMap().results) r.values[out.name] = std::nan("");
       for (const auto& m : p.measurements) r.values[m.name] = m.value;
       r.errorCode = p.verdict == Verdict::Error ? 1 : 0;
       r.triggerSequence = j.trigger ? j.trigger->sequence : 0;
