@@ -150,6 +150,7 @@ struct Recipe {
   std::string description;
   std::string version;               // free text from the file (may be empty)
   std::string contentHash;           // FNV-1a 64 of the recipe file's bytes, 16 hex digits
+  SourceLocation idWhere;            // of the `id:` value, for messages about duplicate ids
   std::filesystem::path file;        // the recipe file
   std::filesystem::path baseFolder;  // folder its relative paths start from
   std::vector<Step> steps;           // in execution order

@@ -87,6 +87,13 @@ class RecipeReader {
     root_ = options.root ? std::filesystem::absolute(*options.root) : recipe_.baseFolder;
   }
 
+  // Every file looked at so far (valid after read(), also when it failed).
+  std::vector<std::filesystem::path> files() const {
+    std::vector<std::filesystem::path> all{recipe_.file};
+    all.insert(all.end(), recipe_.dependencies.begin(), recipe_.dependencies.end());
+    return all;
+  }
+
   std::optional<Recipe> read() {
     const auto yaml = readYamlFile(file_, out_);
     if (!yaml) return std::nullopt;
@@ -98,6 +105,7 @@ class RecipeReader {
 
     recipe_.schemaVersion = static_cast<int>(readInteger(root["schema_version"]).value_or(0));
     recipe_.id = static_cast<int>(readInteger(root["id"]).value_or(0));
+    if (root["id"]) recipe_.idWhere = where(root["id"]);
     recipe_.name = text(root["name"]);
     recipe_.version = text(root["version"]);
     recipe_.description = text(root["description"]);
@@ -109,7 +117,7 @@ class RecipeReader {
     }
     checkRegisterCollisions(registerUses(), out_);
     if (out_.hasErrors()) return std::nullopt;
-    return std::move(recipe_);
+    return recipe_;
   }
 
  private:
@@ -567,7 +575,9 @@ void checkRegisterCollisions(const std::vector<RegisterUse>& uses, Diagnostics& 
 
 RecipeLoadResult loadRecipe(const std::filesystem::path& file, const RecipeLoadOptions& options) {
   RecipeLoadResult result;
-  result.recipe = RecipeReader(file, options, result.diagnostics).read();
+  RecipeReader reader(file, options, result.diagnostics);
+  result.recipe = reader.read();
+  result.files = reader.files();
   return result;
 }
 

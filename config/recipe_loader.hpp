@@ -36,6 +36,9 @@ struct RecipeLoadOptions {
 struct RecipeLoadResult {
   std::optional<Recipe> recipe;  // set exactly when diagnostics has no error
   Diagnostics diagnostics;       // errors and warnings, in file order
+  // The recipe file and every file it names that lies inside the root, absolute, also when the
+  // recipe has errors: a change to any of them is a reason to load it again.
+  std::vector<std::filesystem::path> files;
 };
 
 RecipeLoadResult loadRecipe(const std::filesystem::path& file,

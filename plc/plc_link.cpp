@@ -271,7 +271,6 @@ void PlcLink::State::connect() {
     stats.connected = true;
   }
   spdlog::info("PLC: connected to {}", bus->describe());
-  onConnected();
 }
 
 // After every (re)connect the PLC's view is rebuilt from the daemon's state: the PLC may have
@@ -354,12 +353,15 @@ void PlcLink::State::writeResult(const Pending& pending) {
   for (const auto& output : map.results) {
     const auto found = r.values.find(output.name);
     double value = std::numeric_limits<double>::quiet_NaN();
+    // Outputs of another recipe: their registers keep what that recipe last wrote.
+    if (found == r.values.end() && r.onlyGivenValues) continue;
     if (found == r.values.end())
       spdlog::error("PLC: part '{}' has no value for mapped result '{}'", r.partId, output.name);
     else
       value = found->second;
     const EncodedValue encoded = encodeValue(output, value);
-    if (encoded.clamped && found != r.values.end())
+    // NaN is "not measured" (its step failed): written as NaN / 0 without complaint.
+    if (encoded.clamped && found != r.values.end() && !std::isnan(value))
       spdlog::error("PLC: part '{}': {} = {} does not fit {} at register {}; written saturated",
                     r.partId, output.name, value, toString(output.type), output.address);
     const int wire = map.wireAddress(output.address);
@@ -451,7 +453,10 @@ void PlcLink::State::step() {
     std::lock_guard lock(mutex);
     requestedRecipe = recipe;
   }
-  if (!headWritten) deliverHead();
+  // Four-phase handshake: the next result waits until the PLC has dropped its acknowledge, so
+  // the PLC sees result valid fall between two results.
+  const bool ackReleased = settings.mode == HandshakeMode::FreeRun || !lastAck;
+  if (!headWritten && ackReleased) deliverHead();
 }
 
 void PlcLink::State::run() {
@@ -460,11 +465,13 @@ void PlcLink::State::run() {
       std::lock_guard lock(mutex);
       if (stopping) break;
     }
-    if (!connected) {
+    const bool fresh = !connected;
+    if (fresh) {
       connect();
-      continue;
+      if (!connected) continue;
     }
     try {
+      if (fresh) onConnected();
       step();
     } catch (const TryAgain&) {
       // device busy: the same step runs again after the poll period
@@ -481,7 +488,8 @@ void PlcLink::State::run() {
     bool more = false;
     {
       std::lock_guard lock(mutex);
-      more = !queue.empty() && !headWritten;
+      more =
+          !queue.empty() && !headWritten && (settings.mode == HandshakeMode::FreeRun || !lastAck);
     }
     if (!more && !sleepFor(settings.pollPeriod)) break;
   }
@@ -510,6 +518,8 @@ PlcLink::PlcLink(RegisterMap map, PlcSettings settings) : state_(std::make_uniqu
     RegisterServerOptions options;
     options.host = state_->settings.host;
     options.port = state_->settings.port;
+    options.coils = 65536;  // the whole address space: any valid map fits
+    options.holdingRegisters = 65536;
     state_->server = std::make_unique<RegisterServer>(options);
     state_->bus = makeServerBus(*state_->server);
   } else {

@@ -11,7 +11,8 @@
 //   daemon publish(result)    -> all result registers, pass, error code, inspection counter are
 //                                written, then result valid = 1 and completed toggle flipped,
 //                                busy = 0
-//   PLC result ack 0->1       -> result valid = 0; the next queued result may follow
+//   PLC result ack 0->1       -> result valid = 0
+//   PLC result ack 1->0       -> the next queued result may follow (four-phase handshake)
 //   trigger 0->1 while busy   -> missed trigger = 1 (latched until the next accepted trigger)
 // Free-run handshake: each result is written with the next inspection counter and the toggle
 // flipped; no trigger, no acknowledge.
@@ -44,6 +45,9 @@ struct InspectionResult {
                                          // missing is written as NaN/0 and logged
   int errorCode = 0;                     // 0 = inspection ran; sets status.error when non-zero
   std::uint64_t triggerSequence = 0;     // TriggerEvent::sequence it answers; 0 = none
+  // Mapped outputs missing from `values` are left unwritten instead of written as NaN/0 and
+  // logged: a station with several recipes maps every recipe's outputs, a part has only its own.
+  bool onlyGivenValues = false;
 };
 
 // A trigger the PLC raised and the link accepted (busy is already written when it is queued).
