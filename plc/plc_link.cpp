@@ -499,7 +499,7 @@ PlcLink::PlcLink(RegisterMap map, PlcSettings settings) : state_(std::make_uniqu
   const auto issues = map.validate();
   if (!issues.empty()) {
     std::string message = "invalid PLC register map:";
-    for (const auto& issue : issues) message += "\n  " + issue.message;
+    for (const auto& issue : issues) message += "\n  " + describe(issue);
     throw std::invalid_argument(message);
   }
   const std::string missing = missingSignals(map, settings.mode);

@@ -185,7 +185,7 @@ PlcSimulator::PlcSimulator(RegisterMap map, PlcSimulatorOptions options)
   const auto issues = map.validate();
   if (!issues.empty()) {
     std::string message = "invalid PLC register map:";
-    for (const auto& issue : issues) message += "\n  " + issue.message;
+    for (const auto& issue : issues) message += "\n  " + describe(issue);
     throw std::invalid_argument(message);
   }
   state_->map = std::move(map);
