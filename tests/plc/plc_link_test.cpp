@@ -17,6 +17,7 @@
 
 #include "plc/plc_link.hpp"
 #include "plc/register_encoding.hpp"
+#include "plc/register_map_yaml.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
 
 namespace facet::plc {
@@ -164,12 +165,12 @@ std::size_t countIn(const std::vector<nlohmann::json>& events, const char* kind)
                                                 [&](const auto& e) { return e["event"] == kind; }));
 }
 
-void triggeredRoundTrip(int base) {
-  const RegisterMap map = fullMap(base);
+void triggeredRoundTrip(const RegisterMap& map) {
   const int port = test::freeTcpPort();
   PymodbusPlc plc(test::writePeerConfig(map, false), port);
   plc.start();
-  plc.command("set_register 5 7");  // recipe select (wire address 5)
+  plc.command("set_register " +  // recipe select
+              std::to_string(map.wireAddress(map.control.recipeSelect->address)) + " 7");
   PlcLink link(map, fastSettings(port));
   link.setActiveRecipe(7);
   link.start();
@@ -211,11 +212,19 @@ void triggeredRoundTrip(int base) {
 }
 
 TEST(PlcLinkWithPymodbus, TriggeredHandshakeDeliversEveryTypeAndWordOrder) {
-  triggeredRoundTrip(0);
+  triggeredRoundTrip(fullMap(0));
+}
+
+// The example station map keeps its status flags in adjacent coils: they go out in one request.
+TEST(PlcLinkWithPymodbus, ExampleStationMapWithAdjacentStatusCoils) {
+  RegisterMap map =
+      loadRegisterMap(std::string(FACET_SOURCE_DIR) + "/tests/plc/data/station_register_map.yaml");
+  map.control.enable.reset();  // the pymodbus PLC does not enable; tested separately
+  triggeredRoundTrip(map);
 }
 
 TEST(PlcLinkWithPymodbus, OneBasedMapReachesTheSameWireAddresses) {
-  triggeredRoundTrip(1);
+  triggeredRoundTrip(fullMap(1));
 }
 
 TEST(PlcLinkWithPymodbus, TriggerWhileBusyRaisesMissedTrigger) {
