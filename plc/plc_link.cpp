@@ -119,7 +119,7 @@ struct PlcLink::State {
   void pollTrigger(bool triggerLevel);
   void deliverHead();
   void writeResult(const Pending& pending, bool clearBusy);
-  void writeResultFlags(bool pass, bool error, bool clearBusy);
+  void writeResultFlags(bool pass, bool error, bool clearBusy, bool withVerdict);
   void writeDaemonStatus();
   void beat();
 
@@ -371,28 +371,36 @@ void PlcLink::State::writeResult(const Pending& pending, bool clearBusy) {
     writes.push_back({map.wireAddress(map.status.errorCode->address),
                       static_cast<std::uint16_t>(r.errorCode), "status.error_code"});
   writeRegisterRuns(std::move(writes));
-  // The counter, the toggle and result valid go last: a PLC watching them finds the values in
-  // place.
+  // What the PLC watches goes last, so that it finds everything else in place: in free run the
+  // counter (the verdict before it), when triggered result valid (the counter before it).
+  const bool freeRun = settings.mode == HandshakeMode::FreeRun;
+  if (freeRun) {
+    writeFlag("status.pass", map.status.pass, r.pass);
+    writeFlag("status.error", map.status.error, r.errorCode != 0);
+  }
   writeNumber("status.inspection_counter", map.status.inspectionCounter, pending.counter);
   toggle = !toggle;
-  writeResultFlags(r.pass, r.errorCode != 0, clearBusy);
+  writeResultFlags(r.pass, r.errorCode != 0, clearBusy, /*withVerdict=*/!freeRun);
 }
 
-// pass, error, completed toggle, result valid (and busy = 0 when this result answers the open
+// [pass, error,] completed toggle, result valid (and busy = 0 when this result answers the open
 // trigger). When these are coils that, together with the daemon's other status coils as filler,
 // form one contiguous block, a single request writes them all at once; otherwise one request
 // each, result valid (then busy) last.
-void PlcLink::State::writeResultFlags(bool pass, bool error, bool clearBusy) {
+void PlcLink::State::writeResultFlags(bool pass, bool error, bool clearBusy, bool withVerdict) {
   struct Flag {
     const char* name;
     const std::optional<Location>* at;
     bool value;
   };
   const auto& s = map.status;
-  std::vector<Flag> flags = {{"status.pass", &s.pass, pass},
-                             {"status.error", &s.error, error},
-                             {"status.completed_toggle", &s.completedToggle, toggle},
-                             {"status.result_valid", &s.resultValid, true}};
+  std::vector<Flag> flags;
+  if (withVerdict) {
+    flags.push_back({"status.pass", &s.pass, pass});
+    flags.push_back({"status.error", &s.error, error});
+  }
+  flags.push_back({"status.completed_toggle", &s.completedToggle, toggle});
+  flags.push_back({"status.result_valid", &s.resultValid, true});
   if (clearBusy) flags.push_back({"status.busy", &s.busy, false});
   bool isReady = true;
   {
