@@ -459,3 +459,38 @@ TEST(PlcLinkWithPymodbus, TriggersAreIgnoredWhileNotEnabled) {
 
 }  // namespace
 }  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// What the daemon owns besides results: ready, active recipe, a heartbeat that keeps counting.
+TEST(PlcLinkWithPymodbus, ReadyActiveRecipeAndHeartbeatReachThePlc) {
+  const RegisterMap map = fullMap();
+  const int port = test::freeTcpPort();
+  PymodbusPlc plc(test::writePeerConfig(map, false), port);
+  plc.start();
+  PlcLink link(map, fastSettings(port));  // heartbeat every 20 ms
+  link.setActiveRecipe(12);
+  link.start();
+  ASSERT_TRUE(waitUntil([&] { return link.stats().connected; }, 5s));
+  auto report = [&](const std::string& signal) {
+    const std::size_t before = plc.events("report").size();
+    plc.command("report " + signal);
+    EXPECT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "report") > before; }, 5s));
+    return plc.events("report").back()["value"];
+  };
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(report("ready"), true);
+  EXPECT_EQ(report("active_recipe"), 12);
+  const int beat = report("heartbeat");
+  std::this_thread::sleep_for(200ms);
+  EXPECT_GE(static_cast<int>(report("heartbeat")), beat + 3);
+  link.setReady(false);
+  link.setActiveRecipe(4);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(report("ready"), false);
+  EXPECT_EQ(report("active_recipe"), 4);
+}
+
+}  // namespace
+}  // namespace facet::plc
