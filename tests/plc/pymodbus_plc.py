@@ -18,7 +18,8 @@ plc.json (wire addresses, i.e. zero-based as sent on the wire):
 stdin commands, one per line: "trigger" (raise the trigger; cleared when busy or result valid
 rises, or after 0.5 s), "report <signal>" (emit {"event": "report", ...} with its value),
 "set_register <address> <value>", "quit".
-stdout: one JSON object per line: {"event": "listening", "port": P}, then {"event": "result", ...} per result valid rising edge (decoded here with struct, independently
+stdout: one JSON object per line: {"event": "listening", "port": P}, then
+{"event": "result", ...} per result valid rising edge (decoded here with struct, independently
 of facet's encoder, plus the raw words), {"event": "missed_trigger"} per rising edge.
 """
 import argparse
