@@ -72,7 +72,8 @@ class StationReader {
   // belongs to the administrator, not to recipe authors).
   std::optional<std::filesystem::path> pathOf(const YAML::Node& n) const {
     if (!n || !n.IsScalar() || n.Scalar().empty()) return std::nullopt;
-    return (base_ / n.Scalar()).lexically_normal();
+    const auto p = (base_ / n.Scalar()).lexically_normal();
+    return p.has_filename() ? p : p.parent_path();  // "a/." normalises to "a/"
   }
   std::optional<std::filesystem::path> folderPath(const YAML::Node& n, const std::string& key) {
     const auto p = pathOf(n);

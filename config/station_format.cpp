@@ -1,9 +1,5 @@
 #include "config/station_format.hpp"
 
-// The tables use designated initializers and leave the other members at their defaults on
-// purpose; GCC 12 warns about that under -Wextra.
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-
 namespace facet::config {
 namespace {
 

@@ -23,6 +23,27 @@ bool crossesInsidePixel(const EdgePoint& point, cv::Point pixel) {
   return std::abs(rho) <= 0.5 * axis;
 }
 
+// The final one-point-per-crossing rule on the refined (and curvature-corrected) positions:
+// noise can make two pixels of a row local maxima whose facet points both pass; the refined
+// points, averaged over the whole window, cannot both cross the row inside their pixels.
+void dropPointsOutsideTheirPixel(EdgeContours& result, const std::vector<cv::Point>& pixels) {
+  std::vector<int> newIndex(result.points.size(), -1);
+  size_t kept = 0;
+  for (size_t i = 0; i < result.points.size(); ++i) {
+    if (!crossesInsidePixel(result.points[i], pixels[i])) continue;
+    newIndex[i] = static_cast<int>(kept);
+    result.points[kept++] = result.points[i];
+  }
+  result.points.resize(kept);
+  for (auto& contour : result.contours) {
+    size_t n = 0;
+    for (int index : contour)
+      if (newIndex[index] >= 0) contour[n++] = newIndex[index];
+    contour.resize(n);
+  }
+  std::erase_if(result.contours, [](const std::vector<int>& c) { return c.empty(); });
+}
+
 }  // namespace
 
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params) {
@@ -83,30 +104,55 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   EdgeProfileParams profile;
   const int reach = edgeProfileReach(profile);
   const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
-  if (params.fitProfile) profile.width = estimateEdgeWidth(image, seeds, profile);
+  if (params.fitProfile) {
+    profile.width = estimateEdgeWidth(image, seeds, profile);
+    result.blurSigma = std::sqrt(std::max(profile.width * profile.width - 1.0 / 12, 0.0));
+  }
   std::vector<cv::Point> pixels;
+  std::vector<double> windowBias;  // per point: kappa coefficient of the fit's window bias
   result.points.reserve(seeds.size());
   pixels.reserve(seeds.size());
   for (size_t i = 0; i < seeds.size(); ++i) {
     const EdgeSeed& s = seeds[i];
     EdgePoint point{cv::Point2d(s.pixel) + s.offset * s.normal, s.normal, magnitudes[i]};
+    // The facet zero crossing decides which pixel carries the point (one per row/column
+    // crossing); the profile fit then refines its position, which may leave the pixel by a
+    // little on tight curves.
+    if (!crossesInsidePixel(point, s.pixel)) continue;
+    double bias = 0;
     if (params.fitProfile && fitArea.contains(s.pixel)) {
       EdgeProfileParams local = profile;
       local.halfAlong = profileHalfAlong(curvatures[i], profile);
       const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, local);
       if (!refined) continue;
       point = *refined;
+      bias = profileWindowBias(local);
     }
-    if (!crossesInsidePixel(point, s.pixel)) continue;
     result.points.push_back(point);
     pixels.push_back(s.pixel);
+    windowBias.push_back(bias);
   }
 
-  if (params.linkContours || params.correctCurvatureBias) {
-    result.contours = linkEdgePoints(result.points, pixels);
-    if (params.correctCurvatureBias) correctCurvatureBias(result.points, result.contours);
-    if (!params.linkContours) result.contours.clear();
+  const bool link = params.linkContours || params.correctCurvatureBias || params.fitProfile;
+  if (link) result.contours = linkEdgePoints(result.points, pixels);
+  if (params.fitProfile) {
+    // The straight-line fit returns the arc's mean offset over its window, kappa <t^2> / 2
+    // towards the centre of curvature: remove it with the contour's curvature.
+    // The curvature is shrunk by 0.001/px (r = 1000 px) so that the noise of straight contours'
+    // curvature (~0.0006/px) does not move their points.
+    const std::vector<double> kappa = contourCurvatures(result.points, result.contours, 8);
+    for (size_t i = 0; i < result.points.size(); ++i) {
+      const double k = std::copysign(std::max(0.0, std::abs(kappa[i]) - 0.001), kappa[i]);
+      result.points[i].position += windowBias[i] * k * result.points[i].normal;
+    }
   }
+  if (params.correctCurvatureBias) {
+    CurvatureBiasParams correction;
+    correction.coefficient = curvatureBiasCoefficient(result.blurSigma);
+    correctCurvatureBias(result.points, result.contours, correction);
+  }
+  if (params.fitProfile) dropPointsOutsideTheirPixel(result, pixels);
+  if (!params.linkContours) result.contours.clear();
   return result;
 }
 

@@ -23,10 +23,13 @@ ScaleLevel computeLevel(const cv::Mat& img, double relScale, const HarrisParams&
   cv::GaussianBlur(img, smooth, cv::Size(), sd, sd, cv::BORDER_REFLECT);
   cv::Sobel(smooth, ix, CV_32F, 1, 0, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
   cv::Sobel(smooth, iy, CV_32F, 0, 1, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
-  cv::Mat ixx = ix.mul(ix), iyy = iy.mul(iy), ixy = ix.mul(iy);
-  cv::GaussianBlur(ixx, ixx, cv::Size(), si, si, cv::BORDER_REFLECT);
-  cv::GaussianBlur(iyy, iyy, cv::Size(), si, si, cv::BORDER_REFLECT);
-  cv::GaussianBlur(ixy, ixy, cv::Size(), si, si, cv::BORDER_REFLECT);
+  // The three products are smoothed as one 3-channel image (one filter pass).
+  cv::Mat products;
+  cv::merge(std::vector<cv::Mat>{ix.mul(ix), iy.mul(iy), ix.mul(iy)}, products);
+  cv::GaussianBlur(products, products, cv::Size(), si, si, cv::BORDER_REFLECT);
+  std::vector<cv::Mat> m;
+  cv::split(products, m);
+  const cv::Mat &ixx = m[0], &iyy = m[1], &ixy = m[2];
   ScaleLevel level;
   level.sigma = si;
   level.harris = ixx.mul(iyy) - ixy.mul(ixy) - p.k * (ixx + iyy).mul(ixx + iyy);
@@ -119,6 +122,34 @@ std::vector<HarrisCorner> spreadCorners(const std::vector<HarrisCorner>& corners
   return kept;
 }
 
+std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
+                                           const HarrisParams& params) {
+  CV_Assert(grey.type() == CV_32F && cell > 0);
+  HarrisParams p = params;
+  p.selectScale = false;
+  const ScaleLevel level = computeLevel(grey, 1.0, p);
+  double maxResponse = 0;
+  cv::minMaxLoc(level.harris, nullptr, &maxResponse);
+  const double threshold = std::max(p.absoluteThreshold, p.relativeThreshold * maxResponse);
+  std::vector<HarrisCorner> out;
+  const int b = std::max(p.border, 2);
+  for (int y0 = b; y0 < grey.rows - b; y0 += cell)
+    for (int x0 = b; x0 < grey.cols - b; x0 += cell) {
+      const cv::Rect r(x0, y0, std::min(cell, grey.cols - b - x0),
+                       std::min(cell, grey.rows - b - y0));
+      double best = 0;
+      cv::Point loc;
+      cv::minMaxLoc(level.harris(r), nullptr, &best, nullptr, &loc);
+      if (best <= threshold) continue;
+      HarrisCorner c;
+      c.pt = {static_cast<double>(x0 + loc.x), static_cast<double>(y0 + loc.y)};
+      c.scale = level.sigma;
+      c.response = best;
+      out.push_back(c);
+    }
+  return out;
+}
+
 std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisParams& params) {
   CV_Assert(grey.type() == CV_32F);
   std::vector<HarrisCorner> all;
@@ -141,7 +172,9 @@ std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisP
     octave = next;
   }
   // Keep a pool of the strongest before the quadratic-time spreading.
-  const std::size_t pool = static_cast<std::size_t>(params.maxCorners) * 6;
+  const std::size_t pool =
+      std::min<std::size_t>(static_cast<std::size_t>(params.maxCorners) * 6,
+                            static_cast<std::size_t>(params.maxCorners) + 4000);
   if (all.size() > pool) {
     std::nth_element(
         all.begin(), all.begin() + pool, all.end(),

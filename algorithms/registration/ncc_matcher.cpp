@@ -20,8 +20,9 @@ struct Placement {
   // Energy of the window minus its mean, ring effects and column effects (the two profiles are
   // orthogonal after centring): what neither projection explains.
   double interaction = 0;
-  std::vector<double> ringSums;    // radius profile, rings entries
-  std::vector<double> columnSums;  // angle profile, stored twice (2 * angles entries)
+  std::vector<double> ringSums;   // radius profile, rings entries
+  std::vector<float> columnSums;  // angle profile, stored twice (2 * angles entries)
+  double columnNorm = 0;          // |angle profile|, for the float rounding pad
   // |DFT| of the angle profile at frequencies 1..angles/2, weighted by sqrt of their multiplicity
   // (2, or 1 for angles/2) so that a plain dot product gives sum_{k=1}^{A-1} |X_k| |Y_k|.
   std::vector<double> spectrum;
@@ -46,9 +47,10 @@ Placement place(const LogPolarWindow& w, int first, int rings) {
   double columnEnergy = 0;
   for (int t = 0; t < A; ++t) {
     const double c = w.columnSum[(first + rings) * A + t] - w.columnSum[first * A + t];
-    p.columnSums[t] = p.columnSums[t + A] = c;
+    p.columnSums[t] = p.columnSums[t + A] = static_cast<float>(c);  // exact: integers < 2^24
     columnEnergy += c * c;
   }
+  p.columnNorm = std::sqrt(columnEnergy);
   const double sum = static_cast<double>(p.sum);
   p.interaction = std::max(0.0, static_cast<double>(p.squares) - ringEnergy / A -
                                     columnEnergy / rings + sum * sum / static_cast<double>(n)) +
@@ -57,8 +59,8 @@ Placement place(const LogPolarWindow& w, int first, int rings) {
     double re = 0, im = 0;
     for (int t = 0; t < A; ++t) {
       const double phase = 2.0 * std::numbers::pi * k * t / A;
-      re += p.columnSums[t] * std::cos(phase);
-      im -= p.columnSums[t] * std::sin(phase);
+      re += static_cast<double>(p.columnSums[t]) * std::cos(phase);
+      im -= static_cast<double>(p.columnSums[t]) * std::sin(phase);
     }
     const double weight = (2 * k == A) ? 1.0 : std::sqrt(2.0);
     // Rounded up a little: the spectrum only feeds an upper bound.
@@ -202,10 +204,13 @@ WindowScore comparePlaced(const Pair& q, double threshold, const NccAcceleration
       const double ringSpectral = static_cast<double>(dot) * (1 + 1e-4) + 1.0;
       if (N * (ringCross + ringSpectral / q.A) / den < threshold - kBoundSlack) continue;
     }
+    // Float dot products (vectorised); their rounding error is below A * 2^-24 * |X| |Y|.
+    const double crossPad = 4.0 * q.A * 6e-8 * q.pa.columnNorm * pb.columnNorm + 1.0;
     for (int t = 0; t < q.A; ++t) {
-      double cross = 0;
-      const double* cb = pb.columnSums.data() + t;
-      for (int i = 0; i < q.A; ++i) cross += q.pa.columnSums[i] * cb[i];
+      float crossF = 0;
+      const float* cb = pb.columnSums.data() + t;
+      for (int i = 0; i < q.A; ++i) crossF += q.pa.columnSums[i] * cb[i];
+      const double cross = static_cast<double>(crossF) + crossPad;
       const double bound = N * (ringCross + cross / q.R - meanTerm + interaction) / den;
       if (bound >= threshold - kBoundSlack) candidates.push_back({bound, si, t});
     }

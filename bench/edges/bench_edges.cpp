@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[i], "--angle") == 0) {
       setenv("BENCH_EDGES_DUMP", "1", 1);
       const StraightResult r = measureStraight(std::atof(argv[i + 1]), std::atof(argv[i + 2]),
-                                               std::atof(argv[i + 3]), 1, false);
+                                               std::atof(argv[i + 3]), 1000 + static_cast<std::uint64_t>(std::atof(argv[i + 1])), false);
       std::printf("rms %.4f points %d doubled %d\n", r.rms, r.points, r.doubled);
       return 0;
     }

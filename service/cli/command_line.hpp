@@ -38,5 +38,7 @@ void addResultsCommand(CLI::App& app);
 void addEdgesCommand(CLI::App& app);
 void addModelCommand(CLI::App& app);
 void addMatchCommand(CLI::App& app);
+void addRegisterCommand(CLI::App& app);
+void addRecipeCommand(CLI::App& app);
 
 }  // namespace facet::cli

@@ -24,6 +24,8 @@ int main(int argc, char** argv) {
   addEdgesCommand(app);
   addModelCommand(app);
   addMatchCommand(app);
+  addRegisterCommand(app);
+  addRecipeCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
