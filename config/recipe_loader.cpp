@@ -87,6 +87,9 @@ class RecipeReader {
     root_ = options.root ? std::filesystem::absolute(*options.root) : recipe_.baseFolder;
   }
 
+  [[nodiscard]] int id() const { return recipe_.id; }
+  [[nodiscard]] const SourceLocation& idWhere() const { return recipe_.idWhere; }
+
   // Every file looked at so far (valid after read(), also when it failed).
   std::vector<std::filesystem::path> files() const {
     std::vector<std::filesystem::path> all{recipe_.file};
@@ -578,6 +581,8 @@ RecipeLoadResult loadRecipe(const std::filesystem::path& file, const RecipeLoadO
   RecipeReader reader(file, options, result.diagnostics);
   result.recipe = reader.read();
   result.files = reader.files();
+  result.id = reader.id();
+  result.idWhere = reader.idWhere();
   return result;
 }
 

@@ -166,7 +166,7 @@ class Validator {
           std::string message = "unknown " + f.name + " " + inQuotes(*s);
           if (const auto near = closestName(*s, f.choices))
             message += " (did you mean " + inQuotes(*near) + "?)";
-          error(v, message + "; expected one of " + joined(f.choices));
+          error(at(v, key), message + "; expected one of " + joined(f.choices));
         }
         break;
       }
@@ -208,13 +208,6 @@ class Validator {
           else
             object(item, *f.object, what + " item");
         }
-        break;
-      case FieldType::Map:
-        if (!v.IsMap()) {
-          error(at(v, key), what + " must be a mapping, not " + describe(v));
-          break;
-        }
-        for (const auto& entry : v) object(entry.second, *f.object, inQuotes(entry.first.Scalar()));
         break;
     }
   }
