@@ -90,11 +90,12 @@ struct V4l2Settings {
 // Replay of recorded 2D range scans (for scan recipes), see scan_source.hpp.
 struct ScanReplaySettings {
   std::filesystem::path folder;  // required when a recipe uses scans
-  // File-name pattern with '*' and '?'; empty = every *.csv, *.log, *.clf and *.carmen file.
+  // File-name pattern with '*' and '?'; empty = every *.csv, *.log, *.clf, *.carmen and their
+  // .gz forms.
   std::string glob;
   bool loop = false;
-  // CARMEN FLASER/RAWLASER readings with a range at or above this are "no return" and dropped
-  // (metres; 0 = keep every reading).
+  // Ranges at or beyond this are "no return" and dropped (metres); 0 = the scan readers'
+  // default of 80 m (CARMEN writes about 81.9 for no return).
   double max_range_m = 0.0;
 };
 

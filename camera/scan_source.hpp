@@ -1,27 +1,26 @@
 #pragma once
 // ScanSource: recorded 2D range scans replayed the way a folder of images is, for scan recipes.
-// Formats: CSV (rows "x,y" in metres, one scan per file; or "scan,x,y" with several scans per
-// file, grouped by the first column; a non-numeric first row is a header) and CARMEN logs
-// (FLASER / RLASER / RAWLASER lines; ranges turned into points in the sensor frame).
+// Files are read with the scan module's readers (algorithms/scan/scan_file.hpp, plain or
+// gzip-compressed): *.csv is one scan per file ("x,y" or "angle_deg,range" rows); any other
+// matching file is a CARMEN log whose FLASER messages are replayed one scan each.
 
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
-#include <vector>
 
-#include <opencv2/core/types.hpp>
-
+#include "algorithms/scan/scan.hpp"
 #include "camera/camera.hpp"
 #include "camera/camera_settings.hpp"
 
 namespace facet {
 
 struct RangeScan {
-  std::vector<cv::Point2d> points;  // metres, sensor frame: x forward, y left
-  std::uint64_t id = 0;             // running number over the replay
-  double timestamp_s = 0.0;         // from the log when it has one, else 0
-  std::string source;               // "file" or "file:line"
+  scan::Scan scan;           // metres, sensor frame (x forward, y left), beam order
+  std::uint64_t id = 0;      // running number over the replay
+  double timestamp_s = 0.0;  // CARMEN ipc_timestamp; 0 for CSV
+  std::string source;        // "file" (CSV) or "file:line" (CARMEN)
+  // CARMEN: "pose_x", "pose_y" (metres), "pose_theta" (radians) of the laser in the world.
   std::map<std::string, std::string> metadata;
 };
 
@@ -35,14 +34,14 @@ struct ScanResult {
 class ScanSource {
  public:
   virtual ~ScanSource() = default;
-  // The next scan in natural file order. A malformed file or line is skipped with a logged
-  // error naming file and line, and counted in health().skipped_files.
+  // The next scan in natural file order. A malformed or unreadable file is skipped with a
+  // logged error naming file and line, and counted in health().skipped_files.
   virtual ScanResult next() = 0;
   virtual CameraHealth health() const = 0;
   virtual std::string name() const = 0;
 };
 
-// Throws CameraError when the folder is missing or holds no matching file.
+// Lists the folder at once; throws CameraError when it is missing or holds no matching file.
 std::unique_ptr<ScanSource> makeScanReplay(const ScanReplaySettings& settings);
 
 }  // namespace facet

@@ -271,7 +271,6 @@ void PlcLink::State::connect() {
     stats.connected = true;
   }
   spdlog::info("PLC: connected to {}", bus->describe());
-  onConnected();
 }
 
 // After every (re)connect the PLC's view is rebuilt from the daemon's state: the PLC may have
@@ -451,7 +450,10 @@ void PlcLink::State::step() {
     std::lock_guard lock(mutex);
     requestedRecipe = recipe;
   }
-  if (!headWritten) deliverHead();
+  // Four-phase handshake: the next result waits until the PLC has dropped its acknowledge, so
+  // the PLC sees result valid fall between two results.
+  const bool ackReleased = settings.mode == HandshakeMode::FreeRun || !lastAck;
+  if (!headWritten && ackReleased) deliverHead();
 }
 
 void PlcLink::State::run() {
@@ -460,11 +462,13 @@ void PlcLink::State::run() {
       std::lock_guard lock(mutex);
       if (stopping) break;
     }
-    if (!connected) {
+    const bool fresh = !connected;
+    if (fresh) {
       connect();
-      continue;
+      if (!connected) continue;
     }
     try {
+      if (fresh) onConnected();
       step();
     } catch (const TryAgain&) {
       // device busy: the same step runs again after the poll period
@@ -481,7 +485,8 @@ void PlcLink::State::run() {
     bool more = false;
     {
       std::lock_guard lock(mutex);
-      more = !queue.empty() && !headWritten;
+      more =
+          !queue.empty() && !headWritten && (settings.mode == HandshakeMode::FreeRun || !lastAck);
     }
     if (!more && !sleepFor(settings.pollPeriod)) break;
   }
@@ -510,6 +515,8 @@ PlcLink::PlcLink(RegisterMap map, PlcSettings settings) : state_(std::make_uniqu
     RegisterServerOptions options;
     options.host = state_->settings.host;
     options.port = state_->settings.port;
+    options.coils = 65536;  // the whole address space: any valid map fits
+    options.holdingRegisters = 65536;
     state_->server = std::make_unique<RegisterServer>(options);
     state_->bus = makeServerBus(*state_->server);
   } else {

@@ -11,7 +11,8 @@
 //   daemon publish(result)    -> all result registers, pass, error code, inspection counter are
 //                                written, then result valid = 1 and completed toggle flipped,
 //                                busy = 0
-//   PLC result ack 0->1       -> result valid = 0; the next queued result may follow
+//   PLC result ack 0->1       -> result valid = 0
+//   PLC result ack 1->0       -> the next queued result may follow (four-phase handshake)
 //   trigger 0->1 while busy   -> missed trigger = 1 (latched until the next accepted trigger)
 // Free-run handshake: each result is written with the next inspection counter and the toggle
 // flipped; no trigger, no acknowledge.

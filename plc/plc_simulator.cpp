@@ -91,6 +91,7 @@ struct PlcSimulator::State {
 
 void PlcSimulator::State::scan() {
   Tables tables(*server, map);
+  tables.setFlag(map.control.enable, true);  // a running line enables inspections
   const bool triggered = options.mode == HandshakeMode::Triggered;
   const auto ratePeriod = options.triggerRate > 0
                               ? std::chrono::duration_cast<SteadyClock::duration>(
@@ -99,6 +100,8 @@ void PlcSimulator::State::scan() {
   auto nextTrigger = SteadyClock::now() + ratePeriod;
   // Plain time points with flags: GCC 12 warns about std::optional<time_point> here.
   bool triggerHigh = false;
+  bool raisePending = false;
+  SteadyClock::time_point triggerLoweredAt{};
   bool busyAtRaise = false;  // raised while busy: hold the full pulse so the daemon sees it
   SteadyClock::time_point triggerRaisedAt{};
   bool ackPending = false;
@@ -111,13 +114,15 @@ void PlcSimulator::State::scan() {
   while (!stopping) {
     const auto now = SteadyClock::now();
     if (triggered) {
-      // Trigger: raised on request or at the rate; cleared once busy shows or after the pulse.
-      bool raise = triggerRequested.exchange(false);
+      // Trigger: raised on request or at the rate.
+      if (triggerRequested.exchange(false)) raisePending = true;
       if (ratePeriod > SteadyClock::duration::zero() && now >= nextTrigger) {
-        raise = true;
+        raisePending = true;
         nextTrigger += ratePeriod;
       }
-      if (raise && !triggerHigh) {
+      // A polling daemon sees an edge only if the trigger stayed low for a few of its polls.
+      if (raisePending && !triggerHigh && now - triggerLoweredAt >= options.triggerGap) {
+        raisePending = false;
         tables.setFlag(map.control.trigger, true);
         triggerHigh = true;
         busyAtRaise = tables.flag(map.status.busy);
@@ -125,14 +130,17 @@ void PlcSimulator::State::scan() {
         std::lock_guard lock(mutex);
         ++stats.triggersRaised;
       }
-      if (triggerHigh && ((tables.flag(map.status.busy) && !busyAtRaise) ||
-                          now - triggerRaisedAt >= options.triggerPulse)) {
-        tables.setFlag(map.control.trigger, false);
-        triggerHigh = false;
-      }
       // Result valid: read everything, acknowledge after the delay, release the ack when the
       // daemon clears result valid.
       const bool valid = tables.flag(map.status.resultValid);
+      // The trigger is held until the daemon answers (busy, or a result when the inspection was
+      // quicker than a scan), at the latest until the pulse ends.
+      if (triggerHigh && ((tables.flag(map.status.busy) && !busyAtRaise) || (valid && !lastValid) ||
+                          now - triggerRaisedAt >= options.triggerPulse)) {
+        tables.setFlag(map.control.trigger, false);
+        triggerHigh = false;
+        triggerLoweredAt = now;
+      }
       if (valid && !lastValid) {
         const ReceivedResult result = tables.readResult();
         validSince = now;

@@ -101,7 +101,7 @@ class ServerBus final : public RegisterBus {
   void connect() override {}
   void close() override {}
   std::string describe() const override {
-    return "Modbus server on port " + std::to_string(server_.port());
+    return "the daemon's Modbus server (port " + std::to_string(server_.port()) + ")";
   }
   void readCoils(int wire, int count, std::uint8_t* out) override {
     for (int i = 0; i < count; ++i) out[i] = guard([&] { return server_.coil(wire + i); });

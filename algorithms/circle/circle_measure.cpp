@@ -8,8 +8,8 @@
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
+#include "algorithms/circle/annulus_edges.hpp"
 #include "algorithms/circle/circle_profile_fit.hpp"
-#include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/geometry/ransac.hpp"
 
 namespace facet {
@@ -65,11 +65,14 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
   double lambda = 1e-6;
   auto cost = [&](const Circle& k) {
     double s = 0;
-    for (std::size_t i = 0; i < pts.size(); ++i) s += w[i] * std::pow(residual(k, pts[i]), 2);
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double r = residual(k, pts[i]);
+      s += w[i] * r * r;
+    }
     return s;
   };
   double current = cost(c);
-  for (int it = 0; it < 30; ++it) {
+  for (int it = 0; it < 20; ++it) {
     Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
     Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
     for (std::size_t i = 0; i < pts.size(); ++i) {
@@ -91,7 +94,7 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
       const double nextCost = cost(next);
       if (nextCost <= current) {
         improved = true;
-        const bool converged = step.norm() < 1e-9;
+        const bool converged = step.norm() < 1e-5;  // pixels: far below the accuracy sought
         c = next;
         current = nextCost;
         lambda = std::max(lambda * 0.1, 1e-12);
@@ -142,6 +145,11 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
     return "the nominal radius must be positive (got " + std::to_string(p.radius) + ")";
   if (!(p.width > 0.0) || !std::isfinite(p.width))
     return "the search width must be positive (got " + std::to_string(p.width) + ")";
+  if (p.radius + p.width > 1e5)
+    return "the annulus (radius + width = " + std::to_string(p.radius + p.width) +
+           " px) is larger than any image";
+  if (std::abs(p.centre.x) > 1e7 || std::abs(p.centre.y) > 1e7)
+    return "the expected centre lies absurdly far outside the image";
   if (!(p.directionToleranceDeg > 0.0 && p.directionToleranceDeg <= 90.0))
     return "the direction tolerance must be in (0, 90] degrees";
   if (!(p.ransacThreshold > 0.0)) return "the RANSAC threshold must be positive";
@@ -197,42 +205,16 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   const double rOut = params.radius + params.width;
   const cv::Point2d c0 = params.centre;
 
-  // The annulus' bounding box plus the Facet window's margin, clipped to the image.
-  constexpr int kMargin = 4;
-  const cv::Rect box(static_cast<int>(std::floor(c0.x - rOut)) - kMargin,
-                     static_cast<int>(std::floor(c0.y - rOut)) - kMargin,
-                     static_cast<int>(2 * rOut) + 2 * kMargin + 3,
-                     static_cast<int>(2 * rOut) + 2 * kMargin + 3);
-  const cv::Rect crop = box & cv::Rect(0, 0, image.cols, image.rows);
-  // Only pixels at least 2 px from the image border carry a full 5x5 Facet window.
-  const cv::Rect usable = cv::Rect(2, 2, image.cols - 4, image.rows - 4);
-  cv::Mat mask = cv::Mat::zeros(crop.size(), CV_8U);
-  int annulusPixels = 0;
-  const double rIn2 = rIn * rIn, rOut2 = rOut * rOut;
-  for (int y = 0; y < crop.height; ++y) {
-    auto* row = mask.ptr<std::uint8_t>(y);
-    const double dy = crop.y + y - c0.y;
-    for (int x = 0; x < crop.width; ++x) {
-      const double dx = crop.x + x - c0.x;
-      const double d2 = dx * dx + dy * dy;
-      if (d2 >= rIn2 && d2 <= rOut2 && usable.contains({crop.x + x, crop.y + y})) {
-        row[x] = 255;
-        ++annulusPixels;
-      }
-    }
-  }
-  if (annulusPixels == 0)
+  // Canny thresholds from the annulus alone, then Facet subpixel points (annulus_edges.hpp).
+  const AnnulusEdges edges =
+      detectAnnulusEdges(image, c0, rIn, rOut, params.cannyLow, params.cannyHigh);
+  if (edges.annulusPixels == 0)
     return failed(m, CircleFailure::AnnulusOutsideImage,
                   "the search annulus around (" + std::to_string(c0.x) + ", " +
                       std::to_string(c0.y) + ") with radius " + std::to_string(params.radius) +
                       " +- " + std::to_string(params.width) + " lies outside the " +
                       std::to_string(image.cols) + "x" + std::to_string(image.rows) + " image");
 
-  EdgeParams ep;
-  ep.low = params.cannyLow;
-  ep.high = params.cannyHigh;
-  ep.mask = mask;  // thresholds come from the annulus alone
-  const EdgeContours edges = detectSubpixelEdges(image(crop), ep);
   m.lowThreshold = edges.lowThreshold;
   m.highThreshold = edges.highThreshold;
   m.edgePoints = static_cast<int>(edges.points.size());
@@ -242,7 +224,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::vector<Candidate> candidates;
   candidates.reserve(edges.points.size());
   for (const EdgePoint& e : edges.points) {
-    const Eigen::Vector2d p{e.position.x + crop.x, e.position.y + crop.y};
+    const Eigen::Vector2d p{e.position.x, e.position.y};
     const Eigen::Vector2d radial = p - Eigen::Vector2d{c0.x, c0.y};
     const double d = radial.norm();
     if (d < rIn || d > rOut || d == 0.0) continue;
@@ -268,6 +250,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::optional<Circle> best;
   std::vector<Eigen::Vector2d> bestPts;
   std::size_t bestCount = 0;
+  int rimSign = +1;  // +1: gradient points outwards (dark inside), -1: inwards
   for (int sign : {+1, -1}) {
     std::vector<Eigen::Vector2d> pts;
     for (const Candidate& c : candidates)
@@ -286,6 +269,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     auto found = ransac<Circle>(pts.size(), 3, fit, res, rp);
     if (found && found->inliers.size() > bestCount) {
       bestCount = found->inliers.size();
+      rimSign = sign;
       best = found->model;
       bestPts = std::move(pts);
     }
@@ -306,7 +290,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
       if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
     if (static_cast<int>(in.size()) < params.minInliers) break;
     w.assign(in.size(), 1.0);
-    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 4;
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 2;
     for (int k = 0; k < irls; ++k) {
       if (k > 0) {
         std::vector<double> a;
@@ -339,7 +323,21 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
   if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
-    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints)) {
+    // Strong edge points that are not the rim: off the circle, or not radial with its polarity.
+    std::vector<cv::Point2d> foreign;
+    for (const EdgePoint& e : edges.points) {
+      const Eigen::Vector2d p{e.position.x, e.position.y};
+      const Eigen::Vector2d radial = p - circle.centre;
+      const double d = radial.norm();
+      if (d == 0.0) continue;
+      const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
+      // Weak points (below the high threshold) are mostly noise; they must not punch holes.
+      if (e.magnitude >= edges.highThreshold &&
+          (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
+        foreign.push_back(e.position);
+    }
+    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints, foreign,
+                                     edges.noiseSigma)) {
       m.centre = fine->centre;
       m.radius = fine->radius;
       m.blur = fine->blur;

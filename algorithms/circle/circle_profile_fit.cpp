@@ -1,6 +1,7 @@
 #include "algorithms/circle/circle_profile_fit.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -11,18 +12,35 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-// One pixel of the band: position and grey value, with its fixed angular interpolation.
+// One pixel of the band, relative to the starting centre.
 struct Sample {
   double x, y, grey;
-  int k0, k1;  // sector nodes either side of the pixel's angle
-  double w1;   // weight of k1 (k0 gets 1 - w1)
+  int bin;  // angular bin
 };
 
-// Parameters: 0 cx, 1 cy, 2 R, 3 s, then a_k (4 + 2k) and b_k (5 + 2k) per sector node.
-struct Model {
-  Eigen::VectorXd p;
-  int nodes = 0;
-};
+using Vector8 = Eigen::Matrix<double, 8, 1>;
+using Matrix8 = Eigen::Matrix<double, 8, 8>;
+
+// A monotonic stand-in for the polar angle, in [0, 4) (no atan2 in the pixel loops); bins of
+// equal width in it are within a factor 1.5 of equal angles.
+double diamondAngle(double dx, double dy) {
+  const double sum = std::abs(dx) + std::abs(dy);
+  if (sum == 0.0) return 0.0;
+  const double q = dy / sum;
+  return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
+}
+
+// Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): Abramowitz & Stegun
+// 7.1.26 for erfc (absolute error below 1.5e-7), which reuses the exponential the Jacobian needs.
+double upperTail(double z, double gauss) {
+  const double x = std::abs(z) / std::numbers::sqrt2;
+  const double t = 1.0 / (1.0 + 0.3275911 * x);
+  const double poly =
+      t *
+      (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
+  const double tail = 0.5 * poly * gauss;  // 0.5 erfc(x) with exp(-x^2) = gauss
+  return z >= 0.0 ? tail : 1.0 - tail;
+}
 
 double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
@@ -35,94 +53,121 @@ double medianOf(std::vector<double> v) {
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
-                                                 double maxShift) {
+                                                 const std::vector<cv::Point2d>& foreignPoints,
+                                                 double noiseSigma, double maxShift) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
 
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
   const int bins = std::max(16, static_cast<int>(2.0 * kPi * radius / 2.0));
   auto binOf = [&](double dx, double dy) {
-    const double a = std::atan2(dy, dx) + kPi;  // 0..2pi
-    return std::min(bins - 1, static_cast<int>(a / (2.0 * kPi) * bins));
+    return std::min(bins - 1, static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins));
   };
   std::vector<std::uint8_t> covered(bins, 0);
   for (const auto& q : rimPoints) covered[binOf(q.x - centre.x, q.y - centre.y)] = 1;
+  // Close gaps of up to 2 bins (edge points missed in noise), then drop 2 bins at each end of
+  // every covered run: next to an occluder or a clutter blob the band mixes in foreign edges.
+  {
+    std::vector<std::uint8_t> closed = covered;
+    for (int i = 0; i < bins; ++i)
+      if (!covered[i] && ((covered[(i + bins - 1) % bins] || covered[(i + bins - 2) % bins]) &&
+                          (covered[(i + 1) % bins] || covered[(i + 2) % bins])))
+        closed[i] = 1;
+    for (int i = 0; i < bins; ++i) {
+      bool inside = true;
+      for (int k = -2; k <= 2 && inside; ++k) inside = closed[(i + k + bins) % bins] != 0;
+      covered[i] = inside ? 1 : 0;
+    }
+  }
+  constexpr double kBand = 4.0;
 
-  // Sector nodes for a and b: about one per 25 px of arc, at least 4.
-  const int nodes = std::clamp(static_cast<int>(2.0 * kPi * radius / 25.0), 4, 32);
-
-  // The band |rho - R| <= 3 px inside the image.
-  constexpr double kBand = 3.0;
+  // The band |rho - R| <= kBand inside the image.
   std::vector<Sample> samples;
   const double rOut = radius + kBand, rIn = std::max(0.0, radius - kBand);
   const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - rOut)));
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
   const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - rOut)));
   const int y1 = std::min(image.rows - 1, static_cast<int>(std::ceil(centre.y + rOut)));
+  // Pixels within 2 px of a foreign edge (clutter, an occluder's border) stay out of the fit.
+  cv::Mat tainted;
+  if (!foreignPoints.empty() && x1 >= x0 && y1 >= y0) {
+    tainted = cv::Mat::zeros(y1 - y0 + 1, x1 - x0 + 1, CV_8U);
+    for (const auto& q : foreignPoints) {
+      const int qx = static_cast<int>(std::lround(q.x)), qy = static_cast<int>(std::lround(q.y));
+      for (int v = std::max(y0, qy - 2); v <= std::min(y1, qy + 2); ++v)
+        for (int u = std::max(x0, qx - 2); u <= std::min(x1, qx + 2); ++u)
+          if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= 4.0)
+            tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
+    }
+  }
   for (int y = y0; y <= y1; ++y) {
     const double dy = y - centre.y;
-    for (int x = x0; x <= x1; ++x) {
+    if (dy * dy > rOut * rOut) continue;
+    // The row meets the band in up to two runs: |dx| in [inner, outer].
+    const double outer = std::sqrt(rOut * rOut - dy * dy);
+    const double inner = dy * dy < rIn * rIn ? std::sqrt(rIn * rIn - dy * dy) : 0.0;
+    const int xa = std::max(x0, static_cast<int>(std::ceil(centre.x - outer)));
+    const int xb = std::min(x1, static_cast<int>(std::floor(centre.x + outer)));
+    for (int x = xa; x <= xb; ++x) {
       const double dx = x - centre.x;
-      const double r2 = dx * dx + dy * dy;
-      if (r2 < rIn * rIn || r2 > rOut * rOut || !covered[binOf(dx, dy)]) continue;
+      if (std::abs(dx) < inner) {
+        x = static_cast<int>(std::ceil(centre.x + inner)) - 1;  // jump over the inner disc
+        continue;
+      }
+      const int bin = binOf(dx, dy);
+      if (!covered[bin] || (!tainted.empty() && tainted.at<std::uint8_t>(y - y0, x - x0))) continue;
       const double grey = image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
                                                   : image.at<std::uint8_t>(y, x);
-      const double t = (std::atan2(dy, dx) + kPi) / (2.0 * kPi) * nodes;  // 0..nodes
-      const int k0 = static_cast<int>(std::floor(t)) % nodes;
-      samples.push_back({static_cast<double>(x), static_cast<double>(y), grey, k0, (k0 + 1) % nodes,
-                         t - std::floor(t)});
+      samples.push_back({dx, dy, grey, bin});
     }
   }
   if (samples.size() < 30) return std::nullopt;
 
-  // Start: outside and inside levels from the band's two halves, blur 1.2 px.
+  // Start: outside and inside levels from the band's two halves, blur 1.2 px, no ramp.
   std::vector<double> inside, outside;
-  for (const Sample& s : samples) {
-    const double d = std::hypot(s.x - centre.x, s.y - centre.y) - radius;
-    if (d < -2.0) inside.push_back(s.grey);
-    if (d > 2.0) outside.push_back(s.grey);
+  for (const Sample& e : samples) {
+    const double d = std::sqrt(e.x * e.x + e.y * e.y) - radius;
+    if (d < -2.0) inside.push_back(e.grey);
+    if (d > 2.0) outside.push_back(e.grey);
   }
   if (inside.empty() || outside.empty()) return std::nullopt;
-  const double a0 = medianOf(outside), b0 = medianOf(inside) - a0;
-  const int n = 4 + 2 * nodes;
-  Eigen::VectorXd p(n);
-  p(0) = centre.x;
-  p(1) = centre.y;
-  p(2) = radius;
-  p(3) = 1.2;
-  for (int k = 0; k < nodes; ++k) {
-    p(4 + 2 * k) = a0;
-    p(5 + 2 * k) = b0;
+  Vector8 p;
+  p << 0.0, 0.0, radius, 1.2, medianOf(outside), 0.0, 0.0, 0.0;
+  p(7) = medianOf(inside) - p(4);
+
+  // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
+  // bins, enough for a centre precision of about kTargetSigma px per axis by the Cramer-Rao bound
+  // (information per band pixel about (b / noise)^2 / (2 sqrt(pi) s) / (2 * 2 kBand)); this
+  // bounds the time of big, high-contrast circles and keeps every pixel of faint ones.
+  constexpr double kTargetSigma = 0.0035;
+  if (noiseSigma > 0.0) {
+    const double snr = p(7) / noiseSigma;
+    const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * kBand);
+    const double needed = std::max(1000.0, 1.0 / (kTargetSigma * kTargetSigma * infoPerPixel));
+    const double share = needed / static_cast<double>(samples.size());
+    if (share < 1.0)
+      std::erase_if(samples, [&](const Sample& e) {
+        return std::floor((e.bin + 1) * share) == std::floor(e.bin * share);
+      });
   }
 
-  // One pass over the band at parameters q: residuals (grey - model) and Jacobian rows (8
-  // non-zero entries per pixel: cx, cy, R, s, and a, b at the two sector nodes).
+  // One pass over the band at parameters q: residuals (grey - model) and Jacobian rows.
   const std::size_t m = samples.size();
-  std::vector<double> r(m), rTry(m), jac(8 * m), jacTry(8 * m), weight(m, 1.0);
-  auto evaluate = [&](const Eigen::VectorXd& q, std::vector<double>& res, std::vector<double>& j) {
+  std::vector<double> r(m), rTry(m), weight(m, 1.0);
+  std::vector<Vector8> jac(m), jacTry(m);
+  auto evaluate = [&](const Vector8& q, std::vector<double>& res, std::vector<Vector8>& j) {
     const double s = q(3), inv = 1.0 / s, norm = 1.0 / (std::sqrt(2.0 * kPi) * s);
     for (std::size_t i = 0; i < m; ++i) {
       const Sample& e = samples[i];
       const double ex = e.x - q(0), ey = e.y - q(1);
       const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
-      const double d = rho - q(2);
-      const double w0 = 1.0 - e.w1;
-      const double a = w0 * q(4 + 2 * e.k0) + e.w1 * q(4 + 2 * e.k1);
-      const double b = w0 * q(5 + 2 * e.k0) + e.w1 * q(5 + 2 * e.k1);
-      const double z = d * inv;
-      const double phi = 0.5 * std::erfc(z / std::numbers::sqrt2);  // Phi(-d / s)
-      const double bg = b * norm * std::exp(-0.5 * z * z);          // b * pdf(d; s)
-      res[i] = e.grey - (a + b * phi);
+      const double z = (rho - q(2)) * inv;
+      const double gauss = std::exp(-0.5 * z * z);
+      const double phi = upperTail(z, gauss);  // Phi(-d / s)
+      const double bg = q(7) * norm * gauss;   // b * pdf(d; s)
+      res[i] = e.grey - (q(4) + q(5) * e.x + q(6) * e.y + q(7) * phi);
       // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
-      double* row = &j[8 * i];
-      row[0] = bg * ex / rho;
-      row[1] = bg * ey / rho;
-      row[2] = bg;
-      row[3] = bg * z;
-      row[4] = w0;
-      row[5] = e.w1;
-      row[6] = w0 * phi;
-      row[7] = e.w1 * phi;
+      j[i] << bg * ex / rho, bg * ey / rho, bg, bg * z, 1.0, e.x, e.y, phi;
     }
   };
   auto cost = [&](const std::vector<double>& res) {
@@ -130,23 +175,25 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     for (std::size_t i = 0; i < m; ++i) c += weight[i] * res[i] * res[i];
     return c;
   };
-  Eigen::MatrixXd jtj(n, n);
-  Eigen::VectorXd jtr(n);
+  Matrix8 jtj;
+  Vector8 jtr;
   auto normalEquations = [&] {
     jtj.setZero();
     jtr.setZero();
-    double* h = jtj.data();
+    double h[8][8] = {}, g[8] = {};
     for (std::size_t i = 0; i < m; ++i) {
       const double w = weight[i];
       if (w == 0.0) continue;
-      const Sample& e = samples[i];
-      const int cols[8] = {0, 1, 2, 3, 4 + 2 * e.k0, 4 + 2 * e.k1, 5 + 2 * e.k0, 5 + 2 * e.k1};
-      const double* row = &jac[8 * i];
+      const double* j = jac[i].data();
       for (int u = 0; u < 8; ++u) {
-        const double wu = w * row[u];
-        jtr(cols[u]) += wu * r[i];
-        for (int v = 0; v < 8; ++v) h[cols[u] * n + cols[v]] += wu * row[v];
+        const double wu = w * j[u];
+        g[u] += wu * r[i];
+        for (int v = 0; v <= u; ++v) h[u][v] += wu * j[v];
       }
+    }
+    for (int u = 0; u < 8; ++u) {
+      jtr(u) = g[u];
+      for (int v = 0; v <= u; ++v) jtj(u, v) = jtj(v, u) = h[u][v];
     }
   };
   auto tukeyWeights = [&] {
@@ -161,46 +208,83 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     return sigma;
   };
 
-  evaluate(p, r, jac);
-  double current = cost(r);
+  // Levenberg-Marquardt over the parameters marked free (a fixed one keeps its value).
   double sigma = 0.0;
-  double lambda = 1e-4;
-  for (int it = 0; it < 10; ++it) {
-    // Robust weights once the grey levels have settled (after the first, linear-ish step).
-    if (it == 1 || it == 3) {
-      sigma = tukeyWeights();
-      current = cost(r);
-    }
-    normalEquations();
-    bool accepted = false;
-    Eigen::VectorXd step;
-    for (int tries = 0; tries < 6 && !accepted; ++tries) {
-      Eigen::MatrixXd a = jtj;
-      a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-9);
-      step = a.ldlt().solve(jtr);
-      if (!step.allFinite()) return std::nullopt;
-      const Eigen::VectorXd next = p + step;
-      if (next(3) > 0.05) {
-        evaluate(next, rTry, jacTry);
-        const double c = cost(rTry);
-        if (c <= current) {
-          accepted = true;
-          p = next;
-          current = c;
-          std::swap(r, rTry);
-          std::swap(jac, jacTry);
-          lambda = std::max(lambda * 0.3, 1e-9);
-          break;
-        }
+  auto solve = [&](const std::array<bool, 8>& free, int maxIterations, bool reweight) {
+    evaluate(p, r, jac);
+    double current = cost(r);
+    double lambda = 1e-4;
+    for (int it = 0; it < maxIterations; ++it) {
+      // Robust weights once the grey levels have settled (after the first, nearly linear step).
+      if (reweight && it == 1) {
+        sigma = tukeyWeights();
+        current = cost(r);
       }
-      lambda *= 10;
+      normalEquations();
+      for (int k = 0; k < 8; ++k)
+        if (!free[k]) {
+          jtj.row(k).setZero();
+          jtj.col(k).setZero();
+          jtj(k, k) = 1.0;
+          jtr(k) = 0.0;
+        }
+      bool accepted = false;
+      Vector8 step;
+      for (int tries = 0; tries < 6 && !accepted; ++tries) {
+        Matrix8 a = jtj;
+        a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-9);
+        step = a.ldlt().solve(jtr);
+        if (!step.allFinite()) return false;
+        const Vector8 next = p + step;
+        if (next(3) > 0.05) {
+          evaluate(next, rTry, jacTry);
+          const double c = cost(rTry);
+          if (c <= current) {
+            accepted = true;
+            p = next;
+            current = c;
+            std::swap(r, rTry);
+            std::swap(jac, jacTry);
+            lambda = std::max(lambda * 0.3, 1e-9);
+            break;
+          }
+        }
+        lambda *= 10;
+      }
+      if (!accepted) break;
+      if (it >= 2 && step.head<4>().norm() < 1e-3) break;
     }
-    if (!accepted) break;
-    if (it >= 3 && step.head<4>().norm() < 1e-4) break;
+    return true;
+  };
+
+  // Without the illumination ramp first: in a thin band a ramp resembles a shifted rim, and
+  // fitting one costs about half the precision of a small circle. A score test at that solution
+  // (chi-square of the ramp's gradient, 2 degrees of freedom, 99.9%) decides whether the image
+  // has a ramp worth fitting.
+  if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
+  normalEquations();
+  {
+    constexpr int kRamp[2] = {5, 6};
+    constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
+    Eigen::Matrix2d hgg;
+    Eigen::Matrix<double, 2, 6> hgo;
+    Eigen::Matrix<double, 6, 6> hoo;
+    Eigen::Vector2d score;
+    for (int u = 0; u < 2; ++u) {
+      score(u) = jtr(kRamp[u]);
+      for (int v = 0; v < 2; ++v) hgg(u, v) = jtj(kRamp[u], kRamp[v]);
+      for (int v = 0; v < 6; ++v) hgo(u, v) = jtj(kRamp[u], kRest[v]);
+    }
+    for (int u = 0; u < 6; ++u)
+      for (int v = 0; v < 6; ++v) hoo(u, v) = jtj(kRest[u], kRest[v]);
+    const Eigen::Matrix2d schur = hgg - hgo * hoo.ldlt().solve(hgo.transpose());
+    const double statistic = score.dot(schur.ldlt().solve(score)) / std::max(sigma * sigma, 1e-12);
+    if (std::isfinite(statistic) && statistic > 13.8)
+      if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
   }
 
   const double blur = p(3);
-  const cv::Point2d c{p(0), p(1)};
+  const cv::Point2d c{centre.x + p(0), centre.y + p(1)};
   if (!p.allFinite() || blur < 0.2 || blur > 5.0 || p(2) <= 0.0 ||
       std::hypot(c.x - centre.x, c.y - centre.y) > maxShift || std::abs(p(2) - radius) > maxShift)
     return std::nullopt;

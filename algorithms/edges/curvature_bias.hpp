@@ -1,14 +1,15 @@
 #pragma once
-// Correction of the radial bias of second-derivative edges on curved contours.
+// Correction of the radial bias of the edge points on curved contours.
 //
-// On a blurred curved edge the slope maximum along the gradient moves towards the centre of
-// curvature: for a Gaussian-blurred disc of radius r the shift is about sigma^2 / (2 r), and the
-// facet window adds its own smoothing. Measured on rendered discs (bench_edges prints the table)
-// the points lie about `coefficient / r` pixels inside the true contour. The correction estimates
-// the signed curvature from the turn of the normals along the linked contour,
+// On a blurred disc of radius r the slope maximum lies about sigma^2 / (2 r) inside the true
+// edge, and the facet / profile fit see the curved edge through their windows; what remains
+// after detectSubpixelEdges has removed its own window bias (see subpixel_edges.cpp) is about
+// `coefficient / r` pixels towards the centre of curvature (calibrated by bench_edges on rendered
+// discs, blur 0.8-1.5). The correction estimates the signed curvature from the turn of the normals
+// along the linked contour,
 //   kappa_n = (p_b - p_a) . (n_b - n_a) / |p_b - p_a|^2   (positive: centre on the -n side),
-// over neighbours `halfWindow` points either side, and moves each point by coefficient * kappa_n
-// along its normal, i.e. away from the centre of curvature.
+// over neighbours `halfWindow` points either side, and moves each point away from the centre
+// of curvature by coefficient * |kappa_n|.
 
 #include <vector>
 
@@ -17,9 +18,20 @@
 namespace facet {
 
 struct CurvatureBiasParams {
-  double coefficient = 1.3;  // pixels^2: bias = coefficient / radius
-  int halfWindow = 4;        // points either side used for the curvature estimate
+  double coefficient = 0.5;   // pixels^2: blur part of the bias = coefficient / radius
+  bool profileFitted = true;  // add the profile fit's window bias (points from fitEdgeProfile)
+  int halfWindow = 4;         // points either side used for the curvature estimate
 };
+
+// The coefficient k of the remaining bias k / r for blur `sigma` (pixels), calibrated with
+// bench_edges on rendered discs of radius 10..200 at blur 0.8, 1.0 and 1.5.
+double curvatureBiasCoefficient(double sigma);
+
+// Signed curvature kappa_n (1/pixels, convention above) of every point from the turn of the
+// normals along its contour; 0 for points on contours shorter than 2 * halfWindow + 1.
+std::vector<double> contourCurvatures(const std::vector<EdgePoint>& points,
+                                      const std::vector<std::vector<int>>& contours,
+                                      int halfWindow = 4);
 
 // Corrects `points` in place along each contour of `contours` (index lists into `points`).
 // Contours shorter than 2 * halfWindow + 1 points are left unchanged.

@@ -3,7 +3,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <mutex>
 #include <numbers>
+#include <type_traits>
+#include <vector>
 
 namespace facet {
 namespace {
@@ -16,19 +22,20 @@ constexpr int kTableSize = static_cast<int>(2 * kRange * kPerUnit) + 2;
 
 struct NormalTable {
   std::array<float, kTableSize> cdf{}, pdf{};
+  // The same, packed per interval for the vectorised fit: value and slope of CDF and PDF.
+  struct alignas(16) Interval {
+    float cdf, cdfSlope, pdf, pdfSlope;
+  };
+  std::array<Interval, kTableSize> packed{};
   NormalTable() {
     for (int i = 0; i < kTableSize; ++i) {
       const double z = -kRange + static_cast<double>(i) / kPerUnit;
       cdf[i] = static_cast<float>(0.5 * std::erfc(-z / std::numbers::sqrt2));
       pdf[i] = static_cast<float>(std::exp(-0.5 * z * z) / std::sqrt(2 * std::numbers::pi));
     }
-  }
-  void lookup(float z, float& c, float& p) const {
-    const float f = std::clamp((z + kRange) * kPerUnit, 0.0f, kTableSize - 1.001f);
-    const int i = static_cast<int>(f);
-    const float r = f - static_cast<float>(i);
-    c = cdf[i] + r * (cdf[i + 1] - cdf[i]);
-    p = pdf[i] + r * (pdf[i + 1] - pdf[i]);
+    for (int i = 0; i + 1 < kTableSize; ++i)
+      packed[i] = {cdf[i], cdf[i + 1] - cdf[i], pdf[i], pdf[i + 1] - pdf[i]};
+    packed[kTableSize - 1] = {cdf[kTableSize - 1], 0, pdf[kTableSize - 1], 0};
   }
 };
 
@@ -37,13 +44,188 @@ const NormalTable& normalTable() {
   return table;
 }
 
+// A tabulated edge profile: value P and derivative D per interval (value and slope), looked up
+// at table coordinate (u * coordScale + range) * perUnit for the distance u to the edge line.
+struct ProfileView {
+  const NormalTable::Interval* data = nullptr;
+  int size = 0;
+  float coordScale = 1, range = 0, perUnit = 1;
+  double derivScale = 1;  // D * derivScale = dP/du * (1 / coordScale) convention, see step()
+};
+
+// Profiles of a blurred step seen through the pixel aperture, for one PSF sigma and normal
+// angles 0..45 degrees (1 degree steps; the profile depends only on {|cos|, |sin|}).
+// For the unit pixel square the aperture projected on the normal is box(c) * box(s) with
+// c = |cos|, s = |sin|, so with G(x) = x Phi(x) + phi(x) and H(x) = ((x^2 + 1) Phi(x) + x phi(x))/2
+// (the first and second antiderivatives of Phi):
+//   P(u)  = sigma^2 / (c s) [H((u+p)/sigma) - H((u+m)/sigma) - H((u-m)/sigma) + H((u-p)/sigma)]
+//   P'(u) = sigma   / (c s) [G(...)         - G(...)         - G(...)         + G(...)]
+// with p = (c + s)/2, m = (c - s)/2; for s -> 0 the single box gives
+//   P(u) = sigma / c [G((u+c/2)/sigma) - G((u-c/2)/sigma)],  P'(u) = [Phi(..) - Phi(..)] / c.
+constexpr float kApertureRange = 7.5f;  // pixels either side of the edge
+constexpr int kAperturePerPixel = 16;
+constexpr int kApertureSize = static_cast<int>(2 * kApertureRange * kAperturePerPixel) + 2;
+constexpr int kApertureAngles = 46;
+
+struct ApertureProfiles {
+  double sigma = 0;
+  bool gridBlur = false;
+  std::vector<NormalTable::Interval> rows;  // kApertureAngles x kApertureSize, built on use
+  std::unique_ptr<std::once_flag[]> built;
+
+  ApertureProfiles(double psfSigma, bool blurOnGrid)
+      : sigma(psfSigma), gridBlur(blurOnGrid), built(new std::once_flag[kApertureAngles]) {
+    rows.resize(static_cast<size_t>(kApertureAngles) * kApertureSize);
+  }
+
+  void buildRow(int k) {
+    std::vector<double> value(kApertureSize), slope(kApertureSize);
+    {
+      const double angle = k * std::numbers::pi / 180.0;
+      const double c = std::cos(angle), sn = std::sin(angle);
+      for (int i = 0; i < kApertureSize; ++i) {
+        const double u = -kApertureRange + static_cast<double>(i) / kAperturePerPixel;
+        if (gridBlur)
+          gridProfile(u, c, sn, value[i], slope[i]);
+        else
+          profile(u, c, sn, value[i], slope[i]);
+      }
+      NormalTable::Interval* row = &rows[static_cast<size_t>(k) * kApertureSize];
+      for (int i = 0; i < kApertureSize; ++i) {
+        const int j = std::min(i + 1, kApertureSize - 1);
+        row[i] = {static_cast<float>(value[i]), static_cast<float>(value[j] - value[i]),
+                  static_cast<float>(slope[i]), static_cast<float>(slope[j] - slope[i])};
+      }
+    }
+  }
+
+  ProfileView view(cv::Point2d normal) {
+    const double lo = std::min(std::abs(normal.x), std::abs(normal.y));
+    const double hi = std::max(std::abs(normal.x), std::abs(normal.y));
+    const int k =
+        std::clamp(static_cast<int>(std::lround(std::atan2(lo, hi) * 180 / std::numbers::pi)), 0,
+                   kApertureAngles - 1);
+    std::call_once(built[k], [this, k] { buildRow(k); });
+    return {&rows[static_cast<size_t>(k) * kApertureSize],
+            kApertureSize,
+            1.0f,
+            kApertureRange,
+            static_cast<float>(kAperturePerPixel),
+            1.0};
+  }
+
+ private:
+  static double cdf(double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }
+  static double pdf(double x) { return std::exp(-0.5 * x * x) / std::sqrt(2 * std::numbers::pi); }
+  static double g(double x) { return x * cdf(x) + pdf(x); }
+  static double h(double x) { return 0.5 * ((x * x + 1) * cdf(x) + x * pdf(x)); }
+
+  // The sharp step integrated over the pixel square: the CDF and density of the aperture
+  // box(c) * box(s) at x.
+  static void sharpStep(double x, double c, double s, double& value, double& slope) {
+    if (s < 1e-6) {
+      value = std::clamp((x + c / 2) / c, 0.0, 1.0);
+      slope = std::abs(x) < c / 2 ? 1 / c : 0.0;
+      return;
+    }
+    const double p = (c + s) / 2, m = (c - s) / 2;
+    if (x <= -p) {
+      value = 0, slope = 0;
+    } else if (x <= -m) {
+      value = (x + p) * (x + p) / (2 * c * s), slope = (x + p) / (c * s);
+    } else if (x <= m) {
+      value = s / (2 * c) + (x + m) / c, slope = 1 / c;
+    } else if (x < p) {
+      value = 1 - (p - x) * (p - x) / (2 * c * s), slope = (p - x) / (c * s);
+    } else {
+      value = 1, slope = 0;
+    }
+  }
+
+  // Blur on the pixel grid: the pixel-integrated sharp step convolved with the sampled Gaussian
+  // kernel (truncated at 4 sigma, normalised), as a blur applied to the sampled image does:
+  //   P(u) = sum_k g(kx) g(ky) sharpStep(u - kx c - ky s).
+  void gridProfile(double u, double c, double s, double& value, double& slope) const {
+    const int r = static_cast<int>(std::ceil(4 * sigma));
+    thread_local std::vector<double> kernel;
+    kernel.assign(2 * r + 1, 0.0);
+    double sum = 0;
+    for (int k = -r; k <= r; ++k) sum += kernel[k + r] = std::exp(-0.5 * k * k / (sigma * sigma));
+    value = slope = 0;
+    if (s < 1e-9) {  // axis-aligned: the kernel's rows all project to the same offsets
+      for (int kx = -r; kx <= r; ++kx) {
+        double v, d;
+        sharpStep(u - kx * c, c, s, v, d);
+        value += kernel[kx + r] / sum * v;
+        slope += kernel[kx + r] / sum * d;
+      }
+      return;
+    }
+    for (int ky = -r; ky <= r; ++ky)
+      for (int kx = -r; kx <= r; ++kx) {
+        double v, d;
+        sharpStep(u - kx * c - ky * s, c, s, v, d);
+        const double weight = kernel[kx + r] * kernel[ky + r] / (sum * sum);
+        value += weight * v;
+        slope += weight * d;
+      }
+  }
+
+  void profile(double u, double c, double s, double& value, double& slope) const {
+    const double sg = sigma;
+    if (s < 1e-3) {
+      value = sg / c * (g((u + c / 2) / sg) - g((u - c / 2) / sg));
+      slope = (cdf((u + c / 2) / sg) - cdf((u - c / 2) / sg)) / c;
+      return;
+    }
+    const double p = (c + s) / 2, m = (c - s) / 2;
+    value =
+        sg * sg / (c * s) * (h((u + p) / sg) - h((u + m) / sg) - h((u - m) / sg) + h((u - p) / sg));
+    slope = sg / (c * s) * (g((u + p) / sg) - g((u + m) / sg) - g((u - m) / sg) + g((u - p) / sg));
+  }
+};
+
+// Profiles are pure functions of sigma; keep the last few so that a camera's images (whose blur
+// estimate varies little) build them once.
+std::shared_ptr<ApertureProfiles> apertureProfiles(double sigma, bool gridBlur) {
+  static std::mutex mutex;
+  static std::vector<std::shared_ptr<ApertureProfiles>> cache;
+  const double key = std::round(sigma * 50) / 50;
+  std::lock_guard lock(mutex);
+  for (const auto& p : cache)
+    if (p->sigma == key && p->gridBlur == gridBlur) return p;
+  auto made = std::make_shared<ApertureProfiles>(key, gridBlur);
+  if (cache.size() >= 24) cache.erase(cache.begin());
+  cache.push_back(made);
+  return made;
+}
+
+ProfileView erfView(double w) {
+  const auto& t = normalTable();
+  return {t.packed.data(),
+          kTableSize,
+          static_cast<float>(1.0 / w),
+          kRange,
+          static_cast<float>(kPerUnit),
+          w};
+}
+
 constexpr int kCapacity = 512;
 
+// Four float lanes (GCC/Clang vector extension; SSE on x86, NEON on ARM).
+using Lanes = float __attribute__((vector_size(16)));
+using IntLanes = int __attribute__((vector_size(16)));
+
 struct Samples {
-  int count = 0;
+  int count = 0;  // padded to a multiple of 4 with zero-weight samples
   float mean = 0;
-  std::array<float, kCapacity> s, t, v;  // across, along, grey value minus mean
+  // across, along, grey value minus mean, weight (1, or 0 for padding)
+  alignas(16) std::array<float, kCapacity> s, t, v, weight;
 };
+
+float horizontalSum(Lanes x) {
+  return (x[0] + x[1]) + (x[2] + x[3]);
+}
 
 // Solves the symmetric positive definite n x n system A x = y by Cholesky; false if singular.
 template <int N>
@@ -72,13 +254,14 @@ bool solveSpd(std::array<std::array<double, N>, N>& a, std::array<double, N>& y)
   return true;
 }
 
-// The integer range of dx for which lo <= dx * k + c <= hi (all dx when k ~ 0 and c fits).
-void restrict(double k, double c, double lo, double hi, int& first, int& last) {
+// The integer range of dx for which lo <= dx * k + c <= hi, given invK = 1 / k (all dx when k ~ 0
+// and c fits).
+void restrict(double k, double invK, double c, double lo, double hi, int& first, int& last) {
   if (std::abs(k) < 1e-12) {
     if (c < lo || c > hi) last = first - 1;
     return;
   }
-  double x0 = (lo - c) / k, x1 = (hi - c) / k;
+  double x0 = (lo - c) * invK, x1 = (hi - c) * invK;
   if (x0 > x1) std::swap(x0, x1);
   first = std::max(first, static_cast<int>(std::ceil(x0 - 1e-9)));
   last = std::min(last, static_cast<int>(std::floor(x1 + 1e-9)));
@@ -89,23 +272,41 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
             const EdgeProfileParams& params, float scale, Samples& out) {
   const int reach = edgeProfileReach(params);
   out.count = 0;
-  double sum = 0;
+  float sum = 0;
+  const auto nx = static_cast<float>(n.x), ny = static_cast<float>(n.y);
+  const double invX = std::abs(n.x) < 1e-12 ? 0.0 : 1.0 / n.x;
+  const double invY = std::abs(n.y) < 1e-12 ? 0.0 : -1.0 / n.y;
   for (int dy = -reach; dy <= reach; ++dy) {
     int first = -reach, last = reach;
     // s = dx nx + dy ny within offset +- halfAcross; t = -dx ny + dy nx within +- halfAlong.
-    restrict(n.x, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first, last);
-    restrict(-n.y, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
+    restrict(n.x, invX, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first,
+             last);
+    restrict(-n.y, invY, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
+    last = std::min(last, first + (kCapacity - 4 - out.count) - 1);
     const T* row = image.ptr<T>(c.y + dy) + c.x;
-    for (int dx = first; dx <= last && out.count < kCapacity; ++dx) {
-      const int i = out.count++;
-      out.s[i] = static_cast<float>(dx * n.x + dy * n.y);
-      out.t[i] = static_cast<float>(-dx * n.y + dy * n.x);
-      out.v[i] = static_cast<float>(row[dx]) * scale;
-      sum += out.v[i];
+    const float sRow = static_cast<float>(dy) * ny, tRow = static_cast<float>(dy) * nx;
+    float* ps = &out.s[out.count];
+    float* pt = &out.t[out.count];
+    float* pv = &out.v[out.count];
+    float* pw = &out.weight[out.count];
+    for (int dx = first; dx <= last; ++dx) {
+      const auto fx = static_cast<float>(dx);
+      *ps++ = fx * nx + sRow;
+      *pt++ = tRow - fx * ny;
+      const float v = static_cast<float>(row[dx]) * scale;
+      *pv++ = v;
+      *pw++ = 1.0f;
+      sum += v;
     }
+    out.count += std::max(0, last - first + 1);
   }
-  out.mean = out.count ? static_cast<float>(sum / out.count) : 0.0f;
-  for (int i = 0; i < out.count; ++i) out.v[i] -= out.mean;
+  const int real = out.count;
+  out.mean = real ? sum / static_cast<float>(real) : 0.0f;
+  for (int i = 0; i < real; ++i) out.v[i] -= out.mean;
+  while (out.count % 4) {
+    const int i = out.count++;
+    out.s[i] = out.t[i] = out.v[i] = out.weight[i] = 0.0f;
+  }
 }
 
 // One Gauss-Newton step of the model v = a + b Phi(z), z = (s + phi t - e) / w, for (a, b, e)
@@ -114,42 +315,126 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
 enum class Extra { None, Width, Turn };
 
 template <Extra X>
-bool step(const Samples& smp, double& a, double& b, double& e, double& w, double& phi) {
+bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, double& e,
+          double& w, double& phi) {
   constexpr int N = X == Extra::None ? 3 : 4;
-  const NormalTable& table = normalTable();
-  const float invW = static_cast<float>(1.0 / w), ef = static_cast<float>(e);
-  const float phiF = static_cast<float>(phi);
-  float acc[N][N + 1] = {};
-  for (int i = 0; i < smp.count; ++i) {
-    const float z = (smp.s[i] + phiF * smp.t[i] - ef) * invW;
-    float cdf, pdf;
-    table.lookup(z, cdf, pdf);
-    float basis[4] = {1.0f, cdf, pdf, 0.0f};
+  const NormalTable::Interval* packed = profile.data;
+  const Lanes vScale = Lanes{} + profile.coordScale, vE = Lanes{} + static_cast<float>(e),
+              vPhi = Lanes{} + static_cast<float>(phi);
+  const Lanes vLow = Lanes{}, vHigh = Lanes{} + (static_cast<float>(profile.size) - 1.001f);
+  Lanes acc[N][N + 1] = {};
+  for (int i = 0; i < smp.count; i += 4) {
+    Lanes ss, tt, vv, ww;
+    std::memcpy(&ss, &smp.s[i], sizeof ss);
+    std::memcpy(&tt, &smp.t[i], sizeof tt);
+    std::memcpy(&vv, &smp.v[i], sizeof vv);
+    std::memcpy(&ww, &smp.weight[i], sizeof ww);
+    const Lanes z = (ss + vPhi * tt - vE) * vScale;
+    Lanes f = (z + profile.range) * profile.perUnit;
+    f = f < vLow ? vLow : f;
+    f = f > vHigh ? vHigh : f;
+    const IntLanes idx = __builtin_convertvector(f, IntLanes);
+    const Lanes r = f - __builtin_convertvector(idx, Lanes);
+    const auto& q0 = packed[idx[0]];
+    const auto& q1 = packed[idx[1]];
+    const auto& q2 = packed[idx[2]];
+    const auto& q3 = packed[idx[3]];
+    const Lanes cdf = Lanes{q0.cdf, q1.cdf, q2.cdf, q3.cdf} +
+                      r * Lanes{q0.cdfSlope, q1.cdfSlope, q2.cdfSlope, q3.cdfSlope};
+    const Lanes pdf = (Lanes{q0.pdf, q1.pdf, q2.pdf, q3.pdf} +
+                       r * Lanes{q0.pdfSlope, q1.pdfSlope, q2.pdfSlope, q3.pdfSlope}) *
+                      ww;
+    Lanes basis[4] = {ww, cdf * ww, pdf, Lanes{}};
     if constexpr (X == Extra::Width) basis[3] = z * pdf;
-    if constexpr (X == Extra::Turn) basis[3] = smp.t[i] * pdf;
-    for (int r = 0; r < N; ++r) {
-      acc[r][N] += basis[r] * smp.v[i];
-      for (int k = 0; k <= r; ++k) acc[r][k] += basis[r] * basis[k];
+    if constexpr (X == Extra::Turn) basis[3] = tt * pdf;
+    for (int row = 0; row < N; ++row) {
+      acc[row][N] += basis[row] * vv;
+      for (int k = 0; k <= row; ++k) acc[row][k] += basis[row] * basis[k];
     }
   }
   std::array<std::array<double, N>, N> m{};
   std::array<double, N> y{};
   for (int r = 0; r < N; ++r) {
-    y[r] = acc[r][N];
-    for (int k = 0; k <= r; ++k) m[r][k] = acc[r][k];
+    y[r] = horizontalSum(acc[r][N]);
+    for (int k = 0; k <= r; ++k) m[r][k] = horizontalSum(acc[r][k]);
   }
   if (!solveSpd<N>(m, y)) return false;
   a = y[0];
   b = y[1];
   if (b <= 1e-6) return false;
-  // d/de = -b pdf / w, d/dw = -b z pdf / w, d/dphi = b t pdf / w.
-  e += std::clamp(-y[2] * w / b, -0.5, 0.5);
+  // With D the tabulated derivative and k = derivScale (w for the erf, 1 for pixel units):
+  // d/de = -b D / k, d/dw = -b z D / w (erf only), d/dphi = b t D / k.
+  const double k = profile.derivScale;
+  e += std::clamp(-y[2] * k / b, -0.5, 0.5);
   if constexpr (X == Extra::Width) w = std::clamp(w - y[3] * w / b, 0.3, 5.0);
-  if constexpr (X == Extra::Turn) phi += std::clamp(y[3] * w / b, -0.2, 0.2);
+  if constexpr (X == Extra::Turn) phi += std::clamp(y[3] * k / b, -0.2, 0.2);
   return true;
 }
 
+// Residual sum of squares after two (a, b, e) steps of the fixed-profile model.
+double fitResidual(const Samples& smp, const ProfileView& view, double offset) {
+  double a = 0, b = 0, e = offset, w = 1, phi = 0;
+  if (!step<Extra::None>(smp, view, a, b, e, w, phi) ||
+      !step<Extra::None>(smp, view, a, b, e, w, phi))
+    return std::numeric_limits<double>::infinity();
+  double rss = 0;
+  for (int i = 0; i < smp.count; ++i) {
+    if (smp.weight[i] == 0) continue;
+    const double f = std::clamp((static_cast<double>(smp.s[i]) - e) * view.coordScale + view.range,
+                                0.0, static_cast<double>(view.size - 1) / view.perUnit) *
+                     view.perUnit;
+    const int k = std::min(static_cast<int>(f), view.size - 1);
+    const double r = smp.v[i] - a - b * (view.data[k].cdf + (f - k) * view.data[k].cdfSlope);
+    rss += r * r;
+  }
+  return rss;
+}
+
+template <typename T>
+void gatherAny(const cv::Mat& image, const EdgeSeed& seed, const EdgeProfileParams& params,
+               Samples& out) {
+  gather<T>(image, seed.pixel, seed.normal, seed.offset, params,
+            std::is_same_v<T, ushort> ? 1.0f / 256 : 1.0f, out);
+}
+
+// Axis-aligned edges show the profile at one subpixel phase only, which biases the erf width by
+// up to +-0.05 px depending on that phase. When they dominate, the blur is chosen instead as the
+// one whose exact (pixel-grid) profile fits them best.
+double refineWidthOnAxisEdges(const cv::Mat& image, const std::vector<const EdgeSeed*>& axis,
+                              const EdgeProfileParams& params, double width) {
+  std::vector<Samples> samples(axis.size());
+  for (size_t i = 0; i < axis.size(); ++i) {
+    if (image.depth() == CV_16U)
+      gatherAny<ushort>(image, *axis[i], params, samples[i]);
+    else
+      gatherAny<uchar>(image, *axis[i], params, samples[i]);
+  }
+  const double sigma0 = std::round(std::sqrt(std::max(width * width - 1.0 / 12, 0.04)) * 50) / 50;
+  double best = std::numeric_limits<double>::infinity(), bestSigma = sigma0;
+  for (int step = -6; step <= 6; ++step) {
+    const double sigma = sigma0 + 0.02 * step;
+    if (sigma < 0.2) continue;
+    const auto profiles = apertureProfiles(sigma, true);
+    double rss = 0;
+    for (size_t i = 0; i < axis.size(); ++i)
+      rss += fitResidual(samples[i], profiles->view(axis[i]->normal), axis[i]->offset);
+    if (rss < best) best = rss, bestSigma = sigma;
+  }
+  return std::sqrt(bestSigma * bestSigma + 1.0 / 12);
+}
+
 }  // namespace
+
+double profileHalfAlong(double curvature, const EdgeProfileParams& params) {
+  const double k = std::abs(curvature);
+  if (k * params.halfAlong * params.halfAlong <= 6 * params.maxCurvatureBias)
+    return params.halfAlong;
+  return std::clamp(std::sqrt(6 * params.maxCurvatureBias / k), params.minAlong, params.halfAlong);
+}
+
+double profileWindowBias(const EdgeProfileParams& params) {
+  return params.halfAlong * params.halfAlong / 6;
+}
 
 int edgeProfileReach(const EdgeProfileParams& params) {
   return static_cast<int>(std::ceil(std::hypot(params.halfAcross + 1.5, params.halfAlong)));
@@ -168,16 +453,25 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   // With a known width: (a, b, e) steps, the last one also turning the normal. Otherwise the
   // steps fit the width, and a final step the turn.
   const bool fitWidth = params.width <= 0;
+  // A known width w is the erf width of the blur and the pixel aperture together; the aperture's
+  // variance along any normal is (cos^2 + sin^2) / 12 = 1/12, the rest is the PSF.
+  std::shared_ptr<ApertureProfiles> aperture;
+  if (!fitWidth)
+    aperture = apertureProfiles(std::sqrt(std::max(params.width * params.width - 1.0 / 12, 0.04)),
+                                params.blurOnPixelGrid);
   double a = 0, b = 0, e = offset, w = fitWidth ? params.initialWidth : params.width, phi = 0;
   const int iterations = std::max(1, params.iterations);
   for (int it = 0; it < iterations; ++it) {
     const bool last = it == iterations - 1;
     bool ok = true;
-    if (fitWidth)
-      ok = step<Extra::Width>(smp, a, b, e, w, phi) &&
-           (!last || step<Extra::Turn>(smp, a, b, e, w, phi));
-    else
-      ok = last ? step<Extra::Turn>(smp, a, b, e, w, phi) : step<Extra::None>(smp, a, b, e, w, phi);
+    if (fitWidth) {
+      ok = step<Extra::Width>(smp, erfView(w), a, b, e, w, phi) &&
+           (!last || step<Extra::Turn>(smp, erfView(w), a, b, e, w, phi));
+    } else {
+      const ProfileView view = aperture->view(normal);
+      ok = last ? step<Extra::Turn>(smp, view, a, b, e, w, phi)
+                : step<Extra::None>(smp, view, a, b, e, w, phi);
+    }
     if (!ok) return std::nullopt;
   }
   if (std::abs(e - offset) > 1.0) return std::nullopt;  // wandered off: not a clean edge
@@ -199,6 +493,8 @@ double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seed
   fitParams.iterations = std::max(params.iterations, 3);
   const int reach = edgeProfileReach(fitParams);
   std::vector<double> widths;
+  std::vector<const EdgeSeed*> axis;    // seeds whose normal is within 0.5 deg of an axis
+  constexpr double kAxisSine = 0.0087;  // sin(0.5 deg)
   const size_t stride = std::max<size_t>(1, seeds.size() / std::max(1, maxSamples));
   for (size_t i = 0; i < seeds.size(); i += stride) {
     const EdgeSeed& s = seeds[i];
@@ -206,11 +502,20 @@ double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seed
         s.pixel.y >= image.rows - reach)
       continue;
     double w = 0;
-    if (fitEdgeProfile(image, s.pixel, s.normal, s.offset, fitParams, &w)) widths.push_back(w);
+    if (!fitEdgeProfile(image, s.pixel, s.normal, s.offset, fitParams, &w)) continue;
+    widths.push_back(w);
+    if (std::min(std::abs(s.normal.x), std::abs(s.normal.y)) < kAxisSine) axis.push_back(&s);
   }
   if (widths.empty()) return params.initialWidth;
   std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-  return widths[widths.size() / 2];
+  const double width = widths[widths.size() / 2];
+  if (!params.blurOnPixelGrid || axis.empty() || axis.size() * 2 < widths.size()) return width;
+  if (axis.size() > 16) {
+    std::vector<const EdgeSeed*> fewer;
+    for (size_t i = 0; i < 16; ++i) fewer.push_back(axis[i * axis.size() / 16]);
+    axis.swap(fewer);
+  }
+  return refineWidthOnAxisEdges(image, axis, params, width);
 }
 
 }  // namespace facet

@@ -63,6 +63,8 @@ std::optional<FacetZeroCrossing> facetZeroCrossing(const FacetCoefficients& k) {
   if (z.c3 >= 0) return std::nullopt;
   z.rho = -z.c2 / (3 * z.c3);
   z.magnitude = z.c1 + 2 * z.c2 * z.rho + 3 * z.c3 * z.rho * z.rho;
+  const double tx = -s, ty = c;  // f_xx = 2 k3, f_xy = k4, f_yy = 2 k5
+  z.curvature = -(2 * k[3] * tx * tx + 2 * k[4] * tx * ty + 2 * k[5] * ty * ty) / g;
   return z;
 }
 

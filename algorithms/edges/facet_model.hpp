@@ -33,6 +33,9 @@ struct FacetZeroCrossing {
   cv::Point2d normal;             // unit gradient direction at the pixel centre
   double magnitude = 0;           // first directional derivative at the zero crossing
   double c1 = 0, c2 = 0, c3 = 0;  // the directional cubic's coefficients
+  // Curvature of the isophote through the pixel centre, 1/pixels: -f_tt / |grad f| with t the
+  // tangent; positive when the centre of curvature lies on the +normal (light) side.
+  double curvature = 0;
 };
 
 // Zero crossing of the second directional derivative along the gradient; nullopt when the

@@ -23,10 +23,32 @@ bool crossesInsidePixel(const EdgePoint& point, cv::Point pixel) {
   return std::abs(rho) <= 0.5 * axis;
 }
 
+// The final one-point-per-crossing rule on the refined (and curvature-corrected) positions:
+// noise can make two pixels of a row local maxima whose facet points both pass; the refined
+// points, averaged over the whole window, cannot both cross the row inside their pixels.
+void dropPointsOutsideTheirPixel(EdgeContours& result, const std::vector<cv::Point>& pixels) {
+  std::vector<int> newIndex(result.points.size(), -1);
+  size_t kept = 0;
+  for (size_t i = 0; i < result.points.size(); ++i) {
+    if (!crossesInsidePixel(result.points[i], pixels[i])) continue;
+    newIndex[i] = static_cast<int>(kept);
+    result.points[kept++] = result.points[i];
+  }
+  result.points.resize(kept);
+  for (auto& contour : result.contours) {
+    size_t n = 0;
+    for (int index : contour)
+      if (newIndex[index] >= 0) contour[n++] = newIndex[index];
+    contour.resize(n);
+  }
+  std::erase_if(result.contours, [](const std::vector<int>& c) { return c.empty(); });
+}
+
 }  // namespace
 
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params) {
-  if (image.empty()) throw std::invalid_argument("detectSubpixelEdges: the image is empty");
+  EdgeContours result;
+  if (image.empty()) return result;
   if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
     throw std::invalid_argument(
         "detectSubpixelEdges: expected an 8-bit or 16-bit single-channel image, got " +
@@ -37,7 +59,6 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   const cv::Rect full(0, 0, image.cols, image.rows);
   const cv::Rect roi = params.roi.empty() ? full : (params.roi & full);
-  EdgeContours result;
   if (roi.empty()) return result;
 
   // The gradient covers the ROI plus one pixel for suppression; edge pixels need the facet's
@@ -65,7 +86,7 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   // Facet zero crossings of every Canny pixel.
   std::vector<EdgeSeed> seeds;
-  std::vector<double> magnitudes;
+  std::vector<double> magnitudes, curvatures;
   for (int y = candidates.y; y < candidates.y + candidates.height; ++y) {
     const auto* e = edges.ptr<uchar>(y);
     for (int x = candidates.x; x < candidates.x + candidates.width; ++x) {
@@ -74,6 +95,7 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
       const auto z = facetZeroCrossing(fitCubicFacet(image, p));
       if (!z || std::abs(z->rho) > 1.0) continue;
       seeds.push_back({p, z->normal, z->rho});
+      curvatures.push_back(z->curvature);
       magnitudes.push_back(z->magnitude);
     }
   }
@@ -82,28 +104,55 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   EdgeProfileParams profile;
   const int reach = edgeProfileReach(profile);
   const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
-  if (params.fitProfile) profile.width = estimateEdgeWidth(image, seeds, profile);
+  if (params.fitProfile) {
+    profile.width = estimateEdgeWidth(image, seeds, profile);
+    result.blurSigma = std::sqrt(std::max(profile.width * profile.width - 1.0 / 12, 0.0));
+  }
   std::vector<cv::Point> pixels;
+  std::vector<double> windowBias;  // per point: kappa coefficient of the fit's window bias
   result.points.reserve(seeds.size());
   pixels.reserve(seeds.size());
   for (size_t i = 0; i < seeds.size(); ++i) {
     const EdgeSeed& s = seeds[i];
     EdgePoint point{cv::Point2d(s.pixel) + s.offset * s.normal, s.normal, magnitudes[i]};
+    // The facet zero crossing decides which pixel carries the point (one per row/column
+    // crossing); the profile fit then refines its position, which may leave the pixel by a
+    // little on tight curves.
+    if (!crossesInsidePixel(point, s.pixel)) continue;
+    double bias = 0;
     if (params.fitProfile && fitArea.contains(s.pixel)) {
-      const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, profile);
+      EdgeProfileParams local = profile;
+      local.halfAlong = profileHalfAlong(curvatures[i], profile);
+      const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, local);
       if (!refined) continue;
       point = *refined;
+      bias = profileWindowBias(local);
     }
-    if (!crossesInsidePixel(point, s.pixel)) continue;
     result.points.push_back(point);
     pixels.push_back(s.pixel);
+    windowBias.push_back(bias);
   }
 
-  if (params.linkContours || params.correctCurvatureBias) {
-    result.contours = linkEdgePoints(result.points, pixels);
-    if (params.correctCurvatureBias) correctCurvatureBias(result.points, result.contours);
-    if (!params.linkContours) result.contours.clear();
+  const bool link = params.linkContours || params.correctCurvatureBias || params.fitProfile;
+  if (link) result.contours = linkEdgePoints(result.points, pixels);
+  if (params.fitProfile) {
+    // The straight-line fit returns the arc's mean offset over its window, kappa <t^2> / 2
+    // towards the centre of curvature: remove it with the contour's curvature.
+    // The curvature is shrunk by 0.001/px (r = 1000 px) so that the noise of straight contours'
+    // curvature (~0.0006/px) does not move their points.
+    const std::vector<double> kappa = contourCurvatures(result.points, result.contours, 8);
+    for (size_t i = 0; i < result.points.size(); ++i) {
+      const double k = std::copysign(std::max(0.0, std::abs(kappa[i]) - 0.001), kappa[i]);
+      result.points[i].position += windowBias[i] * k * result.points[i].normal;
+    }
   }
+  if (params.correctCurvatureBias) {
+    CurvatureBiasParams correction;
+    correction.coefficient = curvatureBiasCoefficient(result.blurSigma);
+    correctCurvatureBias(result.points, result.contours, correction);
+  }
+  if (params.fitProfile) dropPointsOutsideTheirPixel(result, pixels);
+  if (!params.linkContours) result.contours.clear();
   return result;
 }
 

@@ -1,9 +1,11 @@
 #pragma once
-// Harris-Affine regions (Mikolajczyk and Schmid 2004): a Harris corner with a characteristic
-// scale chosen where the scale-normalised Laplacian peaks, and an elliptical shape found by
-// iterating the second-moment matrix to isotropy. The ellipse's shape matrix maps the unit
-// circle to the region, so sampling a log-polar window through it normalises the region to a
-// circle: an affine change of view then leaves only a rotation (a cyclic angle shift).
+// Harris-Affine regions (Mikolajczyk and Schmid 2004): a Harris corner with its characteristic
+// scale (selected by the Laplacian in detectHarrisCorners) and an elliptical shape found by
+// iterating the second-moment matrix to isotropy. Simplification: the point and the scale are
+// not re-estimated during the shape iterations; the NCC's ring shifts absorb the scale drift. The
+// ellipse's shape matrix maps the unit circle to the region, so sampling a log-polar window through
+// it normalises the region to a circle: an affine change of view then leaves only a rotation (a
+// cyclic angle shift).
 
 #include <vector>
 
@@ -32,8 +34,8 @@ struct AffineRegion {
 std::vector<AffineRegion> circularRegions(const std::vector<HarrisCorner>& corners);
 
 // Adapts each corner's scale and shape; corners whose adaptation diverges are dropped.
-// `grey` is CV_32F in [0, 1].
-std::vector<AffineRegion> adaptAffineRegions(const cv::Mat& grey,
+// `pyramid` comes from buildSamplingPyramid.
+std::vector<AffineRegion> adaptAffineRegions(const std::vector<cv::Mat>& pyramid,
                                              const std::vector<HarrisCorner>& corners,
                                              const HarrisAffineParams& params = {});
 

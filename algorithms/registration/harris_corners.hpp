@@ -26,6 +26,9 @@ struct HarrisParams {
   double relativeThreshold = 1e-3;
   // Minimum absolute response (on images scaled to [0, 1]): flat images yield no corners.
   double absoluteThreshold = 1e-8;
+  // Harris-Laplace: keep a corner only at scales where |Laplacian| is not smaller than at the
+  // neighbouring scales (one characteristic scale per structure). Off: every scale's corners.
+  bool selectScale = true;
   int border = 16;              // pixels at the level; corners closer to the edge are dropped
   double anmsRobustness = 0.9;  // a neighbour suppresses when response * this > own response
 };
@@ -39,6 +42,13 @@ struct HarrisCorner {
 
 // `grey` is CV_32F scaled to [0, 1]. Returns at most params.maxCorners corners.
 std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisParams& params = {});
+
+// Single-scale Harris points spread on a grid: in every `cell` x `cell` block the strongest
+// response (above the thresholds of `params`) at the finest scale. Dense and even, for
+// re-matching around a known transform. Uses derivationSigma, integrationSigma, k, thresholds
+// and border of `params`.
+std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
+                                           const HarrisParams& params = {});
 
 // Adaptive non-maximal suppression: keeps `count` corners with the largest suppression radii.
 std::vector<HarrisCorner> spreadCorners(const std::vector<HarrisCorner>& corners, int count,

@@ -33,11 +33,18 @@ struct RegistrationParams {
   // (degrees) and log2-scale before RANSAC. <= 0 disables the pruning.
   double pruneRotationDeg = 40.0;
   double pruneLog2Scale = 1.0;
-  // Iterative refinement: warp the reference with the current H, re-match every corner of a
-  // larger detection budget around its predicted position (NCC of square patches within
-  // `refineSearchRadius` pixels), refit. 0 disables it.
+  // Escalation for hard pairs (large viewpoint change): when the first global matching gives
+  // fewer than `escalateBelowInliers` inliers, it is repeated with `escalateCorners` corners per
+  // image and the minimum NCC lowered to `escalateMinScore`. escalateCorners <= maxCorners
+  // disables it.
+  int escalateCorners = 800;
+  double escalateMinScore = 0.7;
+  int escalateBelowInliers = 15;
+  // Iterative refinement: warp the reference with the current H, re-match Harris points spread
+  // on a grid (the strongest per `refineCell` x `refineCell` block) around their predicted
+  // positions (NCC of square patches within `refineSearchRadius` pixels), refit. 0 disables it.
   int refineIterations = 2;
-  int refineCorners = 3000;     // corner budget of the reference for the re-matching
+  int refineCell = 10;          // pixels of the reference
   int refineSearchRadius = 8;   // pixels, in the image
   int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
   double refineMinScore = 0.8;  // minimum NCC of a re-matched patch

@@ -33,11 +33,16 @@ struct ScanMatchParams {
   ScanMatchMethod method = ScanMatchMethod::IdcpBoc;
   ScanMetric dualMetric = ScanMetric::PointToLine;  // error used by Dcp and IdcpBoc
 
-  int maxIterations = 100;     // total over both IDCP phases
-  double initialGate = 1.5;    // metres; pairs farther apart are unused in the first iteration
-  double minGate = 0.15;       // metres; the gate never shrinks below this
-  double gateFactor = 3.0;     // next gate = gateFactor * rms, clamped to [minGate, last gate]
-  double trimFraction = 0.9;   // share of gated pairs kept (the closest ones); 1 = no trimming
+  int maxIterations = 100;  // total over both IDCP phases
+  // metres; pairs farther apart are unused in the first iteration. Wide on purpose: the gate
+  // then follows the residual down, and a narrow first gate loses large displacements.
+  double initialGate = 4.0;
+  double minGate = 0.15;  // metres; the gate never shrinks below this
+  // next gate = gateFactor * (rms distance of the pairs used), clamped to [minGate, last gate]
+  double gateFactor = 3.0;
+  // Share of gated pairs kept (the closest ones); 1 = no trimming. Trimming helps the dual rule
+  // (pairs on what only one scan sees); on the CARMEN logs plain ICP does better with 1.
+  double trimFraction = 0.9;
   int minCorrespondences = 6;  // fewer usable pairs -> not converged, cause TooFewCorrespondences
 
   // Converged when the rms changes by less than this between two iterations (gate settled).
@@ -63,7 +68,8 @@ enum class MatchCause {
 struct ScanMatchResult {
   ScanPose pose;            // maps the scan into the reference's frame
   int iterations = 0;       // correspondence rounds run (both phases for IDCP BoC)
-  double rms = 0.0;         // metres; rms error of the pairs used in the last round
+  double rms = 0.0;         // metres; rms error (point-to-line distance for the line metric) of the
+                            // pairs used in the last round
   int correspondences = 0;  // pairs used in the last round (both directions for DCP)
   bool converged = false;
   MatchCause cause = MatchCause::MaxIterations;

@@ -113,6 +113,7 @@ void thin(std::vector<T>& points, int maxPoints) {
 struct LevelResult {
   std::vector<ShapePoint> points;
   Thresholds thresholds;
+  cv::Mat edgeMask;  // CV_8U, 255 on every edge pixel before thinning
 };
 
 LevelResult levelPoints(const cv::Mat& grey, const cv::Mat& mask, cv::Point2d reference,
@@ -122,7 +123,9 @@ LevelResult levelPoints(const cv::Mat& grey, const cv::Mat& mask, cv::Point2d re
   cv::magnitude(gx, gy, magnitude);
   LevelResult result;
   result.thresholds = chooseThresholds(magnitude, mask, params);
+  result.edgeMask = cv::Mat(grey.size(), CV_8U, cv::Scalar(0));
   for (const cv::Point p : edgePixels(gx, gy, magnitude, mask, result.thresholds)) {
+    result.edgeMask.at<uchar>(p) = 255;
     const float m = magnitude.at<float>(p);
     result.points.push_back(
         {cv::Point2f(static_cast<float>(p.x - reference.x), static_cast<float>(p.y - reference.y)),
@@ -200,6 +203,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   cv::Mat grey = toGreyFloat(templateImage(region));
   const int wanted = params.numLevels > 0 ? params.numLevels : kMaxAutoLevels;
   double radius0 = 0.0;
+  cv::Mat modelEdges;  // level-0 edge pixels, widened by one pixel
   for (int level = 0; level < wanted; ++level) {
     if (level > 0) {
       if (grey.cols < 4 || grey.rows < 4) break;
@@ -220,6 +224,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
                               std::to_string(r.thresholds.high) + " grey levels per pixel)");
       model.contrastLow = r.thresholds.low;
       model.contrastHigh = r.thresholds.high;
+      cv::dilate(r.edgeMask, modelEdges, cv::Mat());
     }
     cv::Size2d box;
     const double radius = extentOf(r.points, box);
@@ -241,10 +246,12 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     model.levels.push_back(std::move(shapeLevel));
   }
 
-  // Subpixel edges of the template for the least-squares refinement.
+  // Subpixel edges of the template for the least-squares refinement: the Facet-model points on
+  // the model's own edge pixels. The edge detector's thresholds are kept loose (its gradient
+  // estimate differs from Sobel's); the model's edge pixels decide which points belong.
   EdgeParams edgeParams;
-  edgeParams.low = model.contrastLow;
-  edgeParams.high = model.contrastHigh;
+  edgeParams.low = 0.5 * model.contrastLow;
+  edgeParams.high = 0.5 * model.contrastHigh;
   edgeParams.roi = region;
   if (!mask.empty()) {
     edgeParams.mask = cv::Mat(templateImage.size(), CV_8U, cv::Scalar(0));
@@ -253,6 +260,10 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   }
   const cv::Point2d origin = model.referencePoint + cv::Point2d(region.tl());
   for (const EdgePoint& e : detectSubpixelEdges(templateImage, edgeParams).points) {
+    const cv::Point pixel(cvRound(e.position.x) - region.x, cvRound(e.position.y) - region.y);
+    if (!cv::Rect(0, 0, region.width, region.height).contains(pixel) ||
+        !modelEdges.at<uchar>(pixel))
+      continue;
     const cv::Point2d p = e.position - origin;
     model.finePoints.push_back(
         {cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)),

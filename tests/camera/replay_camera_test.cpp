@@ -197,6 +197,8 @@ TEST(ReplayCamera, SkipsBrokenFilesAndCountsThem) {
   // A PGM header announcing 10^10 pixels: must be refused before allocating anything.
   folder.write("f4.pgm", "P5\n100000 100000\n255\n\x01\x02\x03");
   folder.write("f5.tif", "II*\0garbage");
+  // Truncated raw PGM: a valid header, half the pixel bytes.
+  folder.write("f5b.pgm", "P5\n64 64\n255\n" + std::string(64 * 32, '\x07'));
   cv::imwrite((folder / "f6.png").string(), good);
 
   ReplayCamera camera(replayOf(folder));
@@ -211,9 +213,9 @@ TEST(ReplayCamera, SkipsBrokenFilesAndCountsThem) {
   EXPECT_TRUE(sameImage(second.frame.image, good));
   EXPECT_EQ(second.frame.id, 1u);
   const CameraHealth health = camera.health();
-  EXPECT_EQ(health.skipped_files, 4u);
+  EXPECT_EQ(health.skipped_files, 5u);
   EXPECT_EQ(health.frames, 2u);
-  EXPECT_NE(health.last_error.find("f5.tif"), std::string::npos) << health.last_error;
+  EXPECT_NE(health.last_error.find("f5b.pgm"), std::string::npos) << health.last_error;
   EXPECT_EQ(camera.grab(1s).status, GrabStatus::EndOfStream);
 }
 

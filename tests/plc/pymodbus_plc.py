@@ -2,7 +2,8 @@
 """An independent PLC for facet's PLC tests: a pymodbus TCP server plus a scan loop that acts
 like a PLC program on the same registers.
 
-    pymodbus_plc.py --config plc.json --port 5020
+    pymodbus_plc.py --config plc.json --port 5020            # the PLC serves the registers
+    pymodbus_plc.py --config plc.json --port 5020 --client   # the daemon serves, the PLC polls
 
 plc.json (wire addresses, i.e. zero-based as sent on the wire):
     {"coils": 64, "registers": 256,
@@ -14,8 +15,8 @@ plc.json (wire addresses, i.e. zero-based as sent on the wire):
                   "factor": 1.0}],
      "auto_ack": true, "mode": "triggered"}   (mode "free_run": report each new counter)
 
-stdin commands, one per line: "trigger" (raise the trigger; cleared when busy rises or after
-0.5 s), "quit". stdout: one JSON object per line: {"event": "listening", "port": P}, then
+stdin commands, one per line: "trigger" (raise the trigger; cleared when busy or result valid
+rises, or after 0.5 s), "quit". stdout: one JSON object per line: {"event": "listening", "port": P}, then
 {"event": "result", ...} per result valid rising edge (decoded here with struct, independently
 of facet's encoder, plus the raw words), {"event": "missed_trigger"} per rising edge.
 """
@@ -32,6 +33,7 @@ try:
     import pymodbus
     from pymodbus.datastore import (ModbusSequentialDataBlock, ModbusServerContext,
                                     ModbusSlaveContext)
+    from pymodbus.client import ModbusTcpClient
     from pymodbus.server import StartAsyncTcpServer
 except ImportError as error:  # the C++ test turns this into a failure with this message
     print(json.dumps({"event": "error",
@@ -123,12 +125,14 @@ class Plc:
                 self.last["counter"] = counter
                 emit(self.read_result())
             return
+        # The trigger is held until the daemon answers: busy rises, or (when the inspection was
+        # quicker than this scan) a result arrives; or 0.5 s pass.
         busy_rising, _ = self.edge("busy")
-        if self.trigger_since is not None and (busy_rising or
+        valid_rising, valid_falling = self.edge("result_valid")
+        if self.trigger_since is not None and (busy_rising or valid_rising or
                                                time.monotonic() - self.trigger_since > 0.5):
             self.set_flag("trigger", False)
             self.trigger_since = None
-        valid_rising, valid_falling = self.edge("result_valid")
         if valid_rising:
             emit(self.read_result())
             if self.config.get("auto_ack", True):
@@ -148,13 +152,67 @@ class Plc:
             self.slave.setValues(HOLDING, int(address), [int(value)])
 
 
+class ClientTables:
+    """The daemon's registers seen through a pymodbus client: the PLC program polls them."""
+
+    def __init__(self, client):
+        self.client = client
+
+    def getValues(self, fc, address, count=1):  # pylint: disable=invalid-name
+        reply = (self.client.read_coils(address, count) if fc == COILS
+                 else self.client.read_holding_registers(address, count))
+        if reply.isError():
+            raise RuntimeError(f"read {fc} {address}: {reply}")
+        return reply.bits[:count] if fc == COILS else reply.registers
+
+    def setValues(self, fc, address, values):  # pylint: disable=invalid-name
+        reply = (self.client.write_coil(address, values[0]) if fc == COILS
+                 else self.client.write_registers(address, values))
+        if reply.isError():
+            raise RuntimeError(f"write {fc} {address}: {reply}")
+
+
+def run_client(config, port):
+    client = ModbusTcpClient("127.0.0.1", port=port)
+    if not client.connect():
+        emit({"event": "error", "message": f"cannot connect to 127.0.0.1:{port}"})
+        sys.exit(4)
+    emit({"event": "connected", "port": port, "pymodbus": pymodbus.__version__})
+    plc = Plc(config, ClientTables(client))
+    commands = []
+    lock = threading.Lock()
+
+    def read_stdin():
+        for line in sys.stdin:
+            with lock:
+                commands.append(line.strip())
+        with lock:
+            commands.append("quit")
+
+    threading.Thread(target=read_stdin, daemon=True).start()
+    while True:
+        with lock:
+            pending, commands[:] = list(commands), []
+        for line in pending:
+            if line == "quit":
+                client.close()
+                return
+            plc.command(line)
+        plc.scan()
+        time.sleep(0.001)
+
+
 async def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--config", required=True)
     parser.add_argument("--port", type=int, required=True)
+    parser.add_argument("--client", action="store_true")
     args = parser.parse_args()
     with open(args.config, encoding="utf-8") as f:
         config = json.load(f)
+    if args.client:
+        run_client(config, args.port)
+        return
 
     slave = ModbusSlaveContext(
         co=ModbusSequentialDataBlock(0, [False] * config.get("coils", 64)),

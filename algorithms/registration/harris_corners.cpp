@@ -1,0 +1,187 @@
+#include "algorithms/registration/harris_corners.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <opencv2/imgproc.hpp>
+
+namespace facet {
+namespace {
+
+// Scale-normalised second-moment matrix entries and the Laplacian at one scale of an octave.
+struct ScaleLevel {
+  cv::Mat harris;     // det - k trace^2
+  cv::Mat laplacian;  // sigma^2 (Ixx + Iyy), for the characteristic-scale test
+  double sigma = 1;   // integration sigma at the octave's resolution
+};
+
+ScaleLevel computeLevel(const cv::Mat& img, double relScale, const HarrisParams& p) {
+  const double sd = p.derivationSigma * relScale;
+  const double si = p.integrationSigma * relScale;
+  cv::Mat smooth, ix, iy;
+  cv::GaussianBlur(img, smooth, cv::Size(), sd, sd, cv::BORDER_REFLECT);
+  cv::Sobel(smooth, ix, CV_32F, 1, 0, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
+  cv::Sobel(smooth, iy, CV_32F, 0, 1, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
+  // The three products are smoothed as one 3-channel image (one filter pass).
+  cv::Mat products;
+  cv::merge(std::vector<cv::Mat>{ix.mul(ix), iy.mul(iy), ix.mul(iy)}, products);
+  cv::GaussianBlur(products, products, cv::Size(), si, si, cv::BORDER_REFLECT);
+  std::vector<cv::Mat> m;
+  cv::split(products, m);
+  const cv::Mat &ixx = m[0], &iyy = m[1], &ixy = m[2];
+  ScaleLevel level;
+  level.sigma = si;
+  level.harris = ixx.mul(iyy) - ixy.mul(ixy) - p.k * (ixx + iyy).mul(ixx + iyy);
+  // The scale-normalised Laplacian at the integration scale picks the characteristic scale
+  // (Harris-Laplace).
+  if (p.selectScale) {
+    cv::Mat blurred;
+    cv::GaussianBlur(img, blurred, cv::Size(), si, si, cv::BORDER_REFLECT);
+    cv::Laplacian(blurred, level.laplacian, CV_32F, 3, si * si, 0, cv::BORDER_REFLECT);
+  }
+  return level;
+}
+
+// Offset of the peak of a parabola through (-1, a), (0, b), (1, c).
+double parabolaPeak(float a, float b, float c) {
+  const double d = a - 2.0 * b + c;
+  if (d >= 0) return 0.0;
+  return std::clamp(0.5 * (a - c) / d, -0.5, 0.5);
+}
+
+void detectAtLevel(const ScaleLevel& below, const ScaleLevel& level, const ScaleLevel& above,
+                   double factor, int levelIndex, const HarrisParams& p,
+                   std::vector<HarrisCorner>& out) {
+  const cv::Mat& r = level.harris;
+  double maxResponse = 0;
+  cv::minMaxLoc(r, nullptr, &maxResponse);
+  const float threshold =
+      static_cast<float>(std::max(p.absoluteThreshold, p.relativeThreshold * maxResponse));
+  const int b = std::max(p.border, 2);
+  for (int y = b; y < r.rows - b; ++y) {
+    const float* r0 = r.ptr<float>(y - 1);
+    const float* r1 = r.ptr<float>(y);
+    const float* r2 = r.ptr<float>(y + 1);
+    for (int x = b; x < r.cols - b; ++x) {
+      const float v = r1[x];
+      if (v <= threshold) continue;
+      if (v <= r1[x - 1] || v < r1[x + 1] || v <= r0[x - 1] || v <= r0[x] || v <= r0[x + 1] ||
+          v < r2[x - 1] || v < r2[x] || v < r2[x + 1])
+        continue;
+      // Characteristic scale: |Laplacian| must not be smaller than at the neighbouring scales.
+      if (p.selectScale) {
+        const float lap = std::abs(level.laplacian.at<float>(y, x));
+        if (lap < std::abs(below.laplacian.at<float>(y, x)) ||
+            lap < std::abs(above.laplacian.at<float>(y, x)))
+          continue;
+      }
+      const double dx = parabolaPeak(r1[x - 1], v, r1[x + 1]);
+      const double dy = parabolaPeak(r0[x], v, r2[x]);
+      HarrisCorner c;
+      c.pt = {(x + dx) * factor, (y + dy) * factor};
+      c.scale = level.sigma * factor;
+      c.response = v;
+      c.level = levelIndex;
+      out.push_back(c);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<HarrisCorner> spreadCorners(const std::vector<HarrisCorner>& corners, int count,
+                                        double robustness) {
+  if (static_cast<int>(corners.size()) <= count) return corners;
+  std::vector<HarrisCorner> sorted = corners;
+  std::sort(sorted.begin(), sorted.end(),
+            [](const HarrisCorner& a, const HarrisCorner& b) { return a.response > b.response; });
+  // Suppression radius: distance to the nearest clearly stronger corner of a similar scale
+  // (corners of very different scale describe different structures and do not suppress).
+  std::vector<double> radius2(sorted.size(), std::numeric_limits<double>::infinity());
+  for (std::size_t i = 1; i < sorted.size(); ++i) {
+    const HarrisCorner& c = sorted[i];
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < i; ++j) {
+      const HarrisCorner& s = sorted[j];
+      if (s.response * robustness <= c.response) break;  // sorted: no stronger ones follow
+      const double ratio = s.scale / c.scale;
+      if (ratio > 2.0 || ratio < 0.5) continue;
+      const double dx = s.pt.x - c.pt.x, dy = s.pt.y - c.pt.y;
+      best = std::min(best, dx * dx + dy * dy);
+    }
+    radius2[i] = best;
+  }
+  std::vector<std::size_t> order(sorted.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return radius2[a] > radius2[b]; });
+  std::vector<HarrisCorner> kept;
+  kept.reserve(count);
+  for (int i = 0; i < count; ++i) kept.push_back(sorted[order[i]]);
+  return kept;
+}
+
+std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
+                                           const HarrisParams& params) {
+  CV_Assert(grey.type() == CV_32F && cell > 0);
+  HarrisParams p = params;
+  p.selectScale = false;
+  const ScaleLevel level = computeLevel(grey, 1.0, p);
+  double maxResponse = 0;
+  cv::minMaxLoc(level.harris, nullptr, &maxResponse);
+  const double threshold = std::max(p.absoluteThreshold, p.relativeThreshold * maxResponse);
+  std::vector<HarrisCorner> out;
+  const int b = std::max(p.border, 2);
+  for (int y0 = b; y0 < grey.rows - b; y0 += cell)
+    for (int x0 = b; x0 < grey.cols - b; x0 += cell) {
+      const cv::Rect r(x0, y0, std::min(cell, grey.cols - b - x0),
+                       std::min(cell, grey.rows - b - y0));
+      double best = 0;
+      cv::Point loc;
+      cv::minMaxLoc(level.harris(r), nullptr, &best, nullptr, &loc);
+      if (best <= threshold) continue;
+      HarrisCorner c;
+      c.pt = {static_cast<double>(x0 + loc.x), static_cast<double>(y0 + loc.y)};
+      c.scale = level.sigma;
+      c.response = best;
+      out.push_back(c);
+    }
+  return out;
+}
+
+std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisParams& params) {
+  CV_Assert(grey.type() == CV_32F);
+  std::vector<HarrisCorner> all;
+  cv::Mat octave = grey;
+  const int L = std::max(1, params.levelsPerOctave);
+  for (int o = 0; o < params.octaves; ++o) {
+    if (std::min(octave.rows, octave.cols) < 2 * params.border + 8) break;
+    const double factor = std::ldexp(1.0, o);
+    // Levels -1 and L only serve the scale test of their neighbours.
+    const int first = params.selectScale ? -1 : 0, last = params.selectScale ? L : L - 1;
+    std::vector<ScaleLevel> levels;
+    for (int j = first; j <= last; ++j)
+      levels.push_back(computeLevel(octave, std::pow(2.0, double(j) / L), params));
+    const int offset = params.selectScale ? 1 : 0;
+    for (int j = 0; j < L; ++j)
+      detectAtLevel(levels[j + offset - (offset ? 1 : 0)], levels[j + offset],
+                    levels[j + offset + (offset ? 1 : 0)], factor, o * L + j, params, all);
+    cv::Mat next;
+    cv::pyrDown(octave, next);
+    octave = next;
+  }
+  // Keep a pool of the strongest before the quadratic-time spreading.
+  const std::size_t pool =
+      std::min<std::size_t>(static_cast<std::size_t>(params.maxCorners) * 6,
+                            static_cast<std::size_t>(params.maxCorners) + 4000);
+  if (all.size() > pool) {
+    std::nth_element(
+        all.begin(), all.begin() + pool, all.end(),
+        [](const HarrisCorner& a, const HarrisCorner& b) { return a.response > b.response; });
+    all.resize(pool);
+  }
+  return spreadCorners(all, params.maxCorners, params.anmsRobustness);
+}
+
+}  // namespace facet

@@ -1,0 +1,293 @@
+#include "algorithms/registration/ncc_matcher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <numbers>
+
+namespace facet {
+namespace {
+
+// Bounds are computed in floating point; a candidate is abandoned only when its bound is below
+// the threshold by more than this, so rounding can never discard the true best.
+constexpr double kBoundSlack = 1e-6;
+
+// Per-window quantities for one placement of its compared rows [first, first + rings).
+struct Placement {
+  int first = 0;
+  std::int64_t sum = 0, squares = 0;
+  double variance = 0;  // N * squares - sum^2 (N times the sum of squared deviations)
+  // Energy of the window minus its mean, ring effects and column effects (the two profiles are
+  // orthogonal after centring): what neither projection explains.
+  double interaction = 0;
+  std::vector<double> ringSums;   // radius profile, rings entries
+  std::vector<float> columnSums;  // angle profile, stored twice (2 * angles entries)
+  double columnNorm = 0;          // |angle profile|, for the float rounding pad
+  // |DFT| of the angle profile at frequencies 1..angles/2, weighted by sqrt of their multiplicity
+  // (2, or 1 for angles/2) so that a plain dot product gives sum_{k=1}^{A-1} |X_k| |Y_k|.
+  std::vector<double> spectrum;
+};
+
+Placement place(const LogPolarWindow& w, int first, int rings) {
+  const int A = w.angles;
+  Placement p;
+  p.first = first;
+  p.sum = w.ringSum[first + rings] - w.ringSum[first];
+  p.squares = w.ringSquares[first + rings] - w.ringSquares[first];
+  const auto n = static_cast<std::int64_t>(rings) * A;
+  p.variance = static_cast<double>(n * p.squares - p.sum * p.sum);
+  p.ringSums.resize(rings);
+  double ringEnergy = 0;
+  for (int r = 0; r < rings; ++r) {
+    p.ringSums[r] = static_cast<double>(w.ringSum[first + r + 1] - w.ringSum[first + r]);
+    ringEnergy += p.ringSums[r] * p.ringSums[r];
+  }
+
+  p.columnSums.resize(2 * A);
+  double columnEnergy = 0;
+  for (int t = 0; t < A; ++t) {
+    const double c = w.columnSum[(first + rings) * A + t] - w.columnSum[first * A + t];
+    p.columnSums[t] = p.columnSums[t + A] = static_cast<float>(c);  // exact: integers < 2^24
+    columnEnergy += c * c;
+  }
+  p.columnNorm = std::sqrt(columnEnergy);
+  const double sum = static_cast<double>(p.sum);
+  p.interaction = std::max(0.0, static_cast<double>(p.squares) - ringEnergy / A -
+                                    columnEnergy / rings + sum * sum / static_cast<double>(n)) +
+                  1e-9 * static_cast<double>(p.squares) + 1.0;  // pad against rounding: bound only
+  for (int k = 1; k <= A / 2; ++k) {
+    double re = 0, im = 0;
+    for (int t = 0; t < A; ++t) {
+      const double phase = 2.0 * std::numbers::pi * k * t / A;
+      re += static_cast<double>(p.columnSums[t]) * std::cos(phase);
+      im -= static_cast<double>(p.columnSums[t]) * std::sin(phase);
+    }
+    const double weight = (2 * k == A) ? 1.0 : std::sqrt(2.0);
+    // Rounded up a little: the spectrum only feeds an upper bound.
+    p.spectrum.push_back(weight * std::hypot(re, im) * (1 + 1e-12) + 1e-9);
+  }
+  return p;
+}
+
+// The image window's placements for ring shifts -S..S, computed once per window.
+std::vector<Placement> placements(const LogPolarWindow& w, int rings, int S) {
+  std::vector<Placement> out;
+  for (int s = -S; s <= S; ++s) out.push_back(place(w, S + s, rings));
+  return out;
+}
+
+inline std::int32_t rowDot(const std::int16_t* a, const std::int16_t* b, int n) {
+  std::int32_t acc = 0;
+  for (int i = 0; i < n; ++i) acc += static_cast<std::int32_t>(a[i]) * b[i];
+  return acc;
+}
+
+struct Pair {
+  const LogPolarWindow& a;
+  const LogPolarWindow& b;
+  const Placement& pa;  // reference placement (central rows)
+  const std::vector<Placement>& pb;
+  int S, R, A;
+  std::int64_t N;
+};
+
+// Full NCC at ring shift index si (s = si - S) and angle shift t. Returns false when the shift
+// has no defined NCC (flat window) or was abandoned by the Jensen bound below `thr`.
+bool fullScore(const Pair& q, int si, int t, double thr, const NccAccelerations& acc,
+               double& score) {
+  const Placement& pb = q.pb[si];
+  const int A = q.A;
+  std::int64_t sb = 0, sbb = 0;
+  if (acc.sumTables) {
+    sb = pb.sum;
+    sbb = pb.squares;
+  } else {
+    for (int r = 0; r < q.R; ++r) {
+      const std::int16_t* b = q.b.row(pb.first + r) + t;
+      for (int i = 0; i < A; ++i) {
+        sb += b[i];
+        sbb += static_cast<std::int32_t>(b[i]) * b[i];
+      }
+    }
+  }
+  const std::int64_t varB = q.N * sbb - sb * sb;
+  if (varB <= 0) return false;
+  const double den = std::sqrt(q.pa.variance * static_cast<double>(varB));
+  const double meanA = static_cast<double>(q.pa.sum) / q.N;
+  const double meanB = static_cast<double>(sb) / q.N;
+  std::int64_t sab = 0;
+  for (int r = 0; r < q.R; ++r) {
+    sab += rowDot(q.a.row(q.pa.first + r), q.b.row(pb.first + r) + t, A);
+    if (acc.jensen && (r & 1) && r + 1 < q.R) {
+      // The rest of the covariance is at most the product of the rest's deviations.
+      const int ra = q.pa.first + r + 1, rb = pb.first + r + 1;
+      const int ea = q.pa.first + q.R, eb = pb.first + q.R;
+      const double n = static_cast<double>(q.R - r - 1) * A;
+      const double sumA = static_cast<double>(q.a.ringSum[ea] - q.a.ringSum[ra]);
+      const double sqA = static_cast<double>(q.a.ringSquares[ea] - q.a.ringSquares[ra]);
+      const double sumB = static_cast<double>(q.b.ringSum[eb] - q.b.ringSum[rb]);
+      const double sqB = static_cast<double>(q.b.ringSquares[eb] - q.b.ringSquares[rb]);
+      const double devA = std::max(0.0, sqA - 2 * meanA * sumA + n * meanA * meanA);
+      const double devB = std::max(0.0, sqB - 2 * meanB * sumB + n * meanB * meanB);
+      const double restBound =
+          std::sqrt(devA * devB) + meanA * sumB + meanB * sumA - n * meanA * meanB;
+      const double bound = (static_cast<double>(q.N) * (static_cast<double>(sab) + restBound) -
+                            static_cast<double>(q.pa.sum) * static_cast<double>(sb)) /
+                           den;
+      if (bound < thr - kBoundSlack) return false;
+    }
+  }
+  const std::int64_t num = q.N * sab - q.pa.sum * sb;
+  score = static_cast<double>(num) / den;
+  return true;
+}
+
+struct Candidate {
+  double bound;
+  int si, t;
+};
+
+WindowScore comparePlaced(const Pair& q, double threshold, const NccAccelerations& acc,
+                          std::vector<Candidate>& candidates) {
+  WindowScore best;
+  int bestIndex = -1;
+  if (q.pa.variance <= 0) return best;
+  const int shifts = 2 * q.S + 1;
+  auto consider = [&](int si, int t) {
+    const double thr = bestIndex < 0 ? threshold : std::max(threshold, best.score);
+    double score = 0;
+    if (!fullScore(q, si, t, thr, acc, score)) return;
+    if (score < threshold) return;
+    const int index = si * q.A + t;
+    if (bestIndex < 0 || score > best.score || (score == best.score && index < bestIndex)) {
+      best = {score, si - q.S, t};
+      bestIndex = index;
+    }
+  };
+  if (!acc.projections) {
+    for (int si = 0; si < shifts; ++si)
+      for (int t = 0; t < q.A; ++t) consider(si, t);
+    return best;
+  }
+  // Exact upper bounds from the projections. A window minus its mean splits into orthogonal
+  // parts: ring effects (radius profile), column effects (angle profile) and the interaction.
+  // For every shift, sum a'b' = <ring effects> + <column effects shifted by t> + <interactions>,
+  // and the last term is at most |interaction_a| |interaction_b| (Cauchy-Schwarz).
+  const double N = static_cast<double>(q.N);
+  const double sa = static_cast<double>(q.pa.sum);
+  candidates.clear();
+  for (int si = 0; si < shifts; ++si) {
+    const Placement& pb = q.pb[si];
+    if (pb.variance <= 0) continue;
+    const double den = std::sqrt(q.pa.variance * pb.variance);
+    const double meanTerm = sa * static_cast<double>(pb.sum) / N;
+    double ringCross = 0;
+    for (int r = 0; r < q.R; ++r) ringCross += q.pa.ringSums[r] * pb.ringSums[r];
+    ringCross = ringCross / q.A - meanTerm;
+    const double interaction = std::sqrt(q.pa.interaction * pb.interaction);
+    // Bound over every angle shift at once from the angle profiles' amplitude spectra: their
+    // cyclic correlation minus its mean term is at most (1/A) sum_k |X_k| |Y_k|.
+    double spectral = 0;
+    for (std::size_t k = 0; k < pb.spectrum.size(); ++k)
+      spectral += q.pa.spectrum[k] * pb.spectrum[k];
+    const double spectralBound = N * (ringCross + spectral / (q.A * q.R) + interaction) / den;
+    if (spectralBound < threshold - kBoundSlack) continue;
+    // Tighter, per ring: each ring's cyclic correlation minus its mean term is at most
+    // (1/A) sum_k |X_rk| |Y_rk|, whatever the shift.
+    {
+      const int K = q.A / 2;
+      const float* sa0 = q.a.ringSpectrum.data() + static_cast<std::size_t>(q.pa.first) * K;
+      const float* sb0 = q.b.ringSpectrum.data() + static_cast<std::size_t>(pb.first) * K;
+      float dot = 0;
+      for (int i = 0; i < q.R * K; ++i) dot += sa0[i] * sb0[i];
+      // float rounding is covered by a relative pad: the value only feeds an upper bound
+      const double ringSpectral = static_cast<double>(dot) * (1 + 1e-4) + 1.0;
+      if (N * (ringCross + ringSpectral / q.A) / den < threshold - kBoundSlack) continue;
+    }
+    // Float dot products (vectorised); their rounding error is below A * 2^-24 * |X| |Y|.
+    const double crossPad = 4.0 * q.A * 6e-8 * q.pa.columnNorm * pb.columnNorm + 1.0;
+    for (int t = 0; t < q.A; ++t) {
+      float crossF = 0;
+      const float* cb = pb.columnSums.data() + t;
+      for (int i = 0; i < q.A; ++i) crossF += q.pa.columnSums[i] * cb[i];
+      const double cross = static_cast<double>(crossF) + crossPad;
+      const double bound = N * (ringCross + cross / q.R - meanTerm + interaction) / den;
+      if (bound >= threshold - kBoundSlack) candidates.push_back({bound, si, t});
+    }
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+    return x.bound > y.bound || (x.bound == y.bound && (x.si * 1000 + x.t) < (y.si * 1000 + y.t));
+  });
+  for (const Candidate& c : candidates) {
+    const double thr = bestIndex < 0 ? threshold : std::max(threshold, best.score);
+    if (c.bound < thr - kBoundSlack) break;
+    consider(c.si, c.t);
+  }
+  return best;
+}
+
+}  // namespace
+
+WindowScore compareWindows(const LogPolarWindow& ref, const LogPolarWindow& image, int ringShifts,
+                           double threshold, const NccAccelerations& acc) {
+  if (!ref.valid || !image.valid || ref.angles != image.angles || ref.rows != image.rows) return {};
+  const int R = ref.rows - 2 * ringShifts;
+  if (R <= 0) return {};
+  const Placement pa = place(ref, ringShifts, R);
+  const std::vector<Placement> pb = placements(image, R, ringShifts);
+  const Pair q{ref,        image, pa,         pb,
+               ringShifts, R,     ref.angles, static_cast<std::int64_t>(R) * ref.angles};
+  std::vector<Candidate> candidates;
+  return comparePlaced(q, threshold, acc, candidates);
+}
+
+std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
+                                      const std::vector<LogPolarWindow>& image, int ringShifts,
+                                      const NccMatchParams& params) {
+  std::vector<WindowMatch> perRef;
+  if (ref.empty() || image.empty()) return perRef;
+  const int rows = ref.front().rows;
+  const int A = ref.front().angles;
+  const int R = rows - 2 * ringShifts;
+  if (R <= 0) return perRef;
+  std::vector<std::vector<Placement>> imagePlacements(image.size());
+  for (std::size_t j = 0; j < image.size(); ++j)
+    if (image[j].valid) imagePlacements[j] = placements(image[j], R, ringShifts);
+  std::vector<Candidate> candidates;
+  const NccAccelerations& acc = params.accelerations;
+  const bool pruneAcrossWindows = acc.projections || acc.jensen;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    if (!ref[i].valid) continue;
+    const Placement pa = place(ref[i], ringShifts, R);
+    WindowMatch best;
+    for (std::size_t j = 0; j < image.size(); ++j) {
+      if (!image[j].valid || image[j].rows != rows || image[j].angles != A) continue;
+      const Pair q{ref[i],     image[j], pa, imagePlacements[j],
+                   ringShifts, R,        A,  static_cast<std::int64_t>(R) * A};
+      // Once a match is known, only a better one matters: it becomes the threshold (ties keep
+      // the earlier image window, as the plain loop does).
+      const double thr =
+          (pruneAcrossWindows && best.image >= 0) ? best.best.score : params.minScore;
+      const WindowScore s = comparePlaced(q, thr, acc, candidates);
+      if (s.score < params.minScore) continue;
+      if (best.image < 0 || s.score > best.best.score) {
+        best.ref = static_cast<int>(i);
+        best.image = static_cast<int>(j);
+        best.best = s;
+      }
+    }
+    if (best.image >= 0) perRef.push_back(best);
+  }
+  // One-to-one: an image window claimed twice keeps its best reference window.
+  std::vector<int> owner(image.size(), -1);
+  for (std::size_t k = 0; k < perRef.size(); ++k) {
+    int& o = owner[perRef[k].image];
+    if (o < 0 || perRef[k].best.score > perRef[o].best.score) o = static_cast<int>(k);
+  }
+  std::vector<WindowMatch> out;
+  for (std::size_t k = 0; k < perRef.size(); ++k)
+    if (owner[perRef[k].image] == static_cast<int>(k)) out.push_back(perRef[k]);
+  return out;
+}
+
+}  // namespace facet

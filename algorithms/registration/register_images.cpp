@@ -1,0 +1,357 @@
+#include "algorithms/registration/register_images.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/registration/harris_affine.hpp"
+
+namespace facet {
+namespace {
+
+cv::Mat toGrey(const cv::Mat& image) {
+  cv::Mat grey = image;
+  if (image.channels() == 3)
+    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
+  else if (image.channels() == 4)
+    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+  double scale = 1.0;
+  if (grey.depth() == CV_8U)
+    scale = 1.0 / 255.0;
+  else if (grey.depth() == CV_16U)
+    scale = 1.0 / 65535.0;
+  cv::Mat out;
+  grey.convertTo(out, CV_32F, scale);
+  return out;
+}
+
+bool isBlank(const cv::Mat& grey) {
+  cv::Scalar mean, stddev;
+  cv::meanStdDev(grey, mean, stddev);
+  return stddev[0] < 1e-3;
+}
+
+struct Features {
+  std::vector<AffineRegion> regions;  // only those with a valid window
+  std::vector<LogPolarWindow> windows;
+  std::vector<int> ranks;  // the corner's position in spreading order
+};
+
+Features describe(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
+                  const RegistrationParams& params, int budget) {
+  HarrisParams hp = params.corners;
+  hp.maxCorners = budget;
+  const std::vector<HarrisCorner> corners = detectHarrisCorners(grey, hp);
+  Features f;
+  for (std::size_t i = 0; i < corners.size(); ++i) {
+    AffineRegion r{corners[i].pt, cv::Matx22d(corners[i].scale, 0, 0, corners[i].scale),
+                   corners[i].response};
+    if (params.affineRegions) {
+      const std::vector<AffineRegion> adapted = adaptAffineRegions(pyramid, {corners[i]});
+      if (adapted.empty()) continue;
+      r = adapted.front();
+    }
+    LogPolarWindow w = sampleLogPolar(pyramid, r.pt, r.shape, params.window);
+    if (!w.valid) continue;
+    f.regions.push_back(r);
+    f.windows.push_back(std::move(w));
+    f.ranks.push_back(static_cast<int>(i));
+  }
+  return f;
+}
+
+double rotationDegOf(const cv::Matx22d& L) {
+  // Pose2D convention: R(a) = [[cos a, sin a], [-sin a, cos a]].
+  return atan2(L(0, 1) - L(1, 0), L(0, 0) + L(1, 1)) * 180.0 / std::numbers::pi;
+}
+
+// Local linear map ref offsets -> image offsets of a window match:
+// L = ringRatio^s * shape_img * Rot(2 pi t / angles) * shape_ref^-1.
+cv::Matx22d localMap(const AffineRegion& ref, const AffineRegion& img, const WindowScore& s,
+                     const LogPolarParams& lp) {
+  const double a = 2.0 * std::numbers::pi * s.angleShift / lp.angles;
+  const cv::Matx22d rot(std::cos(a), -std::sin(a), std::sin(a), std::cos(a));
+  return std::pow(lp.ringRatio, s.ringShift) * img.shape * rot * ref.shape.inv();
+}
+
+// Keeps the matches whose own rotation and scale agree with the dominant ones.
+std::vector<int> pruneByRotationScale(const std::vector<FeatureMatch>& m,
+                                      const RegistrationParams& params) {
+  std::vector<int> keep(m.size());
+  for (std::size_t i = 0; i < m.size(); ++i) keep[i] = static_cast<int>(i);
+  if (params.pruneRotationDeg <= 0 || m.size() < 8) return keep;
+  constexpr int kBins = 36;
+  std::vector<int> hist(kBins, 0);
+  auto binOf = [](double deg) {
+    const int b = static_cast<int>(std::floor((deg + 180.0) / 10.0));
+    return ((b % kBins) + kBins) % kBins;
+  };
+  for (const auto& x : m) ++hist[binOf(x.rotationDeg)];
+  int peak = 0, peakVotes = -1;
+  for (int b = 0; b < kBins; ++b) {
+    const int votes = hist[(b + kBins - 1) % kBins] + hist[b] + hist[(b + 1) % kBins];
+    if (votes > peakVotes) {
+      peakVotes = votes;
+      peak = b;
+    }
+  }
+  const double peakDeg = peak * 10.0 - 175.0;
+  std::vector<double> logScales;
+  std::vector<int> rotKept;
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const double d = std::abs(std::remainder(m[i].rotationDeg - peakDeg, 360.0));
+    if (d <= params.pruneRotationDeg) {
+      rotKept.push_back(static_cast<int>(i));
+      logScales.push_back(std::log2(m[i].scale));
+    }
+  }
+  if (rotKept.empty()) return keep;
+  std::vector<double> sorted = logScales;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double median = sorted[sorted.size() / 2];
+  keep.clear();
+  for (std::size_t k = 0; k < rotKept.size(); ++k)
+    if (params.pruneLog2Scale <= 0 || std::abs(logScales[k] - median) <= params.pruneLog2Scale)
+      keep.push_back(rotKept[k]);
+  return keep;
+}
+
+cv::Matx22d jacobianAt(const cv::Matx33d& H, cv::Point2d p) {
+  const double w = H(2, 0) * p.x + H(2, 1) * p.y + H(2, 2);
+  const double u = (H(0, 0) * p.x + H(0, 1) * p.y + H(0, 2)) / w;
+  const double v = (H(1, 0) * p.x + H(1, 1) * p.y + H(1, 2)) / w;
+  return {(H(0, 0) - u * H(2, 0)) / w, (H(0, 1) - u * H(2, 1)) / w, (H(1, 0) - v * H(2, 0)) / w,
+          (H(1, 1) - v * H(2, 1)) / w};
+}
+
+double parabolaPeak(float a, float b, float c) {
+  const double d = a - 2.0 * b + c;
+  if (d >= 0) return 0.0;
+  return std::clamp(0.5 * (a - c) / d, -0.5, 0.5);
+}
+
+// Warp-and-re-match: the reference warped by H is compared, patch by patch around each reference
+// corner's predicted position, with the image; the NCC peak (subpixel) gives the match.
+std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
+                                  const std::vector<HarrisCorner>& corners, const cv::Matx33d& H,
+                                  const RegistrationParams& params) {
+  const cv::Point2d centre((refGrey.cols - 1) / 2.0, (refGrey.rows - 1) / 2.0);
+  const double s = std::sqrt(std::abs(cv::determinant(jacobianAt(H, centre))));
+  // Match resolutions: blur whichever image is seen at the finer scale.
+  cv::Mat ref = refGrey, img = imgGrey;
+  if (s < 0.8) {
+    const double sigma = 0.5 * std::sqrt(1.0 / (s * s) - 1.0);
+    cv::GaussianBlur(refGrey, ref, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+  } else if (s > 1.25) {
+    const double sigma = 0.5 * std::sqrt(s * s - 1.0);
+    cv::GaussianBlur(imgGrey, img, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+  }
+  cv::Mat warped, valid;
+  cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
+  cv::Mat ones(refGrey.size(), CV_8U, cv::Scalar(255));
+  cv::warpPerspective(ones, valid, H, imgGrey.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  const int r = params.refinePatchRadius, R = params.refineSearchRadius;
+  const cv::Rect bounds(0, 0, imgGrey.cols, imgGrey.rows);
+  std::vector<FeatureMatch> out;
+  cv::Mat result;
+  for (const HarrisCorner& c : corners) {
+    const cv::Point2d q = mapPoint(H, c.pt);
+    if (!std::isfinite(q.x) || !std::isfinite(q.y)) continue;
+    const int cx = static_cast<int>(std::lround(q.x)), cy = static_cast<int>(std::lround(q.y));
+    const cv::Rect templ(cx - r, cy - r, 2 * r + 1, 2 * r + 1);
+    const cv::Rect search(cx - r - R, cy - r - R, 2 * (r + R) + 1, 2 * (r + R) + 1);
+    if ((search & bounds) != search) continue;
+    if (cv::countNonZero(valid(templ)) != templ.area()) continue;
+    cv::matchTemplate(img(search), warped(templ), result, cv::TM_CCOEFF_NORMED);
+    double best = 0;
+    cv::Point loc;
+    cv::minMaxLoc(result, nullptr, &best, nullptr, &loc);
+    if (!(best >= params.refineMinScore)) continue;
+    if (loc.x <= 0 || loc.y <= 0 || loc.x >= result.cols - 1 || loc.y >= result.rows - 1) continue;
+    const double dx =
+        parabolaPeak(result.at<float>(loc.y, loc.x - 1), result.at<float>(loc.y, loc.x),
+                     result.at<float>(loc.y, loc.x + 1));
+    const double dy =
+        parabolaPeak(result.at<float>(loc.y - 1, loc.x), result.at<float>(loc.y, loc.x),
+                     result.at<float>(loc.y + 1, loc.x));
+    FeatureMatch m;
+    m.ref = c.pt;
+    m.image = {q.x + (loc.x - R) + dx, q.y + (loc.y - R) + dy};
+    m.score = best;
+    const cv::Matx22d J = jacobianAt(H, c.pt);
+    m.rotationDeg = rotationDegOf(J);
+    m.scale = std::sqrt(std::abs(cv::determinant(J)));
+    out.push_back(m);
+  }
+  return out;
+}
+
+RegistrationResult failure(RegistrationResult r, std::string cause, std::string message) {
+  r.ok = false;
+  r.failureCause = std::move(cause);
+  r.message = std::move(message);
+  return r;
+}
+
+struct GlobalStage {
+  std::vector<FeatureMatch> matches;
+  std::vector<int> inliers;  // indices into matches
+  cv::Matx33d H = cv::Matx33d::eye();
+  int refCorners = 0, imageCorners = 0;
+  std::string failureCause, message;  // empty when a transform was found
+};
+
+// All-pairs window matching of the first `count` corners of each image, pruning by the matches'
+// own rotation/scale, robust fit seeded by their local maps.
+GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, double minScore,
+                          const RegistrationParams& params) {
+  GlobalStage g;
+  auto subset = [count](const Features& f) {
+    Features s;
+    for (std::size_t i = 0; i < f.windows.size(); ++i)
+      if (f.ranks[i] < count) {
+        s.regions.push_back(f.regions[i]);
+        s.windows.push_back(f.windows[i]);
+        s.ranks.push_back(f.ranks[i]);
+      }
+    return s;
+  };
+  const Features a = subset(fr), b = subset(fi);
+  g.refCorners = static_cast<int>(a.windows.size());
+  g.imageCorners = static_cast<int>(b.windows.size());
+  if (a.windows.size() < 4 || b.windows.size() < 4) {
+    g.failureCause = "too_few_corners";
+    g.message = "fewer than 4 usable corners (reference " + std::to_string(a.windows.size()) +
+                ", image " + std::to_string(b.windows.size()) + ")";
+    return g;
+  }
+  NccMatchParams mp = params.matching;
+  mp.minScore = minScore;
+  const std::vector<WindowMatch> wm =
+      matchWindows(a.windows, b.windows, params.window.ringShifts, mp);
+  std::vector<cv::Matx22d> maps;
+  for (const WindowMatch& w : wm) {
+    const AffineRegion& ra = a.regions[w.ref];
+    const AffineRegion& rb = b.regions[w.image];
+    const cv::Matx22d L = localMap(ra, rb, w.best, params.window);
+    g.matches.push_back(
+        {ra.pt, rb.pt, w.best.score, rotationDegOf(L), std::sqrt(std::abs(cv::determinant(L)))});
+    maps.push_back(L);
+  }
+  const std::vector<int> kept = pruneByRotationScale(g.matches, params);
+  std::vector<cv::Point2d> src, dst;
+  std::vector<cv::Matx22d> keptMaps;
+  for (int k : kept) {
+    src.push_back(g.matches[k].ref);
+    dst.push_back(g.matches[k].image);
+    keptMaps.push_back(maps[k]);
+  }
+  const int minimal = params.model == TransformModel::Similarity ? 2
+                      : params.model == TransformModel::Affine   ? 3
+                                                                 : 4;
+  const int needed = std::max(minimal, params.minInliers);
+  if (static_cast<int>(src.size()) < needed) {
+    g.failureCause = "too_few_matches";
+    g.message = std::to_string(src.size()) + " consistent matches, at least " +
+                std::to_string(needed) + " needed";
+    return g;
+  }
+  TransformFitParams fp;
+  fp.model = params.model;
+  fp.inlierThreshold = params.inlierThreshold;
+  const auto fit = fitTransformWithLocalMaps(src, dst, keptMaps, fp);
+  if (!fit) {
+    g.failureCause = "degenerate_transform";
+    g.message = "no non-degenerate transform fits the matches";
+    return g;
+  }
+  if (static_cast<int>(fit->inliers.size()) < params.minInliers) {
+    g.failureCause = "too_few_inliers";
+    g.message = std::to_string(fit->inliers.size()) + " inliers, at least " +
+                std::to_string(params.minInliers) + " needed";
+    return g;
+  }
+  g.H = fit->H;
+  for (int i : fit->inliers) g.inliers.push_back(kept[i]);
+  return g;
+}
+
+}  // namespace
+
+cv::Point2d mapPoint(const cv::Matx33d& H, cv::Point2d p) {
+  const double w = H(2, 0) * p.x + H(2, 1) * p.y + H(2, 2);
+  return {(H(0, 0) * p.x + H(0, 1) * p.y + H(0, 2)) / w,
+          (H(1, 0) * p.x + H(1, 1) * p.y + H(1, 2)) / w};
+}
+
+std::vector<cv::Vec4d> RegistrationResult::pairs() const {
+  std::vector<cv::Vec4d> out;
+  for (int i : inliers)
+    out.emplace_back(matches[i].ref.x, matches[i].ref.y, matches[i].image.x, matches[i].image.y);
+  return out;
+}
+
+RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
+                                  const RegistrationParams& params) {
+  RegistrationResult result;
+  if (refImage.empty() || image.empty())
+    return failure(result, "empty_image",
+                   refImage.empty() ? "the reference image is empty" : "the image is empty");
+  const cv::Mat ref = toGrey(refImage), img = toGrey(image);
+  if (isBlank(ref))
+    return failure(result, "blank_image", "the reference image is uniform: no corners to register");
+  if (isBlank(img))
+    return failure(result, "blank_image", "the image is uniform: no corners to register");
+
+  const std::vector<cv::Mat> refPyramid = buildSamplingPyramid(ref);
+  const std::vector<cv::Mat> imgPyramid = buildSamplingPyramid(img);
+  // Detected once with the larger budget: the corners come in spreading order, so the first
+  // maxCorners of them are what a smaller budget would have kept.
+  const int budget = std::max(params.corners.maxCorners, params.escalateCorners);
+  const Features fr = describe(ref, refPyramid, params, budget);
+  const Features fi = describe(img, imgPyramid, params, budget);
+
+  GlobalStage stage =
+      matchGlobally(fr, fi, params.corners.maxCorners, params.matching.minScore, params);
+  if (params.escalateCorners > params.corners.maxCorners &&
+      static_cast<int>(stage.inliers.size()) < params.escalateBelowInliers) {
+    GlobalStage wider =
+        matchGlobally(fr, fi, params.escalateCorners, params.escalateMinScore, params);
+    if (wider.inliers.size() > stage.inliers.size() ||
+        (stage.failureCause.empty() == false && wider.failureCause.empty()))
+      stage = std::move(wider);
+  }
+  result.refCorners = stage.refCorners;
+  result.imageCorners = stage.imageCorners;
+  result.matches = std::move(stage.matches);
+  if (!stage.failureCause.empty()) return failure(result, stage.failureCause, stage.message);
+  result.H = stage.H;
+  result.inliers = stage.inliers;
+
+  if (params.refineIterations > 0) {
+    TransformFitParams fp;
+    fp.model = params.model;
+    fp.inlierThreshold = params.inlierThreshold;
+    const std::vector<HarrisCorner> dense =
+        detectHarrisGrid(ref, params.refineCell, params.corners);
+    for (int it = 0; it < params.refineIterations; ++it) {
+      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, params);
+      std::vector<cv::Point2d> s2, d2;
+      for (const auto& m : rm) {
+        s2.push_back(m.ref);
+        d2.push_back(m.image);
+      }
+      const auto refit = fitTransformRobust(s2, d2, fp);
+      if (!refit || refit->inliers.size() < result.inliers.size()) break;
+      result.H = refit->H;
+      result.matches = std::move(rm);
+      result.inliers = refit->inliers;
+    }
+  }
+  result.ok = true;
+  return result;
+}
+
+}  // namespace facet

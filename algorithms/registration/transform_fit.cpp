@@ -1,0 +1,234 @@
+#include "algorithms/registration/transform_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+
+#include <Eigen/Dense>
+
+#include "algorithms/geometry/ransac.hpp"
+
+namespace facet {
+namespace {
+
+int minimalSample(TransformModel model) {
+  switch (model) {
+    case TransformModel::Similarity:
+      return 2;
+    case TransformModel::Affine:
+      return 3;
+    case TransformModel::Homography:
+      return 4;
+  }
+  return 4;
+}
+
+// Isotropic normalisation (Hartley): centroid to the origin, mean distance sqrt(2).
+cv::Matx33d normaliser(const std::vector<cv::Point2d>& pts) {
+  cv::Point2d c(0, 0);
+  for (const auto& p : pts) c += p;
+  c *= 1.0 / static_cast<double>(pts.size());
+  double d = 0;
+  for (const auto& p : pts) d += std::hypot(p.x - c.x, p.y - c.y);
+  d /= static_cast<double>(pts.size());
+  const double s = d > 1e-12 ? std::sqrt(2.0) / d : 1.0;
+  return {s, 0, -s * c.x, 0, s, -s * c.y, 0, 0, 1};
+}
+
+cv::Point2d apply(const cv::Matx33d& T, cv::Point2d p) {
+  const double w = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2);
+  return {(T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2)) / w,
+          (T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2)) / w};
+}
+
+std::optional<cv::Matx33d> fitNormalised(const std::vector<cv::Point2d>& src,
+                                         const std::vector<cv::Point2d>& dst,
+                                         TransformModel model) {
+  const int n = static_cast<int>(src.size());
+  const cv::Matx33d Ts = normaliser(src), Td = normaliser(dst);
+  std::vector<cv::Point2d> a(n), b(n);
+  for (int i = 0; i < n; ++i) {
+    a[i] = apply(Ts, src[i]);
+    b[i] = apply(Td, dst[i]);
+  }
+  cv::Matx33d Hn = cv::Matx33d::eye();
+  if (model == TransformModel::Homography) {
+    Eigen::MatrixXd M(2 * n, 9);
+    for (int i = 0; i < n; ++i) {
+      const double x = a[i].x, y = a[i].y, u = b[i].x, v = b[i].y;
+      M.row(2 * i) << x, y, 1, 0, 0, 0, -u * x, -u * y, -u;
+      M.row(2 * i + 1) << 0, 0, 0, x, y, 1, -v * x, -v * y, -v;
+    }
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(M, Eigen::ComputeFullV);
+    const Eigen::VectorXd h = svd.matrixV().col(8);
+    for (int k = 0; k < 9; ++k) Hn(k / 3, k % 3) = h(k);
+  } else if (model == TransformModel::Affine) {
+    Eigen::MatrixXd M(n, 3);
+    Eigen::VectorXd u(n), v(n);
+    for (int i = 0; i < n; ++i) {
+      M.row(i) << a[i].x, a[i].y, 1;
+      u(i) = b[i].x;
+      v(i) = b[i].y;
+    }
+    const auto qr = M.colPivHouseholderQr();
+    if (qr.rank() < 3) return std::nullopt;
+    const Eigen::Vector3d pu = qr.solve(u), pv = qr.solve(v);
+    Hn = {pu(0), pu(1), pu(2), pv(0), pv(1), pv(2), 0, 0, 1};
+  } else {
+    // u = c x + s y + tx, v = -s x + c y + ty
+    Eigen::MatrixXd M(2 * n, 4);
+    Eigen::VectorXd r(2 * n);
+    for (int i = 0; i < n; ++i) {
+      M.row(2 * i) << a[i].x, a[i].y, 1, 0;
+      M.row(2 * i + 1) << a[i].y, -a[i].x, 0, 1;
+      r(2 * i) = b[i].x;
+      r(2 * i + 1) = b[i].y;
+    }
+    const auto qr = M.colPivHouseholderQr();
+    if (qr.rank() < 4) return std::nullopt;
+    const Eigen::Vector4d p = qr.solve(r);
+    Hn = {p(0), p(1), p(2), -p(1), p(0), p(3), 0, 0, 1};
+  }
+  cv::Matx33d H = Td.inv() * Hn * Ts;
+  if (std::abs(H(2, 2)) < 1e-12) return std::nullopt;
+  H *= 1.0 / H(2, 2);
+  // A usable plane transform keeps orientation and does not collapse the plane.
+  const double det = H(0, 0) * H(1, 1) - H(0, 1) * H(1, 0);
+  if (!(det > 1e-8) || !std::isfinite(det)) return std::nullopt;
+  return H;
+}
+
+std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>& src,
+                           const std::vector<cv::Point2d>& dst, double threshold) {
+  std::vector<int> in;
+  for (std::size_t i = 0; i < src.size(); ++i)
+    if (transferError(H, src[i], dst[i]) <= threshold) in.push_back(static_cast<int>(i));
+  return in;
+}
+
+// Least squares on the inliers, re-selecting the inliers after each fit.
+TransformFit polish(TransformFit fit, const std::vector<cv::Point2d>& src,
+                    const std::vector<cv::Point2d>& dst, const TransformFitParams& params) {
+  const auto minimal = static_cast<std::size_t>(minimalSample(params.model));
+  for (int round = 0; round < 3; ++round) {
+    if (fit.inliers.size() < minimal) break;
+    std::vector<cv::Point2d> s, d;
+    for (int i : fit.inliers) {
+      s.push_back(src[i]);
+      d.push_back(dst[i]);
+    }
+    const auto H = fitTransformLeastSquares(s, d, params.model);
+    if (!H) break;
+    std::vector<int> in = inliersOf(*H, src, dst, params.inlierThreshold);
+    if (in.size() < fit.inliers.size()) break;
+    const bool same = in == fit.inliers;
+    fit = {*H, std::move(in)};
+    if (same) break;
+  }
+  return fit;
+}
+
+}  // namespace
+
+bool parseTransformModel(const std::string& name, TransformModel& model) {
+  if (name == "similarity")
+    model = TransformModel::Similarity;
+  else if (name == "affine")
+    model = TransformModel::Affine;
+  else if (name == "homography")
+    model = TransformModel::Homography;
+  else
+    return false;
+  return true;
+}
+
+double transferError(const cv::Matx33d& H, cv::Point2d src, cv::Point2d dst) {
+  const double w = H(2, 0) * src.x + H(2, 1) * src.y + H(2, 2);
+  if (!(std::abs(w) > 1e-12)) return std::numeric_limits<double>::infinity();
+  const double u = (H(0, 0) * src.x + H(0, 1) * src.y + H(0, 2)) / w;
+  const double v = (H(1, 0) * src.x + H(1, 1) * src.y + H(1, 2)) / w;
+  return std::hypot(u - dst.x, v - dst.y);
+}
+
+std::optional<cv::Matx33d> fitTransformLeastSquares(const std::vector<cv::Point2d>& src,
+                                                    const std::vector<cv::Point2d>& dst,
+                                                    TransformModel model) {
+  if (src.size() != dst.size() || static_cast<int>(src.size()) < minimalSample(model))
+    return std::nullopt;
+  return fitNormalised(src, dst, model);
+}
+
+std::optional<TransformFit> fitTransformRobust(const std::vector<cv::Point2d>& src,
+                                               const std::vector<cv::Point2d>& dst,
+                                               const TransformFitParams& params) {
+  const auto minimal = static_cast<std::size_t>(minimalSample(params.model));
+  if (src.size() != dst.size() || src.size() < minimal) return std::nullopt;
+  RansacParams rp;
+  rp.inlierThreshold = params.inlierThreshold;
+  rp.confidence = params.confidence;
+  rp.maxIterations = params.maxIterations;
+  std::vector<cv::Point2d> s(minimal), d(minimal);
+  auto fit = [&](const std::vector<std::size_t>& sample) -> std::optional<cv::Matx33d> {
+    for (std::size_t k = 0; k < minimal; ++k) {
+      s[k] = src[sample[k]];
+      d[k] = dst[sample[k]];
+    }
+    return fitNormalised(s, d, params.model);
+  };
+  auto residual = [&](const cv::Matx33d& H, std::size_t i) {
+    return transferError(H, src[i], dst[i]);
+  };
+  const auto r = ransac<cv::Matx33d>(src.size(), minimal, fit, residual, rp);
+  if (!r) return std::nullopt;
+  TransformFit out{r->model, {}};
+  for (std::size_t i : r->inliers) out.inliers.push_back(static_cast<int>(i));
+  return polish(std::move(out), src, dst, params);
+}
+
+std::optional<TransformFit> fitTransformWithLocalMaps(const std::vector<cv::Point2d>& src,
+                                                      const std::vector<cv::Point2d>& dst,
+                                                      const std::vector<cv::Matx22d>& localMaps,
+                                                      const TransformFitParams& params) {
+  std::optional<TransformFit> best = fitTransformRobust(src, dst, params);
+  const std::size_t n = src.size();
+  const auto minimal = static_cast<std::size_t>(minimalSample(params.model));
+  if (localMaps.size() != n || n < minimal) return best;
+  // Score every single-match hypothesis by the matches it explains.
+  struct Seed {
+    std::size_t index;
+    std::vector<int> support;
+  };
+  std::vector<Seed> seeds;
+  for (std::size_t k = 0; k < n; ++k) {
+    const cv::Matx22d& L = localMaps[k];
+    std::vector<int> support;
+    for (std::size_t i = 0; i < n; ++i) {
+      const cv::Point2d d = src[i] - src[k];
+      const cv::Point2d q(dst[k].x + L(0, 0) * d.x + L(0, 1) * d.y,
+                          dst[k].y + L(1, 0) * d.x + L(1, 1) * d.y);
+      const double tolerance = 2.0 * params.inlierThreshold + 0.1 * std::hypot(d.x, d.y);
+      if (std::hypot(q.x - dst[i].x, q.y - dst[i].y) <= tolerance)
+        support.push_back(static_cast<int>(i));
+    }
+    if (support.size() >= minimal + 1) seeds.push_back({k, std::move(support)});
+  }
+  std::sort(seeds.begin(), seeds.end(),
+            [](const Seed& a, const Seed& b) { return a.support.size() > b.support.size(); });
+  const std::size_t tries = std::min<std::size_t>(seeds.size(), 12);
+  for (std::size_t t = 0; t < tries; ++t) {
+    std::vector<cv::Point2d> s, d;
+    for (int i : seeds[t].support) {
+      s.push_back(src[i]);
+      d.push_back(dst[i]);
+    }
+    const auto local = fitTransformRobust(s, d, params);
+    if (!local) continue;
+    TransformFit fit{local->H, inliersOf(local->H, src, dst, params.inlierThreshold)};
+    fit = polish(std::move(fit), src, dst, params);
+    if (!best || fit.inliers.size() > best->inliers.size()) best = std::move(fit);
+  }
+  return best;
+}
+
+}  // namespace facet

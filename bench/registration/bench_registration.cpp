@@ -1,0 +1,298 @@
+// bench_registration: log-polar feature registration against OpenCV SIFT on the Oxford graf
+// sequence, synthetic similarity pairs from graf img1, and the NCC accelerations.
+//
+//   bench_registration [--smoke] [--data DIR] [--synthetic N]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/registration/harris_corners.hpp"
+#include "algorithms/registration/log_polar_window.hpp"
+#include "algorithms/registration/ncc_matcher.hpp"
+#include "algorithms/registration/register_images.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+cv::Matx33d readHomography(const std::string& path) {
+  std::ifstream in(path);
+  cv::Matx33d H;
+  for (int k = 0; k < 9; ++k)
+    if (!(in >> H(k / 3, k % 3))) {
+      std::fprintf(stderr, "bench_registration: cannot read homography %s\n", path.c_str());
+      std::exit(1);
+    }
+  return H;
+}
+
+double cornerError(const cv::Matx33d& est, const cv::Matx33d& truth, cv::Size size) {
+  const cv::Point2d corners[4] = {
+      {0, 0}, {size.width - 1.0, 0}, {size.width - 1.0, size.height - 1.0}, {0, size.height - 1.0}};
+  double sum = 0;
+  for (const auto& c : corners) {
+    const cv::Point2d a = facet::mapPoint(est, c), b = facet::mapPoint(truth, c);
+    const double d = std::hypot(a.x - b.x, a.y - b.y);
+    sum += std::isfinite(d) ? d : 1e9;
+  }
+  return sum / 4;
+}
+
+struct Outcome {
+  int matches = 0, correct = 0, inliers = 0;
+  double cornerError = 1e9, ms = 0;
+  bool ok = false;
+};
+
+Outcome runOurs(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth,
+                const facet::RegistrationParams& params) {
+  const auto t0 = Clock::now();
+  const facet::RegistrationResult r = facet::registerImages(a, b, params);
+  Outcome o;
+  o.ms = msSince(t0);
+  o.matches = static_cast<int>(r.matches.size());
+  for (const auto& m : r.matches) {
+    const cv::Point2d q = facet::mapPoint(truth, m.ref);
+    if (std::hypot(q.x - m.image.x, q.y - m.image.y) < 3.0) ++o.correct;
+  }
+  o.ok = r.ok;
+  if (r.ok) {
+    o.inliers = static_cast<int>(r.inliers.size());
+    o.cornerError = cornerError(r.H, truth, a.size());
+  }
+  return o;
+}
+
+Outcome runSift(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth) {
+  const auto t0 = Clock::now();
+  cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
+  std::vector<cv::KeyPoint> ka, kb;
+  cv::Mat da, db;
+  sift->detectAndCompute(a, cv::noArray(), ka, da);
+  sift->detectAndCompute(b, cv::noArray(), kb, db);
+  cv::BFMatcher matcher(cv::NORM_L2);
+  std::vector<std::vector<cv::DMatch>> knn;
+  if (!da.empty() && !db.empty()) matcher.knnMatch(da, db, knn, 2);
+  std::vector<cv::Point2f> pa, pb;
+  for (const auto& m : knn)
+    if (m.size() == 2 && m[0].distance < 0.8f * m[1].distance) {
+      pa.push_back(ka[m[0].queryIdx].pt);
+      pb.push_back(kb[m[0].trainIdx].pt);
+    }
+  cv::Mat mask;
+  cv::Mat H;
+  if (pa.size() >= 4) H = cv::findHomography(pa, pb, cv::RANSAC, 3.0, mask);
+  Outcome o;
+  o.ms = msSince(t0);
+  o.matches = static_cast<int>(pa.size());
+  for (std::size_t i = 0; i < pa.size(); ++i) {
+    const cv::Point2d q = facet::mapPoint(truth, cv::Point2d(pa[i]));
+    if (std::hypot(q.x - pb[i].x, q.y - pb[i].y) < 3.0) ++o.correct;
+  }
+  if (!H.empty()) {
+    o.ok = true;
+    o.inliers = cv::countNonZero(mask);
+    o.cornerError = cornerError(cv::Matx33d(H), truth, a.size());
+  }
+  return o;
+}
+
+facet::RegistrationParams grafParams() {
+  facet::RegistrationParams p;
+  p.affineRegions = true;
+  return p;
+}
+
+void grafTable(const std::string& dir, bool smoke) {
+  const cv::Mat img1 = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
+  if (img1.empty()) {
+    std::fprintf(stderr, "bench_registration: cannot read %s/img1.png\n", dir.c_str());
+    std::exit(1);
+  }
+  std::printf(
+      "\n== Oxford graf: img1 -> imgN (correct = match within 3 px under the true H; "
+      "corner error = mean |H_est - H_true| over img1's corners) ==\n");
+  std::printf("%-5s | %7s %7s %8s %8s | %7s %7s %8s %8s | %8s %8s %s\n", "pair", "correct",
+              "inliers", "corner", "ms", "correct", "inliers", "corner", "ms", "correct", "time",
+              "");
+  std::printf("%-5s | %-33s | %-33s | %-17s |\n", "", "facet (Harris-Affine log-polar NCC)",
+              "OpenCV SIFT (ratio 0.8 + RANSAC 3)", "facet / SIFT");
+  const int last = smoke ? 3 : 6;
+  int met = 0;
+  for (int n = 2; n <= last; ++n) {
+    const cv::Mat imgN =
+        cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
+    const cv::Matx33d truth = readHomography(dir + "/H1to" + std::to_string(n) + "p");
+    const Outcome ours = runOurs(img1, imgN, truth, grafParams());
+    const Outcome sift = runSift(img1, imgN, truth);
+    const bool good = ours.correct > sift.correct && ours.cornerError <= 3.0 && ours.ms <= sift.ms;
+    met += good;
+    std::printf("1-%d   | %7d %7d %8.2f %8.1f | %7d %7d %8.2f %8.1f | %8.2f %8.2f %s\n", n,
+                ours.correct, ours.inliers, ours.cornerError, ours.ms, sift.correct, sift.inliers,
+                sift.cornerError, sift.ms,
+                sift.correct > 0 ? double(ours.correct) / sift.correct : 0.0, ours.ms / sift.ms,
+                good ? "target met" : "TARGET MISSED");
+  }
+  std::printf("graf pairs meeting all targets: %d / %d\n", met, last - 1);
+}
+
+void syntheticTable(const std::string& dir, int count) {
+  const cv::Mat img1 = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> angle(-180, 180), logScale(std::log(0.33), std::log(3.0));
+  std::uniform_int_distribution<int> ox(0, img1.cols - 256), oy(0, img1.rows - 256);
+  int success = 0;
+  double totalMs = 0, worst = 0;
+  for (int k = 0; k < count; ++k) {
+    const double a = angle(rng) * CV_PI / 180, s = std::exp(logScale(rng));
+    const cv::Point2d origin(ox(rng), oy(rng));
+    const cv::Mat ref = img1(cv::Rect(int(origin.x), int(origin.y), 256, 256)).clone();
+    // truth: q = c_img + s R(a) (p - c_ref), R(a) = [[cos, sin], [-sin, cos]]
+    const cv::Point2d cr(127.5, 127.5), ci(159.5, 159.5);
+    const double c = std::cos(a) * s, sn = std::sin(a) * s;
+    const cv::Matx33d truth(c, sn, ci.x - c * cr.x - sn * cr.y, -sn, c, ci.y + sn * cr.x - c * cr.y,
+                            0, 0, 1);
+    // image pixel q shows img1 at origin + truth^-1 q
+    const cv::Matx33d shift(1, 0, -origin.x, 0, 1, -origin.y, 0, 0, 1);
+    const cv::Matx33d full = truth * shift;
+    cv::Mat image;
+    cv::warpAffine(img1, image,
+                   cv::Mat(cv::Matx23d(full(0, 0), full(0, 1), full(0, 2), full(1, 0), full(1, 1),
+                                       full(1, 2))),
+                   cv::Size(320, 320), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::Mat noise(image.size(), CV_16S);
+    cv::randn(noise, 0, 3);
+    cv::Mat noisy;
+    image.convertTo(noisy, CV_16S);
+    noisy += noise;
+    noisy.convertTo(image, CV_8U);
+    facet::RegistrationParams p;
+    p.model = facet::TransformModel::Similarity;
+    const auto t0 = Clock::now();
+    const facet::RegistrationResult r = facet::registerImages(ref, image, p);
+    const double ms = msSince(t0);
+    totalMs += ms;
+    const double err = r.ok ? cornerError(r.H, truth, ref.size()) : 1e9;
+    worst = std::max(worst, std::min(err, 1e9));
+    if (err <= 2.0)
+      ++success;
+    else
+      std::printf("  synthetic %d failed: angle %.1f deg scale %.2f -> %s %s corner error %.2f\n",
+                  k, a * 180 / CV_PI, s, r.ok ? "ok" : r.failureCause.c_str(), r.message.c_str(),
+                  err);
+  }
+  std::printf(
+      "\n== Synthetic similarity pairs (graf img1 crops 256x256 -> 320x320, any angle, scale "
+      "0.33-3, noise sigma 3) ==\n");
+  std::printf(
+      "pairs %d  success (corner error <= 2 px) %d = %.1f%% (target >= 95%%)  mean time %.1f ms\n",
+      count, success, 100.0 * success / count, totalMs / count);
+}
+
+void nccTable(const std::string& dir, bool smoke) {
+  const cv::Mat a8 = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat b8 = cv::imread(dir + "/img2.png", cv::IMREAD_GRAYSCALE);
+  cv::Mat a, b;
+  a8.convertTo(a, CV_32F, 1 / 255.0);
+  b8.convertTo(b, CV_32F, 1 / 255.0);
+  facet::HarrisParams hp;
+  hp.maxCorners = smoke ? 120 : 400;
+  facet::LogPolarParams lp;
+  auto windows = [&](const cv::Mat& g) {
+    const auto pyr = facet::buildSamplingPyramid(g);
+    std::vector<facet::LogPolarWindow> w;
+    for (const auto& c : facet::detectHarrisCorners(g, hp)) {
+      auto x = facet::sampleLogPolar(pyr, c.pt, cv::Matx22d(c.scale, 0, 0, c.scale), lp);
+      if (x.valid) w.push_back(std::move(x));
+    }
+    return w;
+  };
+  const auto wa = windows(a), wb = windows(b);
+  std::printf(
+      "\n== NCC accelerations: all-pairs matching of %zu x %zu log-polar windows (graf 1-2) ==\n",
+      wa.size(), wb.size());
+  std::printf("%-26s %10s %9s %8s %s\n", "variant", "ms", "speed-up", "matches",
+              "identical to plain");
+  struct Variant {
+    const char* name;
+    facet::NccAccelerations acc;
+  };
+  const Variant variants[] = {{"plain NCC", {false, false, false}},
+                              {"1D projections", {true, false, false}},
+                              {"sum tables", {false, true, false}},
+                              {"Jensen early termination", {false, false, true}},
+                              {"all three", {true, true, true}}};
+  std::vector<facet::WindowMatch> plain;
+  double plainMs = 0;
+  for (const auto& v : variants) {
+    facet::NccMatchParams mp;
+    mp.accelerations = v.acc;
+    const auto t0 = Clock::now();
+    const auto m = facet::matchWindows(wa, wb, lp.ringShifts, mp);
+    const double ms = msSince(t0);
+    bool same = true;
+    if (plain.empty() && !v.acc.projections && !v.acc.sumTables && !v.acc.jensen) {
+      plain = m;
+      plainMs = ms;
+    } else {
+      same = m.size() == plain.size();
+      for (std::size_t i = 0; same && i < m.size(); ++i)
+        same = m[i].ref == plain[i].ref && m[i].image == plain[i].image &&
+               m[i].best.score == plain[i].best.score &&
+               m[i].best.ringShift == plain[i].best.ringShift &&
+               m[i].best.angleShift == plain[i].best.angleShift;
+    }
+    std::printf("%-26s %10.1f %9.2f %8zu %s\n", v.name, ms, plainMs / ms, m.size(),
+                same ? "yes" : "NO");
+  }
+}
+
+// The shared data folder sits beside the checkout (FACET_SHARED_DIR); worktrees one level deeper
+// find it one folder further up.
+std::string defaultDataDir() {
+  for (const std::string& base :
+       {std::string(FACET_SHARED_DIR), std::string(FACET_SOURCE_DIR) + "/../../shared"}) {
+    const std::string dir = base + "/data/oxford-graf";
+    if (std::ifstream(dir + "/H1to2p").good()) return dir;
+  }
+  return std::string(FACET_SHARED_DIR) + "/data/oxford-graf";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool smoke = false;
+  std::string dir = defaultDataDir();
+  int synthetic = 100;
+  for (int i = 1; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg == "--smoke")
+      smoke = true;
+    else if (arg == "--data" && i + 1 < argc)
+      dir = argv[++i];
+    else if (arg == "--synthetic" && i + 1 < argc)
+      synthetic = std::stoi(argv[++i]);
+    else {
+      std::fprintf(stderr, "usage: bench_registration [--smoke] [--data DIR] [--synthetic N]\n");
+      return 1;
+    }
+  }
+  if (smoke) synthetic = std::min(synthetic, 6);
+  cv::setNumThreads(1);  // single-threaded, like facet's algorithms
+  grafTable(dir, smoke);
+  syntheticTable(dir, synthetic);
+  nccTable(dir, smoke);
+  return 0;
+}

@@ -1,0 +1,125 @@
+// facet match: finds a shape model in an image and prints the matches' poses.
+#include <chrono>
+#include <iostream>
+#include <sstream>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/shape_model_file.hpp"
+#include "service/cli/command_line.hpp"
+
+namespace facet::cli {
+namespace {
+
+struct MatchOptions {
+  std::string model;
+  std::string image;
+  FindParams find;
+  std::string angleRange;
+  std::string scaleRange;
+  std::string polarity = "use";
+  std::string subpixel = "least_squares";
+  bool json = false;
+};
+
+std::pair<double, double> parsePair(const std::string& text, const std::string& option) {
+  std::istringstream in(text);
+  double a = 0, b = 0;
+  char comma = 0;
+  if (!(in >> a >> comma >> b) || comma != ',' || !(in >> std::ws).eof())
+    throw InputError(option + " must be two numbers a,b (got \"" + text + "\")");
+  return {a, b};
+}
+
+void run(MatchOptions o) {
+  ShapeModel model;
+  try {
+    model = loadShapeModel(o.model);
+  } catch (const ShapeModelFileError& e) {
+    throw InputError(e.what());
+  }
+  const cv::Mat image = cv::imread(o.image, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
+  if (image.empty()) throw InputError(o.image + ": cannot read the image");
+
+  if (o.polarity == "use")
+    o.find.polarity = Polarity::Use;
+  else if (o.polarity == "ignore_global")
+    o.find.polarity = Polarity::IgnoreGlobal;
+  else if (o.polarity == "ignore_local")
+    o.find.polarity = Polarity::IgnoreLocal;
+  else
+    throw InputError("--polarity must be use, ignore_global or ignore_local (got \"" + o.polarity +
+                     "\")");
+  if (o.subpixel == "none")
+    o.find.subpixel = SubpixelMode::None;
+  else if (o.subpixel == "interpolation")
+    o.find.subpixel = SubpixelMode::Interpolation;
+  else if (o.subpixel == "least_squares")
+    o.find.subpixel = SubpixelMode::LeastSquares;
+  else
+    throw InputError("--subpixel must be none, interpolation or least_squares (got \"" +
+                     o.subpixel + "\")");
+  if (!o.angleRange.empty()) {
+    const auto [a0, a1] = parsePair(o.angleRange, "--angle-range");
+    if (a1 < a0) throw InputError("--angle-range: the end must not lie before the start");
+    o.find.angleStart = radians(a0);
+    o.find.angleExtent = radians(a1 - a0);
+  }
+  if (!o.scaleRange.empty()) {
+    const auto [s0, s1] = parsePair(o.scaleRange, "--scale-range");
+    if (!(s0 > 0 && s1 >= s0)) throw InputError("--scale-range must satisfy 0 < s0 <= s1");
+    o.find.scaleMin = s0;
+    o.find.scaleMax = s1;
+  }
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<ShapeMatch> matches;
+  try {
+    matches = findShapeModel(image, model, o.find);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(o.image + ": " + e.what());
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+
+  if (o.json) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& m : matches)
+      list.push_back({{"x", m.x},
+                      {"y", m.y},
+                      {"angle", degrees(m.angle)},
+                      {"scale", m.scale},
+                      {"score", m.score}});
+    printJson({{"matches", list}, {"time_ms", ms}});
+  } else {
+    std::cout << matches.size() << " match(es) in " << ms << " ms\n";
+    for (const auto& m : matches)
+      std::cout << "  x " << m.x << "  y " << m.y << "  angle " << degrees(m.angle)
+                << " deg  scale " << m.scale << "  score " << m.score << "\n";
+  }
+}
+
+}  // namespace
+
+void addMatchCommand(CLI::App& app) {
+  auto* cmd = app.add_subcommand("match", "Find a shape model in an image");
+  auto o = std::make_shared<MatchOptions>();
+  cmd->add_option("--model", o->model, "Model file from `facet model create`")->required();
+  cmd->add_option("--image", o->image, "Image to search (8/16-bit grey)")->required();
+  cmd->add_option("--min-score", o->find.minScore, "Lowest score, 0..1 (default 0.7)");
+  cmd->add_option("--num-matches", o->find.numMatches, "Matches to return, 0 = all (default 1)");
+  cmd->add_option("--max-overlap", o->find.maxOverlap,
+                  "Largest overlap of two matches, 0..1 (default 0.5)");
+  cmd->add_option("--greediness", o->find.greediness, "0 = safe .. 1 = fast (default 0.9)");
+  cmd->add_option("--angle-range", o->angleRange,
+                  "Angles to search: a0,a1 in degrees (default: the model's)");
+  cmd->add_option("--scale-range", o->scaleRange, "Scales to search: s0,s1 (default: the model's)");
+  cmd->add_option("--polarity", o->polarity, "use | ignore_global | ignore_local (default use)");
+  cmd->add_option("--subpixel", o->subpixel,
+                  "none | interpolation | least_squares (default least_squares)");
+  cmd->add_flag("--json", o->json, "Print JSON");
+  cmd->callback([o] { run(*o); });
+}
+
+}  // namespace facet::cli

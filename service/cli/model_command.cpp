@@ -1,0 +1,118 @@
+// facet model create: trains a shape model from a template image and writes it to a model file.
+#include <iostream>
+#include <sstream>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/shape/shape_model.hpp"
+#include "algorithms/shape/shape_model_file.hpp"
+#include "service/cli/command_line.hpp"
+
+namespace facet::cli {
+namespace {
+
+struct ModelOptions {
+  std::string image;
+  std::string roi;
+  std::string angleRange;
+  std::string scaleRange;
+  int levels = 0;
+  double minContrast = ShapeModelParams{}.minContrast;
+  std::string out;
+  bool json = false;
+};
+
+// "a,b,c" -> numbers; exactly `count` of them or an InputError naming the option.
+std::vector<double> parseList(const std::string& text, std::size_t count,
+                              const std::string& option) {
+  std::vector<double> values;
+  std::istringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    std::size_t used = 0;
+    try {
+      values.push_back(std::stod(item, &used));
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != item.size())
+      throw InputError(option + ": \"" + item + "\" is not a number (got \"" + text + "\")");
+  }
+  if (values.size() != count)
+    throw InputError(option + " needs " + std::to_string(count) +
+                     " comma-separated numbers (got \"" + text + "\")");
+  return values;
+}
+
+void run(const ModelOptions& o) {
+  const cv::Mat image = cv::imread(o.image, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
+  if (image.empty()) throw InputError(o.image + ": cannot read the image");
+  ShapeModelParams p;
+  if (!o.roi.empty()) {
+    const auto r = parseList(o.roi, 4, "--roi");
+    p.roi = cv::Rect(cvRound(r[0]), cvRound(r[1]), cvRound(r[2]), cvRound(r[3]));
+  }
+  if (!o.angleRange.empty()) {
+    const auto a = parseList(o.angleRange, 2, "--angle-range");
+    if (a[1] < a[0]) throw InputError("--angle-range: the end must not lie before the start");
+    p.angleStart = radians(a[0]);
+    p.angleExtent = radians(a[1] - a[0]);
+  }
+  if (!o.scaleRange.empty()) {
+    const auto s = parseList(o.scaleRange, 2, "--scale-range");
+    p.scaleMin = s[0];
+    p.scaleMax = s[1];
+  }
+  p.numLevels = o.levels;
+  p.minContrast = o.minContrast;
+
+  ShapeModel model;
+  try {
+    model = createShapeModel(image, p);
+  } catch (const ShapeModelError& e) {
+    throw InputError(o.image + ": " + e.what());
+  }
+  try {
+    saveShapeModel(model, o.out);
+  } catch (const ShapeModelFileError& e) {
+    throw InputError(e.what());
+  }
+  if (o.json) {
+    printJson({{"model", o.out},
+               {"levels", model.numLevels()},
+               {"points", model.levels.front().points.size()},
+               {"subpixel_points", model.finePoints.size()},
+               {"reference", {model.referencePoint.x, model.referencePoint.y}},
+               {"angle_step", degrees(model.levels.front().angleStep)}});
+  } else {
+    std::cout << "wrote " << o.out << ": " << model.numLevels() << " levels, "
+              << model.levels.front().points.size() << " points on level 0, "
+              << model.finePoints.size() << " subpixel points, angle step "
+              << degrees(model.levels.front().angleStep) << " deg\n";
+  }
+}
+
+}  // namespace
+
+void addModelCommand(CLI::App& app) {
+  auto* model = app.add_subcommand("model", "Shape models");
+  model->require_subcommand(1);
+  auto* create = model->add_subcommand("create", "Train a shape model from a template image");
+  auto o = std::make_shared<ModelOptions>();
+  create->add_option("--image", o->image, "Template image (8/16-bit grey)")->required();
+  create->add_option("--roi", o->roi,
+                     "Region of the part: x,y,w,h in pixels (default: whole image)");
+  create->add_option("--angle-range", o->angleRange,
+                     "Angles to search: a0,a1 in degrees (default: all)");
+  create->add_option("--scale-range", o->scaleRange, "Scales to search: s0,s1 (default: 1,1)");
+  create->add_option("--levels", o->levels, "Pyramid levels (default 0 = automatic)");
+  create->add_option("--min-contrast", o->minContrast,
+                     "Weakest gradient used, grey levels per pixel (default 5)");
+  create->add_option("--out", o->out, "Model file to write")->required();
+  create->add_flag("--json", o->json, "Print JSON");
+  create->callback([o] { run(*o); });
+}
+
+}  // namespace facet::cli

@@ -1,0 +1,271 @@
+// findShapeModel: accuracy of each subpixel mode and the effect of every search parameter, on
+// generated scenes with exact ground truth.
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "tests/shape/bracket_scenes.hpp"
+
+namespace facet {
+namespace {
+
+using testing::bracketScene;
+using testing::bracketTemplate;
+
+const ShapeModel& bracketModel() {
+  static const ShapeModel model = createShapeModel(bracketTemplate());
+  return model;
+}
+
+double angleErrorDeg(const ShapeMatch& m, const Pose2D& truth) {
+  return degrees(wrapAngle(m.angle - truth.angle));
+}
+
+double positionError(const ShapeMatch& m, const Pose2D& truth) {
+  return std::hypot(m.x - truth.x, m.y - truth.y);
+}
+
+// The match close to `truth` (within 2 px), or nullptr.
+const ShapeMatch* near(const std::vector<ShapeMatch>& matches, const Pose2D& truth) {
+  for (const auto& m : matches)
+    if (positionError(m, truth) < 2.0 && std::abs(angleErrorDeg(m, truth)) < 2.0) return &m;
+  return nullptr;
+}
+
+TEST(FindShapeModel, LeastSquaresIsSubpixelAccurateAtAnyAngle) {
+  const std::vector<Pose2D> poses = {{200.37, 150.81, radians(33.3), 1.0},
+                                     {210.52, 160.14, radians(-151.7), 1.0},
+                                     {190.05, 145.66, radians(97.25), 1.0}};
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const cv::Mat image = bracketScene({400, 300}, {poses[i]}, 10 + i);
+    const auto matches = findShapeModel(image, bracketModel());
+    ASSERT_EQ(matches.size(), 1u) << "pose " << i;
+    EXPECT_LT(positionError(matches[0], poses[i]), 0.05) << "pose " << i;
+    EXPECT_LT(std::abs(angleErrorDeg(matches[0], poses[i])), 0.03) << "pose " << i;
+    EXPECT_DOUBLE_EQ(matches[0].scale, 1.0);
+    EXPECT_GT(matches[0].score, 0.9);
+    EXPECT_LT(matches[0].residual, 0.2);
+    // The contour is the model's subpixel points at the pose.
+    ASSERT_EQ(matches[0].contour.size(), bracketModel().finePoints.size());
+    const cv::Point2d expected = matches[0].pose().apply(bracketModel().finePoints[7].position);
+    EXPECT_NEAR(matches[0].contour[7].x, expected.x, 1e-9);
+    EXPECT_NEAR(matches[0].contour[7].y, expected.y, 1e-9);
+  }
+}
+
+TEST(FindShapeModel, SubpixelModesRankByAccuracy) {
+  const Pose2D truth{201.3, 149.6, radians(-61.4), 1.0};
+  const cv::Mat image = bracketScene({400, 300}, {truth}, 21);
+  FindParams p;
+  p.subpixel = SubpixelMode::None;
+  const auto none = findShapeModel(image, bracketModel(), p);
+  p.subpixel = SubpixelMode::Interpolation;
+  const auto interp = findShapeModel(image, bracketModel(), p);
+  p.subpixel = SubpixelMode::LeastSquares;
+  const auto ls = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(none.size(), 1u);
+  ASSERT_EQ(interp.size(), 1u);
+  ASSERT_EQ(ls.size(), 1u);
+  // None: on the integer pixel grid and the level-0 angle grid.
+  EXPECT_EQ(none[0].x, std::round(none[0].x));
+  EXPECT_EQ(none[0].y, std::round(none[0].y));
+  EXPECT_LT(positionError(none[0], truth), 1.5);
+  EXPECT_LT(positionError(interp[0], truth), 0.6);
+  EXPECT_NE(interp[0].x, std::round(interp[0].x));
+  EXPECT_LT(positionError(ls[0], truth), 0.05);
+  EXPECT_LT(std::abs(angleErrorDeg(ls[0], truth)), 0.03);
+  EXPECT_LT(positionError(ls[0], truth), positionError(interp[0], truth));
+}
+
+TEST(FindShapeModel, PolarityModes) {
+  const Pose2D truth{200.0, 150.0, radians(20.0), 1.0};
+  // Inverted contrast: a dark part on a light background.
+  const cv::Mat inverted = bracketScene({400, 300}, {truth}, 31, 50.0, 170.0);
+  FindParams p;
+  p.polarity = Polarity::Use;
+  EXPECT_TRUE(findShapeModel(inverted, bracketModel(), p).empty());
+  p.polarity = Polarity::IgnoreGlobal;
+  auto m = findShapeModel(inverted, bracketModel(), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.05);
+  EXPECT_GT(m[0].score, 0.9);
+  p.polarity = Polarity::IgnoreLocal;
+  m = findShapeModel(inverted, bracketModel(), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.05);
+
+  // Locally inverted: the left half of the background is lighter than the part.
+  scene::Scene s(testing::bracketSpec({400, 300}, 32));
+  s.addPolygon({{0, 0}, {200, 0}, {200, 300}, {0, 300}}, 250.0, "background");
+  scene::placePart(s, scene::bracketPart(), truth, 150.0, 50.0);
+  const cv::Mat mixed = s.render();
+  p.minScore = 0.8;
+  p.polarity = Polarity::Use;
+  EXPECT_TRUE(findShapeModel(mixed, bracketModel(), p).empty());
+  p.polarity = Polarity::IgnoreGlobal;
+  EXPECT_TRUE(findShapeModel(mixed, bracketModel(), p).empty());
+  p.polarity = Polarity::IgnoreLocal;
+  m = findShapeModel(mixed, bracketModel(), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.1);
+}
+
+TEST(FindShapeModel, AngleRangeRestrictsResults) {
+  const Pose2D upright{130.0, 150.0, radians(5.0), 1.0};
+  const Pose2D turned{390.0, 150.0, radians(95.0), 1.0};
+  const cv::Mat image = bracketScene({520, 300}, {upright, turned}, 41);
+  FindParams p;
+  p.numMatches = 0;
+  ASSERT_EQ(findShapeModel(image, bracketModel(), p).size(), 2u);
+  p.angleStart = radians(-20.0);
+  p.angleExtent = radians(40.0);
+  auto m = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NE(near(m, upright), nullptr);
+  // The same restriction trained into the model.
+  ShapeModelParams mp;
+  mp.angleStart = radians(60.0);
+  mp.angleExtent = radians(60.0);
+  const ShapeModel restricted = createShapeModel(bracketTemplate(), mp);
+  m = findShapeModel(image, restricted, FindParams{.numMatches = 0});
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NE(near(m, turned), nullptr);
+  // Disjoint requested and trained ranges: nothing to search.
+  EXPECT_TRUE(findShapeModel(image, restricted, p).empty());
+}
+
+TEST(FindShapeModel, NumMatchesAndScoreOrder) {
+  const std::vector<Pose2D> poses = {{110.0, 110.0, radians(10.0), 1.0},
+                                     {330.0, 110.0, radians(-100.0), 1.0},
+                                     {220.0, 300.0, radians(170.0), 1.0}};
+  const cv::Mat image = bracketScene({440, 420}, poses, 51);
+  FindParams p;
+  p.numMatches = 0;
+  const auto all = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(all.size(), 3u);
+  for (const auto& pose : poses) EXPECT_NE(near(all, pose), nullptr);
+  for (std::size_t i = 1; i < all.size(); ++i) EXPECT_GE(all[i - 1].score, all[i].score);
+  p.numMatches = 2;
+  const auto two = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(two.size(), 2u);
+  EXPECT_DOUBLE_EQ(two[0].score, all[0].score);
+  EXPECT_DOUBLE_EQ(two[1].score, all[1].score);
+  p.numMatches = 1;
+  EXPECT_EQ(findShapeModel(image, bracketModel(), p).size(), 1u);
+}
+
+TEST(FindShapeModel, MaxOverlapSuppressesOverlappingMatches) {
+  // Two brackets side by side whose boxes overlap by about a quarter.
+  const Pose2D left{150.0, 150.0, 0.0, 1.0};
+  const Pose2D right{250.0, 150.0, 0.0, 1.0};
+  const cv::Mat image = bracketScene({420, 300}, {left, right}, 61);
+  FindParams p;
+  p.numMatches = 0;
+  p.minScore = 0.6;
+  p.maxOverlap = 0.5;
+  auto m = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(m.size(), 2u);
+  EXPECT_NE(near(m, left), nullptr);
+  EXPECT_NE(near(m, right), nullptr);
+  p.maxOverlap = 0.1;
+  m = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NE(near(m, right), nullptr);  // the one on top is whole, so it scores higher
+}
+
+TEST(FindShapeModel, MinScoreAndOcclusion) {
+  const Pose2D truth{200.0, 150.0, radians(-30.0), 1.0};
+  scene::Scene s(testing::bracketSpec({400, 300}, 71));
+  scene::placePart(s, scene::bracketPart(), truth, testing::kPartGrey, testing::kBackground);
+  // Hide the right part of the bracket under a mid-grey strip.
+  s.addPolygon({{215, 0}, {400, 0}, {400, 300}, {215, 300}}, 110.0, "occluder");
+  const cv::Mat image = s.render();
+  FindParams p;
+  p.minScore = 0.4;
+  auto m = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.1);
+  EXPECT_LT(m[0].score, 0.8);
+  p.minScore = std::min(1.0, m[0].score + 0.05);
+  EXPECT_TRUE(findShapeModel(image, bracketModel(), p).empty());
+}
+
+TEST(FindShapeModel, ScaleRange) {
+  const Pose2D truth{200.0, 160.0, radians(45.0), 1.07};
+  const cv::Mat image = bracketScene({400, 320}, {truth}, 81);
+  // A fixed-scale model does not accept a 7% larger part.
+  EXPECT_TRUE(findShapeModel(image, bracketModel()).empty());
+  ShapeModelParams mp;
+  mp.scaleMin = 0.9;
+  mp.scaleMax = 1.1;
+  const ShapeModel scaled = createShapeModel(bracketTemplate(), mp);
+  auto m = findShapeModel(image, scaled);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NEAR(m[0].scale, 1.07, 1e-3);
+  EXPECT_LT(positionError(m[0], truth), 0.05);
+  EXPECT_LT(std::abs(angleErrorDeg(m[0], truth)), 0.03);
+  // A requested range that excludes the part's scale.
+  FindParams p;
+  p.scaleMin = 0.9;
+  p.scaleMax = 1.0;
+  EXPECT_TRUE(findShapeModel(image, scaled, p).empty());
+}
+
+TEST(FindShapeModel, GreedinessAndLevelsKeepTheResult) {
+  const Pose2D truth{180.3, 140.7, radians(123.0), 1.0};
+  const cv::Mat image = bracketScene({400, 300}, {truth}, 91);
+  for (double g : {0.0, 0.5, 1.0}) {
+    FindParams p;
+    p.greediness = g;
+    const auto m = findShapeModel(image, bracketModel(), p);
+    ASSERT_EQ(m.size(), 1u) << "greediness " << g;
+    EXPECT_LT(positionError(m[0], truth), 0.05) << "greediness " << g;
+  }
+  FindParams p;
+  p.numLevels = 2;
+  p.threads = 1;
+  const auto m = findShapeModel(image, bracketModel(), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.05);
+}
+
+TEST(FindShapeModel, SixteenBitImage) {
+  const Pose2D truth{200.6, 150.2, radians(-10.0), 1.0};
+  const auto m = findShapeModel(
+      bracketScene({400, 300}, {truth}, 95, testing::kPartGrey, testing::kBackground, CV_16U),
+      bracketModel());
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.05);
+}
+
+TEST(FindShapeModel, ClutterAloneGivesNoMatch) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    scene::Scene s(testing::bracketSpec({640, 480}, seed));
+    s.addClutter(25, 10, 60, {});
+    FindParams p;
+    p.numMatches = 0;
+    EXPECT_TRUE(findShapeModel(s.render(), bracketModel(), p).empty()) << "seed " << seed;
+  }
+}
+
+TEST(FindShapeModel, EmptyImageAndBadParameters) {
+  EXPECT_TRUE(findShapeModel(cv::Mat(), bracketModel()).empty());
+  const cv::Mat image(100, 100, CV_8U, cv::Scalar(0));
+  EXPECT_THROW(findShapeModel(image, ShapeModel{}), std::invalid_argument);
+  EXPECT_THROW(findShapeModel(cv::Mat(10, 10, CV_8UC3), bracketModel()), std::invalid_argument);
+  EXPECT_THROW(findShapeModel(image, bracketModel(), FindParams{.minScore = 0.0}),
+               std::invalid_argument);
+  EXPECT_THROW(findShapeModel(image, bracketModel(), FindParams{.numMatches = -1}),
+               std::invalid_argument);
+  EXPECT_THROW(findShapeModel(image, bracketModel(), FindParams{.maxOverlap = 1.5}),
+               std::invalid_argument);
+  EXPECT_THROW(findShapeModel(image, bracketModel(), FindParams{.greediness = -0.1}),
+               std::invalid_argument);
+  // An image smaller than the part: searched, nothing found, no crash.
+  EXPECT_TRUE(findShapeModel(cv::Mat(20, 30, CV_8U, cv::Scalar(9)), bracketModel()).empty());
+}
+
+}  // namespace
+}  // namespace facet

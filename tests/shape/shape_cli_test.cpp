@@ -1,0 +1,111 @@
+// `facet model create` and `facet match`: the real binary on generated images.
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/shape/bracket_scenes.hpp"
+
+namespace facet {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exitCode = -1;
+  std::string out;
+};
+
+// Runs a shell command, capturing stdout (stderr goes to `errFile`).
+CliRun run(const std::string& command, const fs::path& errFile) {
+  CliRun r;
+  FILE* pipe = popen((command + " 2>" + errFile.string()).c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buffer{};
+  std::size_t n = 0;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string readText(const fs::path& p) {
+  std::ifstream in(p);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+TEST(ShapeCli, CreateThenMatchPrintsThePoseAsJson) {
+  const fs::path dir = fs::temp_directory_path() / "facet_shape_cli_test";
+  fs::create_directories(dir);
+  const std::string cli = FACET_CLI;
+  const fs::path err = dir / "stderr.txt";
+
+  // Template inside a larger image, trained through --roi.
+  const cv::Mat templ = testing::bracketTemplate();
+  cv::Mat big(200, 260, CV_8U, cv::Scalar(testing::kBackground));
+  templ.copyTo(big(cv::Rect(40, 30, templ.cols, templ.rows)));
+  ASSERT_TRUE(cv::imwrite((dir / "template.png").string(), big));
+  const Pose2D truth{250.4, 170.8, radians(-72.5), 1.0};
+  ASSERT_TRUE(
+      cv::imwrite((dir / "scene.png").string(), testing::bracketScene({480, 360}, {truth}, 3)));
+
+  const CliRun create =
+      run(cli + " model create --image " + (dir / "template.png").string() +
+              " --roi 40,30,160,130 --out " + (dir / "part.model").string() + " --json",
+          err);
+  ASSERT_EQ(create.exitCode, 0) << readText(err);
+  const auto created = nlohmann::json::parse(create.out);
+  EXPECT_GE(created.at("levels").get<int>(), 3);
+  EXPECT_DOUBLE_EQ(created.at("reference")[0].get<double>(), 79.5);
+
+  const CliRun match = run(cli + " match --model " + (dir / "part.model").string() + " --image " +
+                               (dir / "scene.png").string() +
+                               " --min-score 0.7 --num-matches 1 --subpixel least_squares --json",
+                           err);
+  ASSERT_EQ(match.exitCode, 0) << readText(err);
+  const auto result = nlohmann::json::parse(match.out);
+  ASSERT_EQ(result.at("matches").size(), 1u) << match.out;
+  const auto& m = result["matches"][0];
+  EXPECT_NEAR(m.at("x").get<double>(), truth.x, 0.05);
+  EXPECT_NEAR(m.at("y").get<double>(), truth.y, 0.05);
+  EXPECT_NEAR(m.at("angle").get<double>(), -72.5, 0.03);  // degrees
+  EXPECT_DOUBLE_EQ(m.at("scale").get<double>(), 1.0);
+  EXPECT_GT(m.at("score").get<double>(), 0.9);
+  EXPECT_GE(result.at("time_ms").get<double>(), 0.0);
+
+  // Restricting the angle range away from the part finds nothing (and is not an error).
+  const CliRun none = run(cli + " match --model " + (dir / "part.model").string() + " --image " +
+                              (dir / "scene.png").string() + " --angle-range 0,90 --json",
+                          err);
+  ASSERT_EQ(none.exitCode, 0) << readText(err);
+  EXPECT_TRUE(nlohmann::json::parse(none.out).at("matches").empty());
+
+  // Bad input: exit 1 and an error naming the file.
+  std::ofstream(dir / "bad.model") << "not a model";
+  const CliRun bad = run(cli + " match --model " + (dir / "bad.model").string() + " --image " +
+                             (dir / "scene.png").string() + " --json",
+                         err);
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(readText(err).find("bad.model"), std::string::npos) << readText(err);
+
+  const CliRun flat = run(cli + " model create --image " + (dir / "template.png").string() +
+                              " --roi 0,0,30,25 --out " + (dir / "flat.model").string(),
+                          err);
+  EXPECT_EQ(flat.exitCode, 1);
+  EXPECT_NE(readText(err).find("too few edges"), std::string::npos) << readText(err);
+
+  const CliRun badRoi = run(cli + " model create --image " + (dir / "template.png").string() +
+                                " --roi 1,2,x --out " + (dir / "x.model").string(),
+                            err);
+  EXPECT_EQ(badRoi.exitCode, 1);
+  EXPECT_NE(readText(err).find("--roi"), std::string::npos) << readText(err);
+  fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace facet

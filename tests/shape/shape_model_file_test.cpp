@@ -1,0 +1,151 @@
+// Shape model files: round trip, and every way a file can be bad.
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/shape_model_file.hpp"
+#include "tests/shape/bracket_scenes.hpp"
+
+namespace facet {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ShapeModelFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("facet_shape_file_" + std::to_string(::testing::UnitTest::GetInstance()->random_seed()) +
+         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  std::vector<char> bytesOf(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  void write(const fs::path& p, const std::vector<char>& bytes) {
+    std::ofstream out(p, std::ios::binary | std::ios::trunc);
+    out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+  }
+  // The error loadShapeModel gives for `p`; fails the test if it loads.
+  std::string loadError(const fs::path& p) {
+    try {
+      loadShapeModel(p);
+    } catch (const ShapeModelFileError& e) {
+      return e.what();
+    }
+    ADD_FAILURE() << p << " should have been refused";
+    return {};
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(ShapeModelFile, RoundTripKeepsEverything) {
+  ShapeModelParams params;
+  params.scaleMin = 0.9;
+  params.scaleMax = 1.1;
+  params.angleStart = radians(-45.0);
+  params.angleExtent = radians(90.0);
+  const ShapeModel model = createShapeModel(testing::bracketTemplate(), params);
+  const fs::path file = dir_ / "part.model";
+  saveShapeModel(model, file);
+  const ShapeModel loaded = loadShapeModel(file);
+
+  EXPECT_EQ(loaded.templateSize, model.templateSize);
+  EXPECT_EQ(loaded.referencePoint, model.referencePoint);
+  EXPECT_EQ(loaded.angleStart, model.angleStart);
+  EXPECT_EQ(loaded.angleExtent, model.angleExtent);
+  EXPECT_EQ(loaded.scaleMin, model.scaleMin);
+  EXPECT_EQ(loaded.scaleMax, model.scaleMax);
+  EXPECT_EQ(loaded.minContrast, model.minContrast);
+  EXPECT_EQ(loaded.contrastHigh, model.contrastHigh);
+  ASSERT_EQ(loaded.numLevels(), model.numLevels());
+  for (int l = 0; l < model.numLevels(); ++l) {
+    EXPECT_EQ(loaded.levels[l].angleStep, model.levels[l].angleStep);
+    EXPECT_EQ(loaded.levels[l].scaleStep, model.levels[l].scaleStep);
+    ASSERT_EQ(loaded.levels[l].points.size(), model.levels[l].points.size());
+    for (std::size_t i = 0; i < model.levels[l].points.size(); ++i) {
+      EXPECT_EQ(loaded.levels[l].points[i].position, model.levels[l].points[i].position);
+      EXPECT_EQ(loaded.levels[l].points[i].direction, model.levels[l].points[i].direction);
+    }
+  }
+  ASSERT_EQ(loaded.finePoints.size(), model.finePoints.size());
+  EXPECT_EQ(loaded.finePoints.back().position, model.finePoints.back().position);
+
+  // The loaded model finds exactly what the trained one finds.
+  const Pose2D truth{200.2, 150.9, radians(12.0), 1.03};
+  const cv::Mat image = testing::bracketScene({400, 300}, {truth}, 5);
+  const auto a = findShapeModel(image, model);
+  const auto b = findShapeModel(image, loaded);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(b.size(), 1u);
+  EXPECT_EQ(a[0].x, b[0].x);
+  EXPECT_EQ(a[0].angle, b[0].angle);
+  EXPECT_EQ(a[0].scale, b[0].scale);
+}
+
+TEST_F(ShapeModelFile, BadFilesAreRefusedNamingTheFile) {
+  const fs::path good = dir_ / "good.model";
+  saveShapeModel(createShapeModel(testing::bracketTemplate()), good);
+  const std::vector<char> bytes = bytesOf(good);
+  ASSERT_GT(bytes.size(), 1000u);
+
+  const fs::path missing = dir_ / "missing.model";
+  EXPECT_NE(loadError(missing).find(missing.string()), std::string::npos);
+
+  const fs::path truncated = dir_ / "truncated.model";
+  write(truncated, std::vector<char>(bytes.begin(), bytes.begin() + bytes.size() / 2));
+  std::string e = loadError(truncated);
+  EXPECT_NE(e.find(truncated.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("truncated"), std::string::npos) << e;
+
+  const fs::path headerOnly = dir_ / "header.model";
+  write(headerOnly, std::vector<char>(bytes.begin(), bytes.begin() + 10));
+  EXPECT_NE(loadError(headerOnly).find("truncated"), std::string::npos);
+
+  const fs::path corrupt = dir_ / "corrupt.model";
+  std::vector<char> flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x5a;
+  write(corrupt, flipped);
+  e = loadError(corrupt);
+  EXPECT_NE(e.find(corrupt.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("checksum"), std::string::npos) << e;
+
+  const fs::path version = dir_ / "version.model";
+  std::vector<char> newer = bytes;
+  newer[8] = 99;  // the version follows the 8-byte magic
+  write(version, newer);
+  e = loadError(version);
+  EXPECT_NE(e.find(version.string()), std::string::npos) << e;
+  EXPECT_NE(e.find("version 99"), std::string::npos) << e;
+
+  const fs::path other = dir_ / "other.png";
+  write(other, {'\x89', 'P', 'N', 'G', '\r', '\n', '\x1a', '\n', 0, 0, 0, 0});
+  EXPECT_NE(loadError(other).find("not a facet shape model"), std::string::npos);
+
+  const fs::path empty = dir_ / "empty.model";
+  write(empty, {});
+  EXPECT_NE(loadError(empty).find(empty.string()), std::string::npos);
+
+  const fs::path trailing = dir_ / "trailing.model";
+  std::vector<char> longer = bytes;
+  longer.push_back('x');
+  write(trailing, longer);
+  EXPECT_NE(loadError(trailing).find("corrupt"), std::string::npos);
+
+  EXPECT_THROW(saveShapeModel(ShapeModel{}, dir_ / "empty_model.model"), ShapeModelFileError);
+  EXPECT_THROW(saveShapeModel(loadShapeModel(good), dir_ / "no_such_dir" / "x.model"),
+               ShapeModelFileError);
+}
+
+}  // namespace
+}  // namespace facet

@@ -1,0 +1,151 @@
+// createShapeModel: what a trained model holds, and how each training parameter shapes it.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "algorithms/shape/shape_model.hpp"
+#include "tests/shape/bracket_scenes.hpp"
+
+namespace facet {
+namespace {
+
+using testing::bracketTemplate;
+
+TEST(ShapeModel, DefaultModelHasAPyramidAndSubpixelPoints) {
+  const ShapeModel model = createShapeModel(bracketTemplate());
+  ASSERT_GE(model.numLevels(), 3);
+  EXPECT_EQ(model.templateSize, cv::Size(160, 130));
+  EXPECT_DOUBLE_EQ(model.referencePoint.x, 79.5);
+  EXPECT_DOUBLE_EQ(model.referencePoint.y, 64.5);
+  EXPECT_GT(model.levels[0].points.size(), 300u);
+  EXPECT_LE(model.levels[0].points.size(), 800u);
+  EXPECT_GT(model.finePoints.size(), 300u);
+  // The bracket reaches about 82 px from its centre (corner (-65, 50)).
+  EXPECT_NEAR(model.radius(), std::hypot(65.0, 50.0), 3.0);
+  // Automatic angle step: the outermost point moves by about one pixel per step.
+  EXPECT_NEAR(model.levels[0].angleStep, std::atan(1.0 / model.radius()), 1e-9);
+  for (int l = 1; l < model.numLevels(); ++l) {
+    EXPECT_GT(model.levels[l].angleStep, 1.8 * model.levels[l - 1].angleStep);
+    EXPECT_LT(model.levels[l].points.size(), model.levels[l - 1].points.size());
+    EXPECT_LE(model.levels[l].points.size(), 250u);
+  }
+  EXPECT_EQ(model.levels[0].scaleStep, 0.0);  // fixed scale
+  // Directions are unit vectors, dark -> light: inside the plate's left edge (x = -65) they
+  // point into the part (+x).
+  int leftEdge = 0;
+  for (const auto& p : model.finePoints) {
+    EXPECT_NEAR(std::hypot(p.direction.x, p.direction.y), 1.0, 1e-3);
+    if (std::abs(p.position.x + 65.0) < 0.5 && std::abs(p.position.y) < 40) {
+      ++leftEdge;
+      EXPECT_GT(p.direction.x, 0.95);
+    }
+  }
+  EXPECT_GT(leftEdge, 20);
+}
+
+TEST(ShapeModel, RegionAndReferencePoint) {
+  const cv::Mat templ = bracketTemplate();
+  cv::Mat big(300, 400, CV_8U, cv::Scalar(testing::kBackground));
+  templ.copyTo(big(cv::Rect(30, 20, templ.cols, templ.rows)));
+  ShapeModelParams p;
+  p.roi = cv::Rect(30, 20, templ.cols, templ.rows);
+  const ShapeModel inRoi = createShapeModel(big, p);
+  EXPECT_DOUBLE_EQ(inRoi.referencePoint.x, 79.5);
+  EXPECT_DOUBLE_EQ(inRoi.referencePoint.y, 64.5);
+  EXPECT_NEAR(inRoi.radius(), createShapeModel(templ).radius(), 0.5);
+
+  p.referencePoint = cv::Point2d(30 + 79.5 + 10.0, 20 + 64.5);  // 10 px right of the centre
+  const ShapeModel shifted = createShapeModel(big, p);
+  EXPECT_DOUBLE_EQ(shifted.referencePoint.x, 89.5);
+  // The same edges, 10 px further left of the new reference point.
+  ASSERT_EQ(shifted.finePoints.size(), inRoi.finePoints.size());
+  for (std::size_t i = 0; i < shifted.finePoints.size(); i += 10) {
+    double nearest = 1e9;
+    for (const auto& q : inRoi.finePoints)
+      nearest = std::min(nearest, cv::norm(shifted.finePoints[i].position +
+                                           cv::Point2f(10.0f, 0.0f) - q.position));
+    EXPECT_LT(nearest, 1e-3);
+  }
+
+  p.roi = cv::Rect(300, 200, 200, 200);
+  EXPECT_THROW(createShapeModel(big, p), ShapeModelError);
+}
+
+TEST(ShapeModel, MaskKeepsOnlyMaskedEdges) {
+  const cv::Mat templ = bracketTemplate();
+  ShapeModelParams p;
+  p.mask = cv::Mat(templ.size(), CV_8U, cv::Scalar(0));
+  p.mask(cv::Rect(0, 0, 80, templ.rows)).setTo(255);  // left half
+  const ShapeModel model = createShapeModel(templ, p);
+  for (const auto& pt : model.levels[0].points) EXPECT_LE(pt.position.x, 0.5);
+  for (const auto& pt : model.finePoints) EXPECT_LE(pt.position.x, 1.0);
+  p.mask = cv::Mat(10, 10, CV_8U, cv::Scalar(255));
+  EXPECT_THROW(createShapeModel(templ, p), ShapeModelError);
+}
+
+TEST(ShapeModel, LevelsStepsScaleAndThinning) {
+  const cv::Mat templ = bracketTemplate();
+  ShapeModelParams p;
+  p.numLevels = 2;
+  p.angleStep = radians(1.0);
+  p.scaleMin = 0.9;
+  p.scaleMax = 1.1;
+  p.maxPoints = 100;
+  const ShapeModel model = createShapeModel(templ, p);
+  ASSERT_EQ(model.numLevels(), 2);
+  EXPECT_NEAR(model.levels[0].angleStep, radians(1.0), 1e-12);
+  EXPECT_NEAR(model.levels[1].angleStep, radians(2.0), 1e-12);
+  EXPECT_NEAR(model.levels[0].scaleStep, 1.0 / model.radius(), 1e-3);
+  EXPECT_EQ(model.levels[0].points.size(), 100u);
+  EXPECT_DOUBLE_EQ(model.scaleMin, 0.9);
+  EXPECT_DOUBLE_EQ(model.scaleMax, 1.1);
+}
+
+TEST(ShapeModel, ContrastThresholds) {
+  // The bracket (contrast 120) and a faint disc (contrast 60) in its corner.
+  scene::Scene s =
+      scene::templateScene(scene::bracketPart(), testing::bracketSpec({}, 99), testing::kPartGrey);
+  s.addDisc({148, 118}, 7, testing::kBackground + 60);
+  const cv::Mat templ = s.render();
+  const ShapeModel automatic = createShapeModel(templ);
+  EXPECT_GT(automatic.contrastHigh, 10.0);
+  EXPECT_LT(automatic.contrastHigh, 60.0);  // an edge of 120 grey levels, blur 0.8: ~60 at its peak
+  ShapeModelParams p;
+  p.contrastLow = 30.0;
+  p.contrastHigh = 40.0;
+  const ShapeModel strict = createShapeModel(templ, p);
+  EXPECT_DOUBLE_EQ(strict.contrastHigh, 40.0);
+  EXPECT_LT(strict.levels[0].points.size(), automatic.levels[0].points.size());
+  p.contrastLow = 900.0;
+  p.contrastHigh = 1000.0;
+  EXPECT_THROW(createShapeModel(templ, p), ShapeModelError);
+}
+
+TEST(ShapeModel, TemplateWithoutEdgesIsRefusedClearly) {
+  scene::SceneSpec spec = testing::bracketSpec({160, 130}, 3);
+  const cv::Mat flat = scene::Scene(spec).render();  // noise only
+  try {
+    createShapeModel(flat);
+    FAIL() << "a template without edges must be refused";
+  } catch (const ShapeModelError& e) {
+    EXPECT_NE(std::string(e.what()).find("too few edges"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(createShapeModel(cv::Mat()), ShapeModelError);
+  EXPECT_THROW(createShapeModel(cv::Mat(50, 50, CV_8UC3, cv::Scalar(0))), ShapeModelError);
+  EXPECT_THROW(createShapeModel(cv::Mat(50, 50, CV_32F, cv::Scalar(0))), ShapeModelError);
+  ShapeModelParams bad;
+  bad.scaleMin = 0.0;
+  EXPECT_THROW(createShapeModel(bracketTemplate(), bad), ShapeModelError);
+}
+
+TEST(ShapeModel, SixteenBitTemplateGivesTheSameModel) {
+  const ShapeModel m8 = createShapeModel(bracketTemplate(CV_8U));
+  const ShapeModel m16 = createShapeModel(bracketTemplate(CV_16U));
+  EXPECT_EQ(m8.numLevels(), m16.numLevels());
+  EXPECT_NEAR(static_cast<double>(m16.levels[0].points.size()),
+              static_cast<double>(m8.levels[0].points.size()), 0.1 * m8.levels[0].points.size());
+  EXPECT_NEAR(m8.radius(), m16.radius(), 1.0);
+}
+
+}  // namespace
+}  // namespace facet
