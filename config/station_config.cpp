@@ -295,6 +295,12 @@ RecipeLoadOptions StationConfig::recipeLoadOptions() const {
   return options;
 }
 
+plc::RegisterMap StationConfig::registerMapFor(const Recipe& recipe) const {
+  plc::RegisterMap map = registerMap;
+  for (const auto& [check, step] : recipe.plcOutputs()) map.results.push_back(check->plc->output);
+  return map;
+}
+
 StationLoadResult loadStationConfig(const std::filesystem::path& file) {
   StationLoadResult result;
   result.station = StationReader(file, result.diagnostics).read();
