@@ -7,6 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "algorithms/shape/shape_model_file.hpp"
 #include "config/closest_name.hpp"
 #include "config/confined_path.hpp"
 #include "config/content_hash.hpp"
@@ -510,6 +511,12 @@ class RecipeReader {
     const std::string what = "model " + inQuotes(item["model"].Scalar()) + " ";
     switch (status.state) {
       case ModelState::Fresh:
+        // Also refuses a model written by another (incompatible) version of facet.
+        try {
+          loadShapeModel(*model);
+        } catch (const std::exception& e) {
+          error(item["model"], what + "cannot be loaded: " + e.what() + advice);
+        }
         break;
       case ModelState::Untracked:
         out_.warning(where(item["model"]),
