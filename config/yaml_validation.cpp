@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
-#include <regex>
 
 #include "config/closest_name.hpp"
 #include "config/yaml_document.hpp"
@@ -21,9 +20,12 @@ std::string joined(const std::vector<std::string>& names) {
   return out;
 }
 
+// [a-z][a-z0-9_]*
 bool isIdentifier(const std::string& s) {
-  static const std::regex pattern("[a-z][a-z0-9_]*");
-  return std::regex_match(s, pattern);
+  if (s.empty() || s[0] < 'a' || s[0] > 'z') return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+  });
 }
 
 // "must be between 0 and 1 (got 1.5)", or nothing when `value` is in the field's range.
