@@ -353,12 +353,15 @@ void PlcLink::State::writeResult(const Pending& pending) {
   for (const auto& output : map.results) {
     const auto found = r.values.find(output.name);
     double value = std::numeric_limits<double>::quiet_NaN();
+    // Outputs of another recipe: their registers keep what that recipe last wrote.
+    if (found == r.values.end() && r.onlyGivenValues) continue;
     if (found == r.values.end())
       spdlog::error("PLC: part '{}' has no value for mapped result '{}'", r.partId, output.name);
     else
       value = found->second;
     const EncodedValue encoded = encodeValue(output, value);
-    if (encoded.clamped && found != r.values.end())
+    // NaN is "not measured" (its step failed): written as NaN / 0 without complaint.
+    if (encoded.clamped && found != r.values.end() && !std::isnan(value))
       spdlog::error("PLC: part '{}': {} = {} does not fit {} at register {}; written saturated",
                     r.partId, output.name, value, toString(output.type), output.address);
     const int wire = map.wireAddress(output.address);

@@ -45,6 +45,9 @@ struct InspectionResult {
                                          // missing is written as NaN/0 and logged
   int errorCode = 0;                     // 0 = inspection ran; sets status.error when non-zero
   std::uint64_t triggerSequence = 0;     // TriggerEvent::sequence it answers; 0 = none
+  // Mapped outputs missing from `values` are left unwritten instead of written as NaN/0 and
+  // logged: a station with several recipes maps every recipe's outputs, a part has only its own.
+  bool onlyGivenValues = false;
 };
 
 // A trigger the PLC raised and the link accepted (busy is already written when it is queued).
