@@ -118,8 +118,6 @@ class Generator {
         for (const auto& k : stepKinds_) kinds.push_back(object(k.object));
         return {{"type", "array"}, {"items", {{"oneOf", kinds}}}, {"minItems", f.minItems}};
       }
-      case FieldType::Map:
-        return {{"type", "object"}, {"additionalProperties", reference(*f.object)}};
     }
     return json::object();
   }

@@ -128,7 +128,8 @@ StationFormat::StationFormat() {
             flag("loop", "Start again after the last file.", false),
             {.name = "max_range_m",
              .type = F::Number,
-             .description = "Readings at or beyond this range are dropped, metres; 0 = keep all.",
+             .description =
+                 "Ranges at or beyond this are dropped, metres; 0 = the readers' default (80 m).",
              .minimum = 0.0,
              .defaultValue = 0.0}}};
   camera = {"camera",

@@ -81,7 +81,7 @@ std::optional<std::string> readString(const YAML::Node& node) {
 }
 
 std::string describe(const YAML::Node& node) {
-  if (!node || node.IsNull()) return "nothing";
+  if (!node || node.IsNull()) return "an empty value";
   if (node.IsSequence()) return "a list";
   if (node.IsMap()) return "a mapping";
   return "\"" + node.Scalar() + "\"";

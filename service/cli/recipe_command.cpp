@@ -87,12 +87,13 @@ void check(const Options& opt) {
   std::map<int, std::filesystem::path> ids;  // recipe ids are unique across the files checked
   for (const auto& file : files) {
     auto loaded = config::loadRecipe(file, options);
-    if (loaded.recipe) {
-      const auto [it, first] = ids.emplace(loaded.recipe->id, file);
-      if (!first)
-        loaded.diagnostics.error(loaded.recipe->idWhere,
-                                 "recipe id " + std::to_string(loaded.recipe->id) +
-                                     " is already used by " + it->second.string());
+    if (loaded.id > 0) {
+      const auto [it, first] = ids.emplace(loaded.id, file);
+      if (!first) {
+        loaded.diagnostics.error(loaded.idWhere, "recipe id " + std::to_string(loaded.id) +
+                                                     " is already used by " + it->second.string());
+        loaded.recipe.reset();
+      }
     }
     const bool ok = !loaded.diagnostics.hasErrors();
     nlohmann::json r{{"file", file.string()}, {"ok", ok}};

@@ -36,6 +36,24 @@ TEST(Examples, EveryExampleRecipeIsValidAndEveryStepKindIsCovered) {
   EXPECT_EQ(library.recipes().size(), 4u);
 }
 
+TEST(Examples, RecipeOutputsJoinTheStationRegisterMapWithoutCollisions) {
+  const auto station = loadStationConfig(kRecipes / "station.yaml");
+  ASSERT_TRUE(station.station.has_value()) << station.diagnostics.text();
+  const auto recipe = loadRecipe(kRecipes / "bracket_registration.recipe.yaml",
+                                 station.station->recipeLoadOptions());
+  ASSERT_TRUE(recipe.recipe.has_value()) << recipe.diagnostics.text();
+  const plc::RegisterMap map = station.station->registerMapFor(*recipe.recipe);
+  EXPECT_TRUE(map.validate().empty());
+  const plc::ResultOutput* spacing = map.findResult("bore_spacing.distance");
+  ASSERT_NE(spacing, nullptr);
+  EXPECT_EQ(spacing->address, 104);
+  EXPECT_EQ(spacing->type, plc::ValueType::ScaledInt32);
+  EXPECT_DOUBLE_EQ(spacing->factor, 1000.0);
+  EXPECT_EQ(spacing->wordOrder, plc::WordOrder::ABCD);
+  EXPECT_NE(spacing->origin.find("bracket_registration.recipe.yaml:51:"), std::string::npos)
+      << spacing->origin;
+}
+
 TEST(Examples, ShippedSchemasEqualTheGeneratedOnes) {
   EXPECT_EQ(readJson(kRecipes / "recipe.schema.json"), recipeJsonSchema())
       << "regenerate with: facet recipe schema -o recipes/recipe.schema.json";

@@ -4,6 +4,7 @@
 
 #include "config/recipe_loader.hpp"
 #include "config/recipe_training.hpp"
+#include "config/training_record.hpp"
 #include "tests/config/config_test_support.hpp"
 
 namespace facet::config::test {
@@ -406,13 +407,27 @@ TEST_F(RecipeValidation, ShapeModelsMustBeTrainedAndFresh) {
   ASSERT_EQ(trained.size(), 1u);
   EXPECT_GT(trained[0].points, 8u);
   r = load(text);
-  EXPECT_TRUE(r.recipe.has_value()) << r.diagnostics.text();
+  ASSERT_TRUE(r.recipe.has_value()) << r.diagnostics.text();
+  const std::string params = trainingParameters(r.recipe->steps[1]);
+  EXPECT_EQ(params, "shape;region=all;angle=-30,30");
 
   // Other training parameters in the recipe: stale.
   std::string changed = text;
   changed.replace(changed.find("[-30, 30]"), 9, "[-40, 40]");
   r = load(changed);
   EXPECT_TRUE(hasDiagnostic(r.diagnostics, 13, 12, "is stale: was trained with other parameters"));
+
+  // A model file that the shape module cannot read (another format version, corrupt), even
+  // with a matching training record.
+  const auto model = scratch.path() / "models/label.shape";
+  const auto saved = scratch.path() / "label.shape.saved";
+  std::filesystem::copy_file(model, saved);
+  scratch.write("models/label.shape", "FACETSHM but not really a model");
+  writeTrainingRecord(model, scratch.path() / "label.png", params);
+  r = load(text);
+  EXPECT_TRUE(hasDiagnostic(r.diagnostics, 13, 12, "model 'models/label.shape' cannot be loaded"));
+  std::filesystem::copy_file(saved, model, std::filesystem::copy_options::overwrite_existing);
+  writeTrainingRecord(model, scratch.path() / "label.png", params);
 
   // A new template image: stale.
   scratch.writeImage("label.png", 90, 64);

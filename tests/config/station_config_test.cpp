@@ -37,8 +37,13 @@ TEST(StationConfig, TheExampleStationLoads) {
   ASSERT_EQ(s.calibration.cameraMatrix.rows, 3);
   EXPECT_DOUBLE_EQ(s.calibration.cameraMatrix.at<double>(0, 0), 2400.0);
   EXPECT_EQ(s.calibration.distortion.total(), 5u);
-  // Its registers are reserved for recipe outputs: 6 holding registers in the example map.
-  EXPECT_EQ(s.reservedRegisters().size(), 5u);
+  // Its holding registers are reserved: recipe outputs may not overlap them.
+  const auto reserved = s.reservedRegisters();
+  ASSERT_EQ(reserved.size(), 5u);
+  EXPECT_EQ(reserved[0].owner, "station control.recipe_select");
+  EXPECT_EQ(reserved[0].address, 0);
+  EXPECT_EQ(reserved[0].where.file, kExample.string());
+  EXPECT_EQ(reserved[0].where.line, 33);  // where the PLC module says the entry is
   EXPECT_EQ(s.recipeLoadOptions().root, s.recipesFolder);
 }
 
