@@ -85,6 +85,10 @@ struct PlcSimulator::State {
   mutable std::mutex mutex;  // guards stats and callback
   PlcSimulatorStats stats;
   std::function<void(const ReceivedResult&)> callback;
+  // Free run: the counter and toggle when start() was called; a change after that is a result
+  // (read before the scan thread runs, so a result written right after start() is not missed).
+  int initialCounter = -1;
+  bool initialToggle = false;
 
   void scan();
 };
@@ -108,8 +112,8 @@ void PlcSimulator::State::scan() {
   SteadyClock::time_point validSince{};
   bool lastValid = false;
   bool lastMissed = false;
-  bool lastToggle = tables.flag(map.status.completedToggle);
-  int lastCounter = tables.number(map.status.inspectionCounter);
+  bool lastToggle = initialToggle;
+  int lastCounter = initialCounter;
 
   while (!stopping) {
     const auto now = SteadyClock::now();
@@ -185,7 +189,7 @@ PlcSimulator::PlcSimulator(RegisterMap map, PlcSimulatorOptions options)
   const auto issues = map.validate();
   if (!issues.empty()) {
     std::string message = "invalid PLC register map:";
-    for (const auto& issue : issues) message += "\n  " + issue.message;
+    for (const auto& issue : issues) message += "\n  " + describe(issue);
     throw std::invalid_argument(message);
   }
   state_->map = std::move(map);
@@ -214,6 +218,9 @@ void PlcSimulator::onResult(std::function<void(const ReceivedResult&)> callback)
 void PlcSimulator::start() {
   if (state_->thread.joinable()) return;
   state_->stopping = false;
+  const Tables tables(*state_->server, state_->map);
+  state_->initialCounter = tables.number(state_->map.status.inspectionCounter);
+  state_->initialToggle = tables.flag(state_->map.status.completedToggle);
   state_->thread = std::thread([s = state_.get()] { s->scan(); });
 }
 
