@@ -70,7 +70,10 @@ int tableSize(const RegisterMap& map, Table table) {
   if (table == Table::HoldingRegister)
     for (const auto& output : map.results)
       highest = std::max(highest, map.wireAddress(output.address) + registerCount(output.type) - 1);
-  return highest + 1;
+  // Like a real PLC's data block, the tables are larger than the station's own signals: recipe
+  // outputs (which the simulator does not know) land above them.
+  constexpr int kMinimumTable = 1024;
+  return std::max(highest + 1, kMinimumTable);
 }
 
 }  // namespace
