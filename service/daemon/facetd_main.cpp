@@ -20,8 +20,9 @@ using namespace std::chrono_literals;
 std::string partLine(const service::PartResult& p) {
   std::string line = "part " + std::to_string(p.partId) + "  recipe " + std::to_string(p.recipeId) +
                      " " + p.recipeName + "  " + service::verdictName(p.verdict);
-  if (p.verdict == service::Verdict::Error) return line + "  (" + p.error + ")";
-  for (const auto& m : p.measurements) {
+  if (p.verdict == service::Verdict::Error) line += "  (" + p.error + ")";
+  for (const auto& m : p.verdict == service::Verdict::Error ? std::vector<service::Measurement>{}
+                                                            : p.measurements) {
     char buf[96];
     std::snprintf(buf, sizeof buf, "  %s=%.4g%s%s", m.name.c_str(), m.value,
                   m.unit == "score" || m.unit == "count" ? "" : (" " + m.unit).c_str(),
@@ -105,8 +106,9 @@ int main(int argc, char** argv) {
   options.maxParts = maxParts;
   options.stopAtEndOfStream = exitAtEnd || !replayFolder.empty();
   options.usePlc = !noPlc;
-  options.overflow =
-      blockWhenBehind ? service::OverflowPolicy::Block : service::OverflowPolicy::DropOldest;
+  // A replayed folder can wait for the inspection: nothing is dropped.
+  options.overflow = blockWhenBehind || !replayFolder.empty() ? service::OverflowPolicy::Block
+                                                              : service::OverflowPolicy::DropOldest;
   if (printParts) {
     options.onPart = [&](const service::PartResult& p) {
       ++counts[service::verdictName(p.verdict)];
