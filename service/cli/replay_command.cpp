@@ -7,6 +7,8 @@
 #include <map>
 #include <memory>
 
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -42,6 +44,19 @@ std::string utcNow() {
   return buf;
 }
 
+// A sidecar value: top-level, or inside "annotations" as the scene recorder writes them
+// (recipes/demo/*/part_*.png.json), which the camera passes on as JSON text.
+std::string sidecarValue(const std::map<std::string, std::string>& metadata,
+                         const std::string& key) {
+  if (auto it = metadata.find(key); it != metadata.end()) return it->second;
+  if (auto it = metadata.find("annotations"); it != metadata.end()) {
+    const auto annotations = nlohmann::json::parse(it->second, nullptr, false);
+    if (annotations.is_object() && annotations.contains(key) && annotations[key].is_string())
+      return annotations[key].get<std::string>();
+  }
+  return {};
+}
+
 std::vector<unsigned char> thumbnail(const cv::Mat& image, const service::InspectionOutcome& o,
                                      const std::string& banner, int width) {
   cv::Mat picture =
@@ -56,6 +71,9 @@ std::vector<unsigned char> thumbnail(const cv::Mat& image, const service::Inspec
 }
 
 void runReplay(const ReplayOptions& opt) {
+  // The camera module logs through spdlog, whose default logger writes to stdout: keep stdout
+  // for the one JSON object.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("facet-replay"));
   // Calibration and recipe root come from the station when one is given.
   config::RecipeLoadOptions loadOptions;
   double mmPerPixel = opt.mmPerPixel;
@@ -113,10 +131,8 @@ void runReplay(const ReplayOptions& opt) {
     p.recipeVersion = loaded.recipe->contentHash;
     p.frameId = grab.frame.id;
     p.source = grab.frame.source;
-    if (auto it = grab.frame.metadata.find("serial"); it != grab.frame.metadata.end())
-      p.serial = it->second;
-    if (auto it = grab.frame.metadata.find("expected_verdict"); it != grab.frame.metadata.end())
-      p.expectedVerdict = it->second;
+    p.serial = sidecarValue(grab.frame.metadata, "serial");
+    p.expectedVerdict = sidecarValue(grab.frame.metadata, "expected_verdict");
     if (!grab.ok()) {
       // A file the replay could not use is a part that was not inspected.
       p.verdict = service::Verdict::Error;

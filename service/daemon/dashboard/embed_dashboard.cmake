@@ -1,12 +1,11 @@
 # Writes a C++ source holding the dashboard's files, so an installed facetd needs no asset
-# folder. Run as: cmake -DOUTPUT=<file.cpp> -DFILES="<a;b;...>" -P embed_dashboard.cmake
+# folder. Run as: cmake -DOUTPUT=<file.cpp> -DFOLDER=<dashboard folder> -P embed_dashboard.cmake
+file(GLOB FILES ${FOLDER}/*.html ${FOLDER}/*.css ${FOLDER}/*.js)
+list(SORT FILES)
 set(entries "")
 set(bodies "")
 set(index 0)
 foreach(file IN LISTS FILES)
-  if(file STREQUAL "")
-    continue()
-  endif()
   get_filename_component(name ${file} NAME)
   file(READ ${file} content)
   if(content MATCHES "\\)facet_embed\"")
