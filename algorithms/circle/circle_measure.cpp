@@ -162,6 +162,53 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
   return {};
 }
 
+// Geometric fit of the rim: twice, collect the points within the RANSAC threshold of the current
+// circle and fit them (plain least squares, then reweighted). `in` receives the final inliers.
+std::optional<Circle> fitRim(const std::vector<Eigen::Vector2d>& pts, Circle circle,
+                             const CircleMeasureParams& params, std::vector<Eigen::Vector2d>& in) {
+  std::vector<double> w;
+  for (int round = 0; round < 2; ++round) {
+    in.clear();
+    for (const auto& p : pts)
+      if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
+    if (static_cast<int>(in.size()) < params.minInliers) break;
+    w.assign(in.size(), 1.0);
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 2;
+    for (int k = 0; k < irls; ++k) {
+      if (k > 0) {
+        std::vector<double> a;
+        a.reserve(in.size());
+        for (const auto& p : in) a.push_back(std::abs(residual(circle, p)));
+        std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+        const double sigma = std::max(1.4826 * a[a.size() / 2], 0.01);
+        for (std::size_t i = 0; i < in.size(); ++i)
+          w[i] = robustWeight(params.robustWeight, residual(circle, in[i]), sigma);
+      }
+      auto refined = fitGeometric(in, w, circle);
+      if (!refined) return std::nullopt;
+      circle = *refined;
+    }
+  }
+  return circle;
+}
+
+// Strong edge points that are not the rim: off the circle or not radial with the rim's polarity
+// (rimSign +1: gradient outwards). Weak ones (below the high threshold) are mostly noise and must
+// not punch holes into the grey-value fit.
+std::vector<cv::Point2d> foreignEdges(const AnnulusEdges& edges, const Circle& circle, int rimSign,
+                                      double cosTol) {
+  std::vector<cv::Point2d> foreign;
+  for (const EdgePoint& e : edges.points) {
+    const Eigen::Vector2d radial = Eigen::Vector2d{e.position.x, e.position.y} - circle.centre;
+    const double d = radial.norm();
+    if (d == 0.0) continue;
+    const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
+    if (e.magnitude >= edges.highThreshold && (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
+      foreign.push_back(e.position);
+  }
+  return foreign;
+}
+
 // Edge point relative to the expected centre, with its radial alignment.
 struct Candidate {
   Eigen::Vector2d p;
@@ -239,8 +286,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   if (m.candidates < params.minInliers)
     return failed(m, CircleFailure::TooFewPoints,
                   std::to_string(m.candidates) +
-                      " edge points with a radial gradient in the "
-                      "annulus, fewer than the " +
+                      " edge points with a radial gradient in the annulus, fewer than the " +
                       std::to_string(params.minInliers) + " required");
 
   // RANSAC, once per polarity when either is allowed: a circle's rim has one polarity.
@@ -281,32 +327,11 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
 
   // Geometric fit on the RANSAC inliers, then re-collect the inliers around the refined circle
   // and refit with the robust weight.
-  Circle circle = *best;
   std::vector<Eigen::Vector2d> in;
-  std::vector<double> w;
-  for (int round = 0; round < 2; ++round) {
-    in.clear();
-    for (const auto& p : bestPts)
-      if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
-    if (static_cast<int>(in.size()) < params.minInliers) break;
-    w.assign(in.size(), 1.0);
-    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 2;
-    for (int k = 0; k < irls; ++k) {
-      if (k > 0) {
-        std::vector<double> a;
-        a.reserve(in.size());
-        for (const auto& p : in) a.push_back(std::abs(residual(circle, p)));
-        std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
-        const double sigma = std::max(1.4826 * a[a.size() / 2], 0.01);
-        for (std::size_t i = 0; i < in.size(); ++i)
-          w[i] = robustWeight(params.robustWeight, residual(circle, in[i]), sigma);
-      }
-      auto refined = fitGeometric(in, w, circle);
-      if (!refined)
-        return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
-      circle = *refined;
-    }
-  }
+  const std::optional<Circle> fitted = fitRim(bestPts, *best, params, in);
+  if (!fitted)
+    return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
+  const Circle circle = *fitted;
   m.inliers = static_cast<int>(in.size());
   m.inlierPoints.reserve(in.size());
   double sum2 = 0, lo = 0, hi = 0;
@@ -322,28 +347,6 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   m.coverageDeg = coverageDeg(in, circle);
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
-  if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
-    // Strong edge points that are not the rim: off the circle, or not radial with its polarity.
-    std::vector<cv::Point2d> foreign;
-    for (const EdgePoint& e : edges.points) {
-      const Eigen::Vector2d p{e.position.x, e.position.y};
-      const Eigen::Vector2d radial = p - circle.centre;
-      const double d = radial.norm();
-      if (d == 0.0) continue;
-      const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
-      // Weak points (below the high threshold) are mostly noise; they must not punch holes.
-      if (e.magnitude >= edges.highThreshold &&
-          (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
-        foreign.push_back(e.position);
-    }
-    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints, foreign,
-                                     edges.noiseSigma)) {
-      m.centre = fine->centre;
-      m.radius = fine->radius;
-      m.blur = fine->blur;
-      m.greyRefined = true;
-    }
-  }
   m.diameter = 2.0 * m.radius;
 
   if (m.inliers < params.minInliers)
@@ -358,6 +361,18 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     return failed(
         m, CircleFailure::FitTooPoor,
         "the fit's rms " + std::to_string(m.rms) + " px exceeds " + std::to_string(params.maxRms));
+
+  if (params.refineWithGreyValues) {
+    if (auto fine =
+            fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints,
+                             foreignEdges(edges, circle, rimSign, cosTol), edges.noiseSigma)) {
+      m.centre = fine->centre;
+      m.radius = fine->radius;
+      m.diameter = 2.0 * m.radius;
+      m.blur = fine->blur;
+      m.greyRefined = true;
+    }
+  }
   if (std::abs(m.radius - params.radius) > params.width ||
       std::hypot(m.centre.x - c0.x, m.centre.y - c0.y) > params.width)
     return failed(m, CircleFailure::FitTooPoor, "the fitted circle leaves the search annulus");

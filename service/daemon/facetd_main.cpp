@@ -35,11 +35,29 @@ std::string partLine(const service::PartResult& p) {
   return line + ms;
 }
 
+// --replay: the folder's images replace the configured camera; a folder of range scans replaces
+// the scan replay. Each file is replayed once, as fast as the station takes it.
+void useReplay(config::StationConfig& station, const std::filesystem::path& folder) {
+  bool scans = false;
+  for (const auto& entry : std::filesystem::directory_iterator(folder))
+    if (entry.path().extension() == ".csv") scans = true;
+  if (scans) {
+    station.camera.scans.folder = std::filesystem::absolute(folder);
+    station.camera.scans.glob = "*.csv";
+    return;
+  }
+  station.camera.backend = CameraBackend::Replay;
+  station.camera.replay.folder = std::filesystem::absolute(folder);
+  station.camera.replay.glob.clear();
+  station.camera.replay.loop = false;
+  station.camera.replay.fps = 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"facetd: the facet inspection daemon", "facetd"};
-  std::string configFile, logLevel = "info", portFile;
+  std::string configFile, logLevel = "info", portFile, replayFolder;
   std::optional<int> recipe;
   std::uint64_t maxParts = 0;
   bool exitAtEnd = false, printParts = false, noPlc = false, blockWhenBehind = false;
@@ -53,6 +71,10 @@ int main(int argc, char** argv) {
   app.add_flag(
       "--block-when-behind", blockWhenBehind,
       "Hold the trigger back instead of dropping the oldest frame when inspection falls behind");
+  app.add_option("--replay", replayFolder,
+                 "Replay this recorded folder once instead of the configured camera (images, or "
+                 "*.csv range scans for scan recipes); implies --exit-at-end")
+      ->check(CLI::ExistingDirectory);
   app.add_option("--http-port-file", portFile, "Write the HTTP port here once listening");
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error");
   CLI11_PARSE(app, argc, argv);
@@ -74,12 +96,14 @@ int main(int argc, char** argv) {
     std::cerr << "facetd: " << configFile << ": station config has errors\n";
     return 1;
   }
+  config::StationConfig stationConfig = *loaded.station;
+  if (!replayFolder.empty()) useReplay(stationConfig, replayFolder);
   std::map<std::string, std::uint64_t> counts;
   std::uint64_t unexpected = 0;
   service::StationOptions options;
   options.recipe = recipe;
   options.maxParts = maxParts;
-  options.stopAtEndOfStream = exitAtEnd;
+  options.stopAtEndOfStream = exitAtEnd || !replayFolder.empty();
   options.usePlc = !noPlc;
   options.overflow =
       blockWhenBehind ? service::OverflowPolicy::Block : service::OverflowPolicy::DropOldest;
@@ -92,8 +116,8 @@ int main(int argc, char** argv) {
     };
   }
   try {
-    service::Station station(*loaded.station, options);
-    const auto& httpConfig = loaded.station->http;
+    service::Station station(stationConfig, options);
+    const auto& httpConfig = station.config().http;
     service::HttpServer http(station, {.bindAddress = httpConfig.bind,
                                        .port = httpConfig.port,
                                        .token = httpConfig.token,
@@ -142,9 +166,9 @@ int main(int argc, char** argv) {
       std::cout << "summary:";
       for (const auto& [verdict, n] : counts) std::cout << "  " << verdict << "=" << n;
       std::cout << "  unexpected=" << unexpected << "\n"
-                << "results: " << loaded.station->results.database.string() << "\n";
-      if (!loaded.station->archive.folder.empty())
-        std::cout << "archive: " << loaded.station->archive.folder.string() << "\n";
+                << "results: " << station.config().results.database.string() << "\n";
+      if (!station.config().archive.folder.empty())
+        std::cout << "archive: " << station.config().archive.folder.string() << "\n";
     }
     return 0;
   } catch (const std::exception& e) {

@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/circle/circle_measure.hpp"
+#include "algorithms/circle/disc_locator.hpp"
 #include "algorithms/geometry/pose2d.hpp"
 #include "algorithms/registration/register_images.hpp"
 #include "algorithms/scan/scan_file.hpp"
@@ -183,12 +184,13 @@ class StepRunner {
     }
     const cv::Mat& ref = res_.references.at(step.id);
     const cv::Rect region = clampRect(a.region, ref.size());
+    // The whole reference view is registered: log-polar windows need room around each corner,
+    // which a tight part region does not give. The region sets the nominal point and outline.
     RegistrationParams params;
     params.model = TransformModel::Similarity;
-    const RegistrationResult reg = registerImages(ref(region), live, params);
+    const RegistrationResult reg = registerImages(ref, live, params);
     if (!reg.ok) return failed("alignment failed: " + reg.failureCause);
-    r.refToImage =
-        translation(cv::Point2d(search.tl())) * reg.H * translation(-cv::Point2d(region.tl()));
+    r.refToImage = translation(cv::Point2d(search.tl())) * reg.H;
     r.values["score"] =
         reg.matches.empty() ? 0.0 : static_cast<double>(reg.inliers.size()) / reg.matches.size();
     std::vector<cv::Point2d> outline;
@@ -219,16 +221,24 @@ class StepRunner {
     std::vector<cv::Point2d> nominal, found;
     for (const auto& mark : f.marks) {
       const cv::Point2d expected = apply(H, mark);
+      const double radius = f.markDiameter / 2.0 / mmPerPixel_;
+      const double searchRadius = f.searchRadius / mmPerPixel_;
+      overlay_.circle(expected, searchRadius + radius, true, true);
+      const std::string where =
+          "mark at (" + std::to_string(mark.x) + ", " + std::to_string(mark.y) + ")";
+      // Coarse location first: the search radius is usually larger than the mark.
+      const auto coarse = locateDisc(grey_, {.expected = expected,
+                                             .radius = radius,
+                                             .searchRadius = searchRadius,
+                                             .polarity = circlePolarity(f.polarity)});
+      if (!coarse) return failed(where + " not found within the search radius");
       CircleMeasureParams p;
-      p.centre = expected;
-      p.radius = f.markDiameter / 2.0 / mmPerPixel_;
-      p.width = f.searchRadius / mmPerPixel_;
+      p.centre = coarse->centre;
+      p.radius = radius;
+      p.width = std::max(2.0, 0.35 * radius);
       p.polarity = circlePolarity(f.polarity);
       const CircleMeasurement m = measureCircle(grey_, p);
-      overlay_.circle(expected, p.radius, m.ok(), true);
-      if (!m.ok())
-        return failed("mark at (" + std::to_string(mark.x) + ", " + std::to_string(mark.y) +
-                      ") not found: " + circleFailureCause(m.failures));
+      if (!m.ok()) return failed(where + " not measured: " + circleFailureCause(m.failures));
       overlay_.circle(m.centre, m.radius, true);
       nominal.push_back(expected);
       found.push_back(m.centre);
@@ -472,9 +482,9 @@ InspectionOutcome RecipeInspection::inspect(const InspectionInput& input) const 
   InspectionOutcome out;
   const auto start = Clock::now();
   try {
-    const bool needsImage = std::any_of(recipe_->steps.begin(), recipe_->steps.end(), [](const Step& s) {
-      return s.kind != config::StepKind::ScanAlign;
-    });
+    const bool needsImage =
+        std::any_of(recipe_->steps.begin(), recipe_->steps.end(),
+                    [](const Step& s) { return s.kind != config::StepKind::ScanAlign; });
     if (needsImage && input.image.empty()) throw std::invalid_argument("empty image");
     StepRunner runner(*recipe_, *resources_, mmPerPixel_, input, out.overlay);
     std::map<std::string, StepResult> done;

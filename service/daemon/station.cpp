@@ -55,6 +55,19 @@ plc::RegisterMap fullRegisterMap(
   return map;
 }
 
+// A sidecar value: a top-level key, or one under "annotations" (where the scene generator that
+// records test and demo folders keeps what it was told about the part).
+std::string sidecarValue(const std::map<std::string, std::string>& metadata,
+                         const std::string& key) {
+  if (auto it = metadata.find(key); it != metadata.end()) return it->second;
+  if (auto it = metadata.find("annotations"); it != metadata.end()) {
+    const auto annotations = nlohmann::json::parse(it->second, nullptr, false);
+    if (annotations.is_object() && annotations.contains(key) && annotations[key].is_string())
+      return annotations[key].get<std::string>();
+  }
+  return {};
+}
+
 // A recipe whose every step works on range scans needs no camera frame.
 bool scanOnly(const config::Recipe& recipe) {
   return !recipe.steps.empty() &&
@@ -236,6 +249,17 @@ void Station::acquisitionLoop() {
     job->acquiredAt = t0;
     if (scans_ && scanOnly(recipeForPart(nullptr, trigger ? &*trigger : nullptr)->recipe())) {
       if (!acquireScan(*job)) {
+        if (options_.stopAtEndOfStream && scansEnded_) {
+          // The recorded scans are all used: a trigger now gets a not-inspected answer, and the
+          // replay ends.
+          if (trigger) {
+            job->partId = nextPartId_++;
+            ++partsTaken_;
+            job->inspection = recipeForPart(nullptr, &*trigger);
+            publishNotInspected(std::move(*job), "no range scan left for the trigger");
+          }
+          break;
+        }
         if (trigger) {
           job->partId = nextPartId_++;
           ++partsTaken_;
@@ -253,6 +277,9 @@ void Station::acquisitionLoop() {
       inspectQueue_.push(std::move(job));
       continue;
     }
+    // Free run: a camera set to software trigger is triggered by the station itself, one frame
+    // per part (ignored by free-running cameras).
+    if (!triggered) camera_->softwareTrigger();
     GrabResult grab = camera_->grab(triggered ? 2000ms : 200ms);
     switch (grab.status) {
       case GrabStatus::Ok:
@@ -292,6 +319,13 @@ void Station::acquisitionLoop() {
         continue;
     }
     if (endOfStream) {
+      if (trigger) {
+        // Every accepted trigger gets an answer, even when the replay has nothing left.
+        job->partId = nextPartId_++;
+        ++partsTaken_;
+        job->inspection = recipeForPart(nullptr, &*trigger);
+        publishNotInspected(std::move(*job), "replay finished: no image left for the trigger");
+      }
       if (options_.stopAtEndOfStream) break;
       std::this_thread::sleep_for(50ms);
       continue;
@@ -315,7 +349,10 @@ void Station::acquisitionLoop() {
 
 bool Station::acquireScan(Job& job) {
   ScanResult next = scans_->next();
-  if (next.status == GrabStatus::EndOfStream) return false;
+  if (next.status == GrabStatus::EndOfStream) {
+    scansEnded_ = true;
+    return false;
+  }
   if (!next) {
     spdlog::error("scan replay: {}", next.message);
     return false;
@@ -406,10 +443,8 @@ void Station::publishingLoop() {
     }
     p.frameId = j.frame.id;
     p.source = j.frame.source;
-    if (auto it = j.frame.metadata.find("serial"); it != j.frame.metadata.end())
-      p.serial = it->second;
-    if (auto it = j.frame.metadata.find("expected_verdict"); it != j.frame.metadata.end())
-      p.expectedVerdict = it->second;
+    p.serial = sidecarValue(j.frame.metadata, "serial");
+    p.expectedVerdict = sidecarValue(j.frame.metadata, "expected_verdict");
     const auto t0 = Clock::now();
     // 1. The PLC first: it is what the line waits for.
     if (plc_) {
@@ -417,6 +452,7 @@ void Station::publishingLoop() {
       r.partId = std::to_string(p.partId);
       r.pass = p.verdict == Verdict::Pass;
       for (const auto& m : p.measurements) r.values[m.name] = m.value;
+      r.onlyGivenValues = true;  // other recipes' outputs keep their registers
       r.errorCode = p.verdict == Verdict::Error ? 1 : 0;
       r.triggerSequence = j.trigger ? j.trigger->sequence : 0;
       if (!plc_->publish(std::move(r)))

@@ -122,6 +122,7 @@ class Station : public StationView {
   std::atomic<bool> stopRequested_{false};
   std::atomic<bool> finished_{false};
   std::atomic<bool> drained_{false};
+  bool scansEnded_ = false;  // the scan replay has delivered every file (acquisition thread)
   std::atomic<std::uint64_t> nextPartId_{1};
   std::atomic<std::uint64_t> partsTaken_{0};
   std::atomic<std::int64_t> acquisitionBeat_{0}, inspectionBeat_{0};
