@@ -80,11 +80,13 @@ std::string svgText(double x, double y, const std::string& text, const char* anc
          escape(text) + "</text>";
 }
 
-// Histogram over the chart range, tolerance limits as red lines, nominal grey.
+// Histogram over the chart range (Sturges' bin count, at least 12 so a tight process still shows
+// its shape), tolerance limits as red lines, nominal grey.
 std::string histogramSvg(const Capability& c) {
   const auto [lo, hi] = chartRange(c);
   const int bins = std::clamp(
-      static_cast<int>(std::ceil(std::log2(std::max<std::size_t>(c.values.size(), 1)))) + 1, 5, 30);
+      static_cast<int>(std::ceil(std::log2(std::max<std::size_t>(c.values.size(), 1)))) + 1, 12,
+      40);
   std::vector<int> counts(static_cast<std::size_t>(bins), 0);
   for (double v : c.values) {
     const int b = std::clamp(static_cast<int>((v - lo) / (hi - lo) * bins), 0, bins - 1);

@@ -83,7 +83,7 @@ def main():
             assert time.time() < deadline, 'facetd inspected no part within 30 s'
             time.sleep(0.2)
 
-        browser = wd.Browser()
+        browser = wd.Browser(width=1280, height=1300)
         started = time.time()
         browser.open(base + '/')
         browser.wait_for('return window.facetDashboard && window.facetDashboard.polls > 0 && '

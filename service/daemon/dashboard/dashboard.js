@@ -146,8 +146,8 @@ function renderCharts(checks, parts) {
       const div = document.createElement('div');
       div.className = 'chart';
       const title = document.createElement('h3');
-      title.textContent = check.name + ' [' + check.unit + ']  ' + fmt(check.lower) + ' … ' +
-                          fmt(check.upper);
+      title.textContent = check.name + (check.unit ? ' [' + check.unit + ']' : '') + '  ' +
+                          fmt(check.lower) + ' … ' + fmt(check.upper);
       const canvas = document.createElement('canvas');
       canvas.dataset.check = check.name;
       div.append(title, canvas);
