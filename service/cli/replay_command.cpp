@@ -113,6 +113,10 @@ void runReplay(const ReplayOptions& opt) {
     throw InputError(opt.imagesFolder + ": " + e.what());
   }
 
+  // Checked once recipe and folder are fine, before spending time on the folder.
+  std::ofstream out(opt.reportFile);
+  if (!out) throw InputError(opt.reportFile + ": cannot write the report");
+
   service::ReplayReport report;
   report.title = "recipe " + std::to_string(loaded.recipe->id) + " " + loaded.recipe->name;
   report.recipeFile = opt.recipeFile;
@@ -159,8 +163,6 @@ void runReplay(const ReplayOptions& opt) {
   camera->close();
   if (report.parts.empty()) throw InputError(opt.imagesFolder + ": no image to replay");
 
-  std::ofstream out(opt.reportFile);
-  if (!out) throw InputError(opt.reportFile + ": cannot write the report");
   service::writeReplayReport(report, out);
   out.close();
   if (!out) throw InputError(opt.reportFile + ": writing the report failed");

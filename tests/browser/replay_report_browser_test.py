@@ -26,9 +26,29 @@ def main():
     parser.add_argument('--source', required=True)
     parser.add_argument('--out', required=True)
     args = parser.parse_args()
-    wd.skip_or_fail_without_chromium()
     os.makedirs(args.out, exist_ok=True)
     recipes = os.path.join(args.source, 'recipes')
+    # Bad input: a clear message naming what is wrong, exit code 1, no report.
+    recipe = os.path.join(recipes, 'bracket_shape.recipe.yaml')
+    demo = os.path.join(recipes, 'demo', 'bracket_shape')
+    bad = os.path.join(args.out, 'bad.html')
+    if os.path.exists(bad):
+        os.remove(bad)
+    for argv, named in (
+            (['--recipe', '/nonexistent.yaml', '--images', demo, '--mm-per-pixel', '0.01'],
+             '/nonexistent.yaml'),
+            (['--recipe', recipe, '--images', '/nonexistent-folder', '--mm-per-pixel', '0.01'],
+             '/nonexistent-folder'),
+            (['--recipe', recipe, '--images', demo], '--mm-per-pixel'),
+            (['--recipe', recipe, '--images', demo, '--mm-per-pixel', '0.01', '--report',
+              '/nonexistent-folder/r.html'], '/nonexistent-folder/r.html')):
+        if '--report' not in argv:
+            argv = argv + ['--report', bad]
+        run = subprocess.run([args.facet, 'replay'] + argv, capture_output=True, text=True,
+                             timeout=60)
+        assert run.returncode == 1 and named in run.stderr, (argv, run.returncode, run.stderr)
+    assert not os.path.exists(bad)
+    wd.skip_or_fail_without_chromium()
     folder = os.path.join(recipes, 'demo', 'bracket_shape')
     report = os.path.join(args.out, 'replay-report.html')
     run = subprocess.run([args.facet, 'replay', '--recipe',
@@ -76,6 +96,7 @@ def main():
         print('report: %d rows, %d highlighted mismatches, %d failed-part thumbnails, '
               '%d measured values with charts' % (len(rows), mismatches, len(thumbs), charts))
 
+        browser.screenshot(os.path.join(args.out, 'replay-report-top.png'))
         # Scroll the first charts into view and check they are drawn.
         browser.run('document.querySelector(".check").scrollIntoView()')
         shot = browser.screenshot(os.path.join(args.out, 'replay-report.png'))

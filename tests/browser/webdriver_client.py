@@ -15,8 +15,9 @@ import time
 import urllib.error
 import urllib.request
 
-CHROMIUM = '/usr/bin/chromium'
-CHROMEDRIVER = '/usr/bin/chromedriver'
+# Debian's packages; the environment may point elsewhere (e.g. to check the skip path).
+CHROMIUM = os.environ.get('FACET_CHROMIUM', '/usr/bin/chromium')
+CHROMEDRIVER = os.environ.get('FACET_CHROMEDRIVER', '/usr/bin/chromedriver')
 ELEMENT_KEY = 'element-6066-11e4-a52e-4f735466cecf'  # the W3C element reference key
 
 
