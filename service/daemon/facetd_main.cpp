@@ -4,6 +4,7 @@
 #include <csignal>
 #include <fstream>
 #include <iostream>
+#include <thread>
 
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
@@ -128,7 +129,12 @@ int main(int argc, char** argv) {
     spdlog::info("http listening on {}:{}", httpConfig.bind, http.port());
     if (!portFile.empty()) std::ofstream(portFile) << http.port() << "\n";
     station.start();
-    systemd.ready("inspecting");
+    // READY once camera and PLC are up; a PLC still unreachable after a few seconds does not
+    // hold the service back (parts are queued for it), the status says so.
+    const auto readyDeadline = std::chrono::steady_clock::now() + 5s;
+    while (!station.plcConnected() && std::chrono::steady_clock::now() < readyDeadline)
+      std::this_thread::sleep_for(20ms);
+    systemd.ready(station.plcConnected() ? "inspecting" : "inspecting; PLC not connected");
 
     const timespec tick{0, 200'000'000};
     auto lastChangeCheck = std::chrono::steady_clock::now();
