@@ -2,9 +2,9 @@
 // (READY, WATCHDOG, RELOADING, STOPPING), a clean exit on SIGTERM with every taken part stored,
 // and a SIGKILL that leaves the SQLite store intact for the restarted daemon.
 #include <gtest/gtest.h>
+#include <poll.h>
 #include <sys/socket.h>
 #include <sys/un.h>
-#include <poll.h>
 #include <unistd.h>
 
 #include <csignal>
@@ -96,8 +96,8 @@ TEST(DaemonSystemd, NotifyProtocolAndCleanStop) {
   TempDir dir;
   const auto station = writeStationFile(dir.path(), replayCamera(), 0);
   NotifySocket notify(dir / "notify.sock");
-  auto facetd = startFacetd(dir, station,
-                            {{"NOTIFY_SOCKET", notify.path()}, {"WATCHDOG_USEC", "1000000"}});
+  auto facetd =
+      startFacetd(dir, station, {{"NOTIFY_SOCKET", notify.path()}, {"WATCHDOG_USEC", "1000000"}});
   ASSERT_TRUE(notify.waitFor("READY=1", 30s)) << "no READY=1; see " << dir / "facetd.log";
   // WatchdogSec=1 s: pings at least every 0.5 s.
   const auto t0 = Clock::now();

@@ -56,7 +56,8 @@ std::vector<StoredPart> storedParts(const std::string& database) {
   std::vector<StoredPart> parts;
   std::map<std::int64_t, std::size_t> index;
   query(database,
-        "SELECT part_id, recipe_id, frame_id, source, serial, expected, verdict, failed_checks "
+        "SELECT part_id, recipe_id, frame_id, source, serial, expected, verdict, failed_checks, "
+        "error "
         "FROM parts ORDER BY part_id",
         [&](sqlite3_stmt* s) {
           StoredPart p;
@@ -68,6 +69,7 @@ std::vector<StoredPart> storedParts(const std::string& database) {
           p.expected = text(s, 5);
           p.verdict = text(s, 6);
           p.failedChecks = text(s, 7);
+          p.error = text(s, 8);
           index[p.partId] = parts.size();
           parts.push_back(p);
         });
@@ -93,9 +95,9 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
   std::ofstream f(dir + "/station.yaml");
   f << "schema_version: 1\nname: integration-station\ncamera:\n" << camera;
   f << "  scans:\n    folder: " << recipes << "/demo/scan_offset\n    glob: \"*.csv\"\n";
-  if (plcPort > 0) {
+  {  // facetd --no-plc ignores the section, but the station file needs one
     f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
-      << "  port: " << plcPort << "\n  unit_id: 1\n  word_order: ABCD\n"
+      << "  port: " << (plcPort > 0 ? plcPort : 502) << "\n  unit_id: 1\n  word_order: ABCD\n"
       << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
       << "  register_map:\n    address_base: 0\n    control:\n"
       << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n"

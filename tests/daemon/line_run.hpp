@@ -30,7 +30,7 @@ struct StoredPart {
   std::int64_t partId = 0;
   int recipeId = 0;
   std::int64_t frameId = 0;
-  std::string source, serial, expected, verdict, failedChecks;
+  std::string source, serial, expected, verdict, failedChecks, error;
   std::map<std::string, StoredMeasurement> measurements;
 };
 
@@ -40,7 +40,8 @@ std::vector<StoredPart> storedParts(const std::string& database);
 std::string integrityCheck(const std::string& database);
 
 // The station file for a test: results, archive and HTTP in `dir`; `camera` is the YAML of the
-// camera section (indented by two spaces); plcPort 0 leaves the PLC out.
+// camera section (indented by two spaces); plcPort 0: a placeholder PLC section for facetd
+// --no-plc.
 std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort);
 
 // The pymodbus peer's config for that station and the bracket_shape recipe's PLC outputs.
