@@ -168,8 +168,9 @@ TEST(DaemonLine, FakeGigECameraAndPymodbusPlc) {
     ASSERT_LT(k, served.size()) << where << ": frame id " << p.frameId << " never served";
     const std::string& file = served[k].second;
     ASSERT_TRUE(expected.count(file)) << file;
-    if (p.verdict != "error")
+    if (p.verdict != "error") {
       EXPECT_EQ(p.verdict, expected.at(file).verdict) << where << " (" << file << ")";
+    }
     EXPECT_TRUE(p.serial.empty() && p.expected.empty())
         << where << ": a live camera has no sidecar";
     expectRowConsistent(p);
