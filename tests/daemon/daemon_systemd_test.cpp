@@ -86,7 +86,11 @@ void expectContiguous(const std::vector<StoredPart>& parts) {
 void waitForParts(const std::string& database, std::size_t n, std::chrono::seconds timeout) {
   const auto until = Clock::now() + timeout;
   while (Clock::now() < until) {
-    if (std::filesystem::exists(database) && storedParts(database).size() >= n) return;
+    try {
+      if (std::filesystem::exists(database) && storedParts(database).size() >= n) return;
+    } catch (const std::exception&) {
+      // facetd has created the file but not yet its tables
+    }
     std::this_thread::sleep_for(100ms);
   }
   FAIL() << "fewer than " << n << " parts stored within " << timeout.count() << " s";
@@ -147,9 +151,11 @@ TEST(DaemonSystemd, KillThenRestartContinuesPartIds) {
     EXPECT_EQ(facetd->wait(10s), std::optional<int>(128 + SIGKILL));
   }
   EXPECT_EQ(integrityCheck(database), "ok");
+  // Killed mid-run: the parts in flight are lost (a missed part is published by acquisition
+  // while an earlier one is still being inspected, so the stored ids may have a hole at the end).
   const auto before = storedParts(database);
   ASSERT_GE(before.size(), 4u);
-  expectContiguous(before);
+  const std::int64_t lastBefore = before.back().partId;
 
   auto facetd = startFacetd(dir, station);
   ASSERT_NO_FATAL_FAILURE(waitForParts(database, before.size() + 3, 60s));
@@ -157,12 +163,16 @@ TEST(DaemonSystemd, KillThenRestartContinuesPartIds) {
   EXPECT_EQ(facetd->wait(20s), std::optional<int>(0));
   const auto after = storedParts(database);
   EXPECT_EQ(integrityCheck(database), "ok");
-  expectContiguous(after);  // the restarted daemon continues after the last stored id
   ASSERT_GT(after.size(), before.size());
-  for (std::size_t i = 0; i < before.size(); ++i) {
+  for (std::size_t i = 0; i < before.size(); ++i) {  // the old rows are untouched
+    EXPECT_EQ(after[i].partId, before[i].partId);
     EXPECT_EQ(after[i].verdict, before[i].verdict);
     EXPECT_EQ(after[i].frameId, before[i].frameId);
   }
+  // The restarted daemon continues after the last stored id, and (stopped cleanly) stores every
+  // part it took.
+  for (std::size_t i = before.size(); i < after.size(); ++i)
+    EXPECT_EQ(after[i].partId, lastBefore + static_cast<std::int64_t>(i - before.size()) + 1);
 }
 
 }  // namespace

@@ -26,6 +26,7 @@ void query(const std::string& database, const std::string& sql, Row row) {
     sqlite3_close(db);
     throw std::runtime_error(database + ": cannot open");
   }
+  sqlite3_busy_timeout(db, 5000);  // facetd may be writing (WAL) or creating the schema
   sqlite3_stmt* s = nullptr;
   if (sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) != SQLITE_OK) {
     const std::string message = sqlite3_errmsg(db);
