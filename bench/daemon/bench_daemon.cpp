@@ -20,6 +20,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <mutex>
 #include <string>
 #include <thread>
@@ -177,7 +178,6 @@ double ms(Clock::duration d) {
 
 struct Latency {
   std::vector<double> ms;
-  int unexpected = 0;
 };
 
 // One part at a time: trigger, wait for the result registers, next trigger.
@@ -203,10 +203,6 @@ Latency measureLatency(const fs::path& dir, const fs::path& frames, int triggers
   plc.start();
   auto station = loadStation(writeStation(dir / "latency", frames, plc.port()));
   service::StationOptions options;
-  int unexpected = 0;
-  options.onPart = [&](const service::PartResult& p) {
-    unexpected += p.expectedVerdict != service::verdictName(p.verdict);
-  };
   service::Station s(station, options);
   s.start();
   Latency out;
@@ -228,7 +224,6 @@ Latency measureLatency(const fs::path& dir, const fs::path& frames, int triggers
   s.requestStop();
   s.join();
   plc.stop();
-  out.unexpected = unexpected;
   return out;
 }
 
@@ -236,7 +231,7 @@ struct FreeRun {
   double partsPerSecond = 0;
   std::vector<long> rss;
   double grab = 0, inspect = 0, publish = 0;
-  int unexpected = 0;
+  std::map<std::string, int> verdicts;  // written by the publishing thread only
 };
 
 double stageMean(service::Station& s, const char* stage) {
@@ -257,7 +252,7 @@ FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, int parts) {
   std::mutex mutex;
   options.onPart = [&](const service::PartResult& p) {
     const int n = ++done;
-    if (p.expectedVerdict != service::verdictName(p.verdict)) ++out.unexpected;
+    ++out.verdicts[service::verdictName(p.verdict)];
     if (n % 1000 == 0 || n == parts / 10) {
       std::lock_guard lock(mutex);
       out.rss.push_back(rssKb());
@@ -332,8 +327,8 @@ int main(int argc, char** argv) {
     }
   }
   if (smoke) {
-    parts = std::min(parts, 60);
-    triggers = std::min(triggers, 20);
+    parts = std::min(parts, 24);
+    triggers = std::min(triggers, 8);
   }
   spdlog::set_level(spdlog::level::err);
   char name[] = "/tmp/facet-bench-daemon-XXXXXX";
@@ -341,7 +336,7 @@ int main(int argc, char** argv) {
   try {
     const auto frames = makeFrames(dir / "frames");
     const Latency latency = measureLatency(dir, dir / "frames", triggers);
-    const FreeRun run = measureFreeRun(dir, dir / "frames", parts);
+    FreeRun run = measureFreeRun(dir, dir / "frames", parts);
     const Baseline cv = openCvBaseline(frames, smoke ? 1 : 5);
     const double median = percentile(latency.ms, 0.5), p99 = percentile(latency.ms, 0.99);
     const long rssFirst = run.rss.empty() ? 0 : run.rss.front();
@@ -364,8 +359,10 @@ int main(int argc, char** argv) {
                 std::abs(growth) <= 5 ? "yes" : "NO ");
     std::printf("  (VmRSS samples: %zu, first %ld kB, max %ld kB)\n", run.rss.size(), rssFirst,
                 rssMax);
-    std::printf("  verdicts differing from the sidecars: %d (latency run), %d (free run)\n\n",
-                latency.unexpected, run.unexpected);
+    // The bench recipe checks fewer things than bracket_shape (no label angle, no bore-to-edge
+    // distance), so parts the sidecars call "fail" may pass here; errors must be 0.
+    std::printf("  free-run verdicts: pass %d, fail %d, error %d\n\n", run.verdicts["pass"],
+                run.verdicts["fail"], run.verdicts["error"]);
     std::printf("| stage (mean per part)  | facet     | OpenCV baseline              | ratio |\n");
     std::printf("| ---------------------- | --------- | ---------------------------- | ----- |\n");
     std::printf("| grab (PNG decode)      | %6.2f ms | %6.2f ms cv::imread          | %5.2f |\n",
