@@ -70,7 +70,10 @@ int tableSize(const RegisterMap& map, Table table) {
   if (table == Table::HoldingRegister)
     for (const auto& output : map.results)
       highest = std::max(highest, map.wireAddress(output.address) + registerCount(output.type) - 1);
-  return highest + 1;
+  // Like a real PLC's data block, the tables are larger than the station's own signals: recipe
+  // outputs (which the simulator does not know) land above them.
+  constexpr int kMinimumTable = 1024;
+  return std::max(highest + 1, kMinimumTable);
 }
 
 }  // namespace
@@ -85,6 +88,10 @@ struct PlcSimulator::State {
   mutable std::mutex mutex;  // guards stats and callback
   PlcSimulatorStats stats;
   std::function<void(const ReceivedResult&)> callback;
+  // Free run: the counter and toggle when start() was called; a change after that is a result
+  // (read before the scan thread runs, so a result written right after start() is not missed).
+  int initialCounter = -1;
+  bool initialToggle = false;
 
   void scan();
 };
@@ -108,8 +115,8 @@ void PlcSimulator::State::scan() {
   SteadyClock::time_point validSince{};
   bool lastValid = false;
   bool lastMissed = false;
-  bool lastToggle = tables.flag(map.status.completedToggle);
-  int lastCounter = tables.number(map.status.inspectionCounter);
+  bool lastToggle = initialToggle;
+  int lastCounter = initialCounter;
 
   while (!stopping) {
     const auto now = SteadyClock::now();
@@ -185,7 +192,7 @@ PlcSimulator::PlcSimulator(RegisterMap map, PlcSimulatorOptions options)
   const auto issues = map.validate();
   if (!issues.empty()) {
     std::string message = "invalid PLC register map:";
-    for (const auto& issue : issues) message += "\n  " + issue.message;
+    for (const auto& issue : issues) message += "\n  " + describe(issue);
     throw std::invalid_argument(message);
   }
   state_->map = std::move(map);
@@ -214,6 +221,9 @@ void PlcSimulator::onResult(std::function<void(const ReceivedResult&)> callback)
 void PlcSimulator::start() {
   if (state_->thread.joinable()) return;
   state_->stopping = false;
+  const Tables tables(*state_->server, state_->map);
+  state_->initialCounter = tables.number(state_->map.status.inspectionCounter);
+  state_->initialToggle = tables.flag(state_->map.status.completedToggle);
   state_->thread = std::thread([s = state_.get()] { s->scan(); });
 }
 

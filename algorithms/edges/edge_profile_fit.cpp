@@ -102,9 +102,16 @@ struct ApertureProfiles {
   ProfileView view(cv::Point2d normal) {
     const double lo = std::min(std::abs(normal.x), std::abs(normal.y));
     const double hi = std::max(std::abs(normal.x), std::abs(normal.y));
-    const int k =
-        std::clamp(static_cast<int>(std::lround(std::atan2(lo, hi) * 180 / std::numbers::pi)), 0,
-                   kApertureAngles - 1);
+    // The nearest whole degree of atan(lo / hi), by comparing with tan(k + 1/2 degree).
+    static const std::array<double, kApertureAngles> tanHalf = [] {
+      std::array<double, kApertureAngles> t{};
+      for (int k = 0; k < kApertureAngles; ++k) t[k] = std::tan((k + 0.5) * std::numbers::pi / 180);
+      return t;
+    }();
+    const double ratio = hi > 0 ? lo / hi : 0.0;
+    const int k = std::min(
+        static_cast<int>(std::lower_bound(tanHalf.begin(), tanHalf.end(), ratio) - tanHalf.begin()),
+        kApertureAngles - 1);
     std::call_once(built[k], [this, k] { buildRow(k); });
     return {&rows[static_cast<size_t>(k) * kApertureSize],
             kApertureSize,
@@ -437,7 +444,9 @@ double profileWindowBias(const EdgeProfileParams& params) {
 }
 
 int edgeProfileReach(const EdgeProfileParams& params) {
-  return static_cast<int>(std::ceil(std::hypot(params.halfAcross + 1.5, params.halfAlong)));
+  return static_cast<int>(
+      std::ceil(std::sqrt((params.halfAcross + 1.5) * (params.halfAcross + 1.5) +
+                          params.halfAlong * params.halfAlong)));
 }
 
 std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, cv::Point2d normal,
@@ -474,6 +483,19 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
     }
     if (!ok) return std::nullopt;
   }
+  // A seed normal off by more than a degree or two (noise, a corner nearby) needs more turn
+  // steps: the linearisation in phi is only good for small turns. Give up when they do not
+  // settle.
+  if (!fitWidth && std::abs(phi) > 0.03) {
+    const ProfileView view = aperture->view(normal);
+    double previous = phi;
+    for (int extra = 0; extra < 3; ++extra) {
+      if (!step<Extra::Turn>(smp, view, a, b, e, w, phi)) return std::nullopt;
+      if (std::abs(phi - previous) < 0.003) break;
+      previous = phi;
+    }
+    if (std::abs(phi - previous) >= 0.003) return std::nullopt;
+  }
   if (std::abs(e - offset) > 1.0) return std::nullopt;  // wandered off: not a clean edge
   if (fittedWidth) *fittedWidth = w;
 
@@ -481,8 +503,8 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   // e / |n + phi t| along the turned unit normal.
   const cv::Point2d t{-normal.y, normal.x};
   cv::Point2d n = normal + phi * t;
-  n /= std::hypot(n.x, n.y);
-  return EdgePoint{cv::Point2d(pixel) + e / std::hypot(1.0, phi) * n, n,
+  n /= std::sqrt(n.x * n.x + n.y * n.y);
+  return EdgePoint{cv::Point2d(pixel) + e / std::sqrt(1.0 + phi * phi) * n, n,
                    b / (w * std::sqrt(2 * std::numbers::pi))};
 }
 

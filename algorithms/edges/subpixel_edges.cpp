@@ -64,25 +64,28 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   // The gradient covers the ROI plus one pixel for suppression; edge pixels need the facet's
   // 5x5 window inside the image.
   const cv::Rect area = cv::Rect(roi.x - 1, roi.y - 1, roi.width + 2, roi.height + 2) & full;
-  const EdgeGradient gradient = computeEdgeGradient(image, area);
   const cv::Rect usable = cv::Rect(2, 2, image.cols - 4, image.rows - 4) & roi;
   if (usable.empty()) return result;
   const cv::Rect candidates = usable - area.tl();
   const cv::Mat mask = params.mask.empty() ? cv::Mat() : params.mask(area);
 
+  cv::Mat edges;
   if (params.low && params.high) {
     result.lowThreshold = *params.low;
     result.highThreshold = *params.high;
+    edges = cannyInStrips(image, area, result.lowThreshold, result.highThreshold, mask, candidates);
   } else {
+    // Automatic thresholds need the whole region's magnitudes first.
+    const EdgeGradient gradient = computeEdgeGradient(image, area);
     cv::Mat region = cv::Mat::zeros(area.size(), CV_8U);
     region(candidates).setTo(255);
     if (!mask.empty()) region &= mask;
     const CannyThresholds t = autoCannyThresholds(gradient.magnitude, region);
     result.lowThreshold = t.low;
     result.highThreshold = t.high;
+    edges =
+        cannyFromGradient(gradient, result.lowThreshold, result.highThreshold, mask, candidates);
   }
-  const cv::Mat edges =
-      cannyFromGradient(gradient, result.lowThreshold, result.highThreshold, mask, candidates);
 
   // Facet zero crossings of every Canny pixel.
   std::vector<EdgeSeed> seeds;
@@ -102,12 +105,15 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   // Profile refinement where its window fits in the image, with one blur width per image.
   EdgeProfileParams profile;
-  const int reach = edgeProfileReach(profile);
-  const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
   if (params.fitProfile) {
     profile.width = estimateEdgeWidth(image, seeds, profile);
     result.blurSigma = std::sqrt(std::max(profile.width * profile.width - 1.0 / 12, 0.0));
+    // What separates the offset from the background level is the plateau on either side; keep
+    // about 4 widths of it in the window when the blur is wide.
+    profile.halfAcross = std::clamp(3.9 * profile.width, profile.halfAcross, 6.5);
   }
+  const int reach = edgeProfileReach(profile);
+  const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
   std::vector<cv::Point> pixels;
   std::vector<double> windowBias;  // per point: kappa coefficient of the fit's window bias
   result.points.reserve(seeds.size());

@@ -50,7 +50,26 @@ double parabolaPeak(float a, float b, float c) {
   return std::clamp(0.5 * (a - c) / d, -0.5, 0.5);
 }
 
-void detectAtLevel(const ScaleLevel& below, const ScaleLevel& level, const ScaleLevel& above,
+// The Laplacian of a neighbouring scale, possibly stored at another octave's resolution:
+// `shift` +1 = a finer octave (coordinates x2), -1 = a coarser one (coordinates /2).
+struct Neighbour {
+  const cv::Mat* laplacian = nullptr;
+  int shift = 0;
+  [[nodiscard]] float at(int x, int y) const {
+    if (shift > 0) {
+      x *= 2;
+      y *= 2;
+    } else if (shift < 0) {
+      x /= 2;
+      y /= 2;
+    }
+    x = std::clamp(x, 0, laplacian->cols - 1);
+    y = std::clamp(y, 0, laplacian->rows - 1);
+    return std::abs(laplacian->at<float>(y, x));
+  }
+};
+
+void detectAtLevel(const Neighbour& below, const ScaleLevel& level, const Neighbour& above,
                    double factor, int levelIndex, const HarrisParams& p,
                    std::vector<HarrisCorner>& out) {
   const cv::Mat& r = level.harris;
@@ -72,9 +91,7 @@ void detectAtLevel(const ScaleLevel& below, const ScaleLevel& level, const Scale
       // Characteristic scale: |Laplacian| must not be smaller than at the neighbouring scales.
       if (p.selectScale) {
         const float lap = std::abs(level.laplacian.at<float>(y, x));
-        if (lap < std::abs(below.laplacian.at<float>(y, x)) ||
-            lap < std::abs(above.laplacian.at<float>(y, x)))
-          continue;
+        if (lap < below.at(x, y) || lap < above.at(x, y)) continue;
       }
       const double dx = parabolaPeak(r1[x - 1], v, r1[x + 1]);
       const double dy = parabolaPeak(r0[x], v, r2[x]);
@@ -153,23 +170,56 @@ std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
 std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisParams& params) {
   CV_Assert(grey.type() == CV_32F);
   std::vector<HarrisCorner> all;
-  cv::Mat octave = grey;
   const int L = std::max(1, params.levelsPerOctave);
+  auto relScale = [L](int j) { return std::pow(2.0, double(j) / L); };
+  // Levels 0..L-1 of every octave. Level L of octave o has the scale of level 0 of octave o+1
+  // and level -1 that of level L-1 of octave o-1, so the scale test reads its neighbours there;
+  // only the finest and the coarsest ends need an extra level.
+  std::vector<std::vector<ScaleLevel>> octaves;
+  cv::Mat octave = grey;
   for (int o = 0; o < params.octaves; ++o) {
     if (std::min(octave.rows, octave.cols) < 2 * params.border + 8) break;
-    const double factor = std::ldexp(1.0, o);
-    // Levels -1 and L only serve the scale test of their neighbours.
-    const int first = params.selectScale ? -1 : 0, last = params.selectScale ? L : L - 1;
     std::vector<ScaleLevel> levels;
-    for (int j = first; j <= last; ++j)
-      levels.push_back(computeLevel(octave, std::pow(2.0, double(j) / L), params));
-    const int offset = params.selectScale ? 1 : 0;
-    for (int j = 0; j < L; ++j)
-      detectAtLevel(levels[j + offset - (offset ? 1 : 0)], levels[j + offset],
-                    levels[j + offset + (offset ? 1 : 0)], factor, o * L + j, params, all);
-    cv::Mat next;
-    cv::pyrDown(octave, next);
-    octave = next;
+    for (int j = 0; j < L; ++j) levels.push_back(computeLevel(octave, relScale(j), params));
+    octaves.push_back(std::move(levels));
+    if (o + 1 < params.octaves) {
+      cv::Mat next;
+      cv::pyrDown(octave, next);
+      octave = next;
+    }
+  }
+  if (octaves.empty()) return {};
+  ScaleLevel finest, coarsest;
+  if (params.selectScale) {
+    finest = computeLevel(grey, relScale(-1), params);
+    cv::Mat last = grey;
+    for (std::size_t o = 1; o < octaves.size(); ++o) {
+      cv::Mat next;
+      cv::pyrDown(last, next);
+      last = next;
+    }
+    coarsest = computeLevel(last, relScale(L), params);
+  }
+  for (std::size_t o = 0; o < octaves.size(); ++o) {
+    const double factor = std::ldexp(1.0, static_cast<int>(o));
+    for (int j = 0; j < L; ++j) {
+      Neighbour below, above;
+      if (params.selectScale) {
+        if (j > 0)
+          below = {&octaves[o][j - 1].laplacian, 0};
+        else if (o > 0)
+          below = {&octaves[o - 1][L - 1].laplacian, +1};
+        else
+          below = {&finest.laplacian, 0};
+        if (j + 1 < L)
+          above = {&octaves[o][j + 1].laplacian, 0};
+        else if (o + 1 < octaves.size())
+          above = {&octaves[o + 1][0].laplacian, -1};
+        else
+          above = {&coarsest.laplacian, 0};
+      }
+      detectAtLevel(below, octaves[o][j], above, factor, static_cast<int>(o) * L + j, params, all);
+    }
   }
   // Keep a pool of the strongest before the quadratic-time spreading.
   const std::size_t pool =

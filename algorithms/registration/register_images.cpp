@@ -17,13 +17,22 @@ cv::Mat toGrey(const cv::Mat& image) {
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   else if (image.channels() == 4)
     cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
-  double scale = 1.0;
-  if (grey.depth() == CV_8U)
+  double scale = 1.0, offset = 0.0;
+  if (grey.depth() == CV_8U) {
     scale = 1.0 / 255.0;
-  else if (grey.depth() == CV_16U)
+  } else if (grey.depth() == CV_16U) {
     scale = 1.0 / 65535.0;
+  } else {
+    // Other depths (float, signed): brought to [0, 1] by their own range when outside it.
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(grey, &lo, &hi);
+    if ((hi > 1.0 || lo < 0.0) && hi > lo) {
+      scale = 1.0 / (hi - lo);
+      offset = -lo * scale;
+    }
+  }
   cv::Mat out;
-  grey.convertTo(out, CV_32F, scale);
+  grey.convertTo(out, CV_32F, scale, offset);
   return out;
 }
 
@@ -34,22 +43,31 @@ bool isBlank(const cv::Mat& grey) {
 }
 
 struct Features {
+  std::vector<HarrisCorner> corners;  // detected, in spreading order
+  int described = 0;                  // corners [0, described) have been turned into windows
   std::vector<AffineRegion> regions;  // only those with a valid window
   std::vector<LogPolarWindow> windows;
   std::vector<int> ranks;  // the corner's position in spreading order
 };
 
-Features describe(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
-                  const RegistrationParams& params, int budget) {
+Features detect(const cv::Mat& grey, const RegistrationParams& params, int budget) {
   HarrisParams hp = params.corners;
   hp.maxCorners = budget;
-  const std::vector<HarrisCorner> corners = detectHarrisCorners(grey, hp);
   Features f;
-  for (std::size_t i = 0; i < corners.size(); ++i) {
-    AffineRegion r{corners[i].pt, cv::Matx22d(corners[i].scale, 0, 0, corners[i].scale),
-                   corners[i].response};
+  f.corners = detectHarrisCorners(grey, hp);
+  return f;
+}
+
+// Regions (adapted when asked) and windows of the corners up to rank `count`; lazily, so that
+// the corners kept for escalation cost nothing unless it happens.
+void describeUpTo(Features& f, const std::vector<cv::Mat>& pyramid,
+                  const RegistrationParams& params, int count) {
+  const int end = std::min(count, static_cast<int>(f.corners.size()));
+  for (int i = f.described; i < end; ++i) {
+    const HarrisCorner& c = f.corners[i];
+    AffineRegion r{c.pt, cv::Matx22d(c.scale, 0, 0, c.scale), c.response};
     if (params.affineRegions) {
-      const std::vector<AffineRegion> adapted = adaptAffineRegions(pyramid, {corners[i]});
+      const std::vector<AffineRegion> adapted = adaptAffineRegions(pyramid, {c});
       if (adapted.empty()) continue;
       r = adapted.front();
     }
@@ -57,9 +75,9 @@ Features describe(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
     if (!w.valid) continue;
     f.regions.push_back(r);
     f.windows.push_back(std::move(w));
-    f.ranks.push_back(static_cast<int>(i));
+    f.ranks.push_back(i);
   }
-  return f;
+  f.described = std::max(f.described, end);
 }
 
 double rotationDegOf(const cv::Matx22d& L) {
@@ -136,7 +154,7 @@ double parabolaPeak(float a, float b, float c) {
 // corner's predicted position, with the image; the NCC peak (subpixel) gives the match.
 std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
                                   const std::vector<HarrisCorner>& corners, const cv::Matx33d& H,
-                                  const RegistrationParams& params) {
+                                  int R, const RegistrationParams& params) {
   const cv::Point2d centre((refGrey.cols - 1) / 2.0, (refGrey.rows - 1) / 2.0);
   const double s = std::sqrt(std::abs(cv::determinant(jacobianAt(H, centre))));
   // Match resolutions: blur whichever image is seen at the finer scale.
@@ -152,7 +170,7 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
   cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
   cv::Mat ones(refGrey.size(), CV_8U, cv::Scalar(255));
   cv::warpPerspective(ones, valid, H, imgGrey.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
-  const int r = params.refinePatchRadius, R = params.refineSearchRadius;
+  const int r = params.refinePatchRadius;
   const cv::Rect bounds(0, 0, imgGrey.cols, imgGrey.rows);
   std::vector<FeatureMatch> out;
   cv::Mat result;
@@ -310,17 +328,21 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
   // Detected once with the larger budget: the corners come in spreading order, so the first
   // maxCorners of them are what a smaller budget would have kept.
   const int budget = std::max(params.corners.maxCorners, params.escalateCorners);
-  const Features fr = describe(ref, refPyramid, params, budget);
-  const Features fi = describe(img, imgPyramid, params, budget);
+  Features fr = detect(ref, params, budget);
+  Features fi = detect(img, params, budget);
+  describeUpTo(fr, refPyramid, params, params.corners.maxCorners);
+  describeUpTo(fi, imgPyramid, params, params.corners.maxCorners);
 
   GlobalStage stage =
       matchGlobally(fr, fi, params.corners.maxCorners, params.matching.minScore, params);
   if (params.escalateCorners > params.corners.maxCorners &&
       static_cast<int>(stage.inliers.size()) < params.escalateBelowInliers) {
+    describeUpTo(fr, refPyramid, params, params.escalateCorners);
+    describeUpTo(fi, imgPyramid, params, params.escalateCorners);
     GlobalStage wider =
         matchGlobally(fr, fi, params.escalateCorners, params.escalateMinScore, params);
     if (wider.inliers.size() > stage.inliers.size() ||
-        (stage.failureCause.empty() == false && wider.failureCause.empty()))
+        (!stage.failureCause.empty() && wider.failureCause.empty()))
       stage = std::move(wider);
   }
   result.refCorners = stage.refCorners;
@@ -330,25 +352,44 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
   result.H = stage.H;
   result.inliers = stage.inliers;
 
+  const std::size_t globalInliers = result.inliers.size();
   if (params.refineIterations > 0) {
-    TransformFitParams fp;
-    fp.model = params.model;
-    fp.inlierThreshold = params.inlierThreshold;
+    TransformFitParams tight;
+    tight.model = params.model;
+    tight.inlierThreshold = params.finalThreshold;
     const std::vector<HarrisCorner> dense =
         detectHarrisGrid(ref, params.refineCell, params.corners);
     for (int it = 0; it < params.refineIterations; ++it) {
-      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, params);
+      // Once H rests on the dense pairs, the prediction is within a pixel or two.
+      const int radius =
+          it == 0 ? params.refineSearchRadius : std::min(params.refineSearchRadius, 3);
+      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, radius, params);
       std::vector<cv::Point2d> s2, d2;
       for (const auto& m : rm) {
         s2.push_back(m.ref);
         d2.push_back(m.image);
       }
-      const auto refit = fitTransformRobust(s2, d2, fp);
-      if (!refit || refit->inliers.size() < result.inliers.size()) break;
+      // The re-matched pairs are subpixel: the consensus is sought at the tight threshold so that
+      // a cluster of slightly wrong pairs cannot bias H; inliers are then counted as usual.
+      const auto refit = fitTransformRobust(s2, d2, tight);
+      if (!refit) break;
+      std::vector<int> inliers;
+      for (std::size_t i = 0; i < s2.size(); ++i)
+        if (transferError(refit->H, s2[i], d2[i]) <= params.inlierThreshold)
+          inliers.push_back(static_cast<int>(i));
+      if (inliers.size() < result.inliers.size()) break;
       result.H = refit->H;
       result.matches = std::move(rm);
-      result.inliers = refit->inliers;
+      result.inliers = std::move(inliers);
     }
+    // A transform resting on very few global matches must be confirmed by the re-matching.
+    if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
+        static_cast<int>(result.inliers.size()) < params.confirmInliers)
+      return failure(result, "too_few_inliers",
+                     std::to_string(globalInliers) +
+                         " global inliers, not confirmed by re-matching (" +
+                         std::to_string(result.inliers.size()) + " inliers, " +
+                         std::to_string(params.confirmInliers) + " needed)");
   }
   result.ok = true;
   return result;

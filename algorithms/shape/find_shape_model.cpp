@@ -94,8 +94,9 @@ double clampAngle(const Interval& range, double a) {
   return std::clamp(a, range.start, range.start + range.extent);
 }
 
-// Best pose in a (2r+1)^2 x 3 x 3 neighbourhood of `c`, climbing while the best lies on the border.
-Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius) {
+// Best pose in a neighbourhood of `c`: (2 radius + 1)^2 positions x (2 angleSteps + 1) angles x 3
+// scales, climbing while the best lies on the border.
+Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angleSteps = 1) {
   const double aStep = s.level->angleStep;
   const double sStep = s.scaleMax > s.scaleMin ? s.level->scaleStep : 0.0;
   Candidate best = c;
@@ -104,7 +105,7 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius) {
     Candidate centre = climb == 0 ? c : best;
     bool onBorder = false;
     const int ns = sStep > 0.0 ? 1 : 0;
-    for (int k = -1; k <= 1; ++k) {
+    for (int k = -angleSteps; k <= angleSteps; ++k) {
       const double a = clampAngle(s.angles, centre.angle + k * aStep);
       for (int m = -ns; m <= ns; ++m) {
         const double sc = std::clamp(centre.scale + m * sStep, s.scaleMin, s.scaleMax);
@@ -117,13 +118,14 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius) {
             if (score > best.score) {
               best = {double(at.x), double(at.y), a, sc, score};
               onBorder = std::abs(dx) == radius || std::abs(dy) == radius ||
-                         (k != 0 && aStep > 0.0) || m != 0;
+                         (std::abs(k) == angleSteps && aStep > 0.0) || m != 0;
             }
           }
       }
     }
     if (!onBorder || best.score < s.minScore) break;
     radius = 1;
+    angleSteps = 1;
   }
   return best;
 }
@@ -293,6 +295,9 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     if (params.numMatches > 0 && static_cast<int>(matches.size()) >= params.numMatches) break;
     if (clashes({c.x, c.y, c.angle, c.scale})) continue;
     ShapeMatch m;
+    // Occluders and clutter can bend the score surface so that tracking stops on a secondary
+    // peak next to the true one; a wider look around each match about to be returned finds it.
+    if (const Candidate wide = refineOnLevel(search, c, 2, 3); wide.score > c.score) c = wide;
     if (params.subpixel != SubpixelMode::None) c = interpolate(search, c);
     Pose2D pose{c.x, c.y, c.angle, c.scale};
     if (params.subpixel == SubpixelMode::LeastSquares) {

@@ -55,6 +55,19 @@ plc::RegisterMap fullRegisterMap(
   return map;
 }
 
+// A sidecar value: a top-level key, or one under "annotations" (where the scene generator that
+// records test and demo folders keeps what it was told about the part).
+std::string sidecarValue(const std::map<std::string, std::string>& metadata,
+                         const std::string& key) {
+  if (auto it = metadata.find(key); it != metadata.end()) return it->second;
+  if (auto it = metadata.find("annotations"); it != metadata.end()) {
+    const auto annotations = nlohmann::json::parse(it->second, nullptr, false);
+    if (annotations.is_object() && annotations.contains(key) && annotations[key].is_string())
+      return annotations[key].get<std::string>();
+  }
+  return {};
+}
+
 // A recipe whose every step works on range scans needs no camera frame.
 bool scanOnly(const config::Recipe& recipe) {
   return !recipe.steps.empty() &&
@@ -306,6 +319,13 @@ void Station::acquisitionLoop() {
         continue;
     }
     if (endOfStream) {
+      if (trigger) {
+        // Every accepted trigger gets an answer, even when the replay has nothing left.
+        job->partId = nextPartId_++;
+        ++partsTaken_;
+        job->inspection = recipeForPart(nullptr, &*trigger);
+        publishNotInspected(std::move(*job), "replay finished: no image left for the trigger");
+      }
       if (options_.stopAtEndOfStream) break;
       std::this_thread::sleep_for(50ms);
       continue;
@@ -423,20 +443,16 @@ void Station::publishingLoop() {
     }
     p.frameId = j.frame.id;
     p.source = j.frame.source;
-    if (auto it = j.frame.metadata.find("serial"); it != j.frame.metadata.end())
-      p.serial = it->second;
-    if (auto it = j.frame.metadata.find("expected_verdict"); it != j.frame.metadata.end())
-      p.expectedVerdict = it->second;
+    p.serial = sidecarValue(j.frame.metadata, "serial");
+    p.expectedVerdict = sidecarValue(j.frame.metadata, "expected_verdict");
     const auto t0 = Clock::now();
     // 1. The PLC first: it is what the line waits for.
     if (plc_) {
       plc::InspectionResult r;
       r.partId = std::to_string(p.partId);
       r.pass = p.verdict == Verdict::Pass;
-      // Outputs of the other recipes in the map are written as NaN (0 for integers): the PLC
-      // reads the registers of the recipe it selected.
-      for (const auto& out : plc_->registerMap().results) r.values[out.name] = std::nan("");
       for (const auto& m : p.measurements) r.values[m.name] = m.value;
+      r.onlyGivenValues = true;  // other recipes' outputs keep their registers
       r.errorCode = p.verdict == Verdict::Error ? 1 : 0;
       r.triggerSequence = j.trigger ? j.trigger->sequence : 0;
       if (!plc_->publish(std::move(r)))

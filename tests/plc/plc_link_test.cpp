@@ -17,6 +17,7 @@
 
 #include "plc/plc_link.hpp"
 #include "plc/register_encoding.hpp"
+#include "plc/register_map_yaml.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
 
 namespace facet::plc {
@@ -164,12 +165,12 @@ std::size_t countIn(const std::vector<nlohmann::json>& events, const char* kind)
                                                 [&](const auto& e) { return e["event"] == kind; }));
 }
 
-void triggeredRoundTrip(int base) {
-  const RegisterMap map = fullMap(base);
+void triggeredRoundTrip(const RegisterMap& map) {
   const int port = test::freeTcpPort();
   PymodbusPlc plc(test::writePeerConfig(map, false), port);
   plc.start();
-  plc.command("set_register 5 7");  // recipe select (wire address 5)
+  plc.command("set_register " +  // recipe select
+              std::to_string(map.wireAddress(map.control.recipeSelect->address)) + " 7");
   PlcLink link(map, fastSettings(port));
   link.setActiveRecipe(7);
   link.start();
@@ -211,11 +212,19 @@ void triggeredRoundTrip(int base) {
 }
 
 TEST(PlcLinkWithPymodbus, TriggeredHandshakeDeliversEveryTypeAndWordOrder) {
-  triggeredRoundTrip(0);
+  triggeredRoundTrip(fullMap(0));
+}
+
+// The example station map keeps its status flags in adjacent coils: they go out in one request.
+TEST(PlcLinkWithPymodbus, ExampleStationMapWithAdjacentStatusCoils) {
+  RegisterMap map =
+      loadRegisterMap(std::string(FACET_SOURCE_DIR) + "/tests/plc/data/station_register_map.yaml");
+  map.control.enable.reset();  // the pymodbus PLC does not enable; tested separately
+  triggeredRoundTrip(map);
 }
 
 TEST(PlcLinkWithPymodbus, OneBasedMapReachesTheSameWireAddresses) {
-  triggeredRoundTrip(1);
+  triggeredRoundTrip(fullMap(1));
 }
 
 TEST(PlcLinkWithPymodbus, TriggerWhileBusyRaisesMissedTrigger) {
@@ -446,6 +455,41 @@ TEST(PlcLinkWithPymodbus, TriggersAreIgnoredWhileNotEnabled) {
   plc.command("set_register 6 1");
   plc.command("trigger");
   EXPECT_TRUE(link.waitTrigger(5s));
+}
+
+}  // namespace
+}  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// What the daemon owns besides results: ready, active recipe, a heartbeat that keeps counting.
+TEST(PlcLinkWithPymodbus, ReadyActiveRecipeAndHeartbeatReachThePlc) {
+  const RegisterMap map = fullMap();
+  const int port = test::freeTcpPort();
+  PymodbusPlc plc(test::writePeerConfig(map, false), port);
+  plc.start();
+  PlcLink link(map, fastSettings(port));  // heartbeat every 20 ms
+  link.setActiveRecipe(12);
+  link.start();
+  ASSERT_TRUE(waitUntil([&] { return link.stats().connected; }, 5s));
+  auto report = [&](const std::string& signal) {
+    const std::size_t before = plc.events("report").size();
+    plc.command("report " + signal);
+    EXPECT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "report") > before; }, 5s));
+    return plc.events("report").back()["value"];
+  };
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(report("ready"), true);
+  EXPECT_EQ(report("active_recipe"), 12);
+  const int beat = report("heartbeat");
+  std::this_thread::sleep_for(200ms);
+  EXPECT_GE(static_cast<int>(report("heartbeat")), beat + 3);
+  link.setReady(false);
+  link.setActiveRecipe(4);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(report("ready"), false);
+  EXPECT_EQ(report("active_recipe"), 4);
 }
 
 }  // namespace

@@ -16,7 +16,9 @@ plc.json (wire addresses, i.e. zero-based as sent on the wire):
      "auto_ack": true, "mode": "triggered"}   (mode "free_run": report each new counter)
 
 stdin commands, one per line: "trigger" (raise the trigger; cleared when busy or result valid
-rises, or after 0.5 s), "quit". stdout: one JSON object per line: {"event": "listening", "port": P}, then
+rises, or after 0.5 s), "report <signal>" (emit {"event": "report", ...} with its value),
+"set_register <address> <value>", "quit".
+stdout: one JSON object per line: {"event": "listening", "port": P}, then
 {"event": "result", ...} per result valid rising edge (decoded here with struct, independently
 of facet's encoder, plus the raw words), {"event": "missed_trigger"} per rising edge.
 """
@@ -147,6 +149,13 @@ class Plc:
         if line == "trigger":
             self.set_flag("trigger", True)
             self.trigger_since = time.monotonic()
+        elif line.startswith("report "):
+            # "report <signal>": the current value of a mapped signal, as the PLC sees it
+            name = line.split()[1]
+            at = self.signals[name]
+            value = (self.flag(name) if at["table"] == "coil" or at.get("bit", -1) >= 0
+                     else self.number(name))
+            emit({"event": "report", "signal": name, "value": value})
         elif line.startswith("set_register "):
             _, address, value = line.split()
             self.slave.setValues(HOLDING, int(address), [int(value)])
