@@ -95,10 +95,17 @@ struct Line {
   int plcPort = plc::test::freeTcpPort();
   std::unique_ptr<plc::test::PymodbusPlc> plc;
   std::unique_ptr<ChildProcess> facetd;
+  std::string peerConfig;  // a /tmp file of writePeerConfig()
+
+  ~Line() {
+    std::error_code ignored;
+    if (!peerConfig.empty()) std::filesystem::remove(peerConfig, ignored);
+  }
 
   void start(const std::string& camera) {
     const auto station = writeStationFile(dir.path(), camera, plcPort);
-    plc = std::make_unique<plc::test::PymodbusPlc>(writePeerConfig(station), plcPort);
+    peerConfig = writePeerConfig(station);
+    plc = std::make_unique<plc::test::PymodbusPlc>(peerConfig, plcPort);
     plc->start();
     // The PLC selects the recipe; facetd starts with the lowest id (1), so the switch is tested.
     plc->command("set_register 0 " + std::to_string(kRecipe));
