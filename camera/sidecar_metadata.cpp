@@ -27,6 +27,12 @@ nlohmann::json readJsonObject(const std::filesystem::path& file) {
 }
 
 void mergeInto(SidecarMetadata::Entries& entries, const nlohmann::json& object) {
+  // The scene generator (tests/support/scene) writes serial, expected_verdict, pose, ... under
+  // "annotations": those become entries too, top-level keys of the same name winning.
+  if (auto it = object.find("annotations"); it != object.end() && it->is_object())
+    for (const auto& [key, value] : it->items())
+      if (!object.contains(key))
+        entries[key] = value.is_string() ? value.get<std::string>() : value.dump();
   for (const auto& [key, value] : object.items())
     entries[key] = value.is_string() ? value.get<std::string>() : value.dump();
 }

@@ -5,7 +5,9 @@
 // Two sources, later ones overriding earlier ones key by key:
 //   1. <folder>/sidecar.json  {"defaults": {...}, "images": {"<file name>": {...}}}
 //   2. <image file name>.json {...}   (e.g. part_0001.png.json)
-// Top-level keys become metadata entries: strings as they are, other JSON values as JSON text.
+// Top-level keys become metadata entries: strings as they are, other JSON values as JSON text;
+// so do the keys of an "annotations" object (the scene generator's sidecars), unless a
+// top-level key has the same name.
 
 #include <filesystem>
 #include <map>

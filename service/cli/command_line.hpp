@@ -40,5 +40,6 @@ void addModelCommand(CLI::App& app);
 void addMatchCommand(CLI::App& app);
 void addRegisterCommand(CLI::App& app);
 void addRecipeCommand(CLI::App& app);
+void addReplayCommand(CLI::App& app);
 
 }  // namespace facet::cli

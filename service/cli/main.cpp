@@ -26,6 +26,7 @@ int main(int argc, char** argv) {
   addMatchCommand(app);
   addRegisterCommand(app);
   addRecipeCommand(app);
+  addReplayCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";

@@ -4,6 +4,7 @@
 #include <csignal>
 #include <fstream>
 #include <iostream>
+#include <thread>
 
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
@@ -20,8 +21,9 @@ using namespace std::chrono_literals;
 std::string partLine(const service::PartResult& p) {
   std::string line = "part " + std::to_string(p.partId) + "  recipe " + std::to_string(p.recipeId) +
                      " " + p.recipeName + "  " + service::verdictName(p.verdict);
-  if (p.verdict == service::Verdict::Error) return line + "  (" + p.error + ")";
-  for (const auto& m : p.measurements) {
+  if (p.verdict == service::Verdict::Error) line += "  (" + p.error + ")";
+  for (const auto& m : p.verdict == service::Verdict::Error ? std::vector<service::Measurement>{}
+                                                            : p.measurements) {
     char buf[96];
     std::snprintf(buf, sizeof buf, "  %s=%.4g%s%s", m.name.c_str(), m.value,
                   m.unit == "score" || m.unit == "count" ? "" : (" " + m.unit).c_str(),
@@ -105,8 +107,9 @@ int main(int argc, char** argv) {
   options.maxParts = maxParts;
   options.stopAtEndOfStream = exitAtEnd || !replayFolder.empty();
   options.usePlc = !noPlc;
-  options.overflow =
-      blockWhenBehind ? service::OverflowPolicy::Block : service::OverflowPolicy::DropOldest;
+  // A replayed folder can wait for the inspection: nothing is dropped.
+  options.overflow = blockWhenBehind || !replayFolder.empty() ? service::OverflowPolicy::Block
+                                                              : service::OverflowPolicy::DropOldest;
   if (printParts) {
     options.onPart = [&](const service::PartResult& p) {
       ++counts[service::verdictName(p.verdict)];
@@ -126,7 +129,12 @@ int main(int argc, char** argv) {
     spdlog::info("http listening on {}:{}", httpConfig.bind, http.port());
     if (!portFile.empty()) std::ofstream(portFile) << http.port() << "\n";
     station.start();
-    systemd.ready("inspecting");
+    // READY once camera and PLC are up; a PLC still unreachable after a few seconds does not
+    // hold the service back (parts are queued for it), the status says so.
+    const auto readyDeadline = std::chrono::steady_clock::now() + 5s;
+    while (!station.plcConnected() && std::chrono::steady_clock::now() < readyDeadline)
+      std::this_thread::sleep_for(20ms);
+    systemd.ready(station.plcConnected() ? "inspecting" : "inspecting; PLC not connected");
 
     const timespec tick{0, 200'000'000};
     auto lastChangeCheck = std::chrono::steady_clock::now();

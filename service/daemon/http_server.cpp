@@ -4,6 +4,7 @@
 
 #include <stdexcept>
 
+#include "service/daemon/dashboard_assets.hpp"
 #include "service/daemon/results_store.hpp"
 
 namespace facet::service {
@@ -100,6 +101,19 @@ void HttpServer::routes() {
            const auto outcome = station_.resetCounters();
            sendJson(res, {{"ok", outcome.ok}, {"message", outcome.message}});
          });
+  // The dashboard compiled into the binary; a configured dashboardDir is served first (its
+  // files override these, e.g. while working on the page).
+  auto sendAsset = [](const DashboardAsset* asset, httplib::Response& res) {
+    if (!asset) return sendJson(res, {{"error", "no such dashboard file"}}, 404);
+    res.set_content(std::string(asset->body), std::string(asset->contentType).c_str());
+  };
+  s.Get("/", [sendAsset](const httplib::Request&, httplib::Response& res) {
+    sendAsset(findDashboardAsset("index.html"), res);
+  });
+  s.Get("/dashboard/([A-Za-z0-9_.-]+)",
+        [sendAsset](const httplib::Request& req, httplib::Response& res) {
+          sendAsset(findDashboardAsset(req.matches[1].str()), res);
+        });
   if (!settings_.dashboardDir.empty()) s.set_mount_point("/", settings_.dashboardDir.string());
 }
 

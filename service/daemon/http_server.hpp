@@ -8,7 +8,9 @@
 //   GET  /api/summary      shift counters, recent parts, recipe
 //   POST /api/recipe       {"id": n}      switch recipe      } only when a token is configured,
 //   POST /api/counters/reset               reset counters     } with "Authorization: Bearer
-//   <token>" GET  /                 the dashboard (files from `dashboardDir`, all served locally)
+//   <token>"
+//   GET  /, /dashboard/*   the dashboard, compiled in (dashboard_assets.hpp); files in
+//                          `dashboardDir` take precedence when it is set
 
 #include <filesystem>
 #include <memory>

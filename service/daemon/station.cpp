@@ -85,6 +85,7 @@ Station::Station(config::StationConfig config, StationOptions options)
       publishQueue_(options_.publishQueue, OverflowPolicy::Block) {
   store_ = std::make_unique<ResultsStore>(config_.results.database);
   nextPartId_ = store_->lastPartId() + 1;
+  firstPartId_ = nextPartId_;
   if (!config_.archive.folder.empty())
     archive_ = std::make_unique<ImageArchive>(archivePolicy(config_.archive));
 
@@ -425,72 +426,90 @@ void Station::publishNotInspected(Job job, const std::string& cause) {
 }
 
 void Station::publishingLoop() {
+  // Parts are published strictly in part-id order: a part that was not inspected (missed,
+  // incomplete frame) skips the inspection stage and must not overtake the parts before it.
+  // Every id the acquisition takes reaches this stage exactly once, so waiting is bounded.
+  std::map<std::uint64_t, std::unique_ptr<Job>> waiting;
+  std::uint64_t next = firstPartId_;
+  auto publishReady = [&](bool all) {
+    while (!waiting.empty() && (all || waiting.begin()->first == next)) {
+      auto job = std::move(waiting.begin()->second);
+      waiting.erase(waiting.begin());
+      next = job->partId + 1;
+      publishPart(*job);
+    }
+  };
   while (true) {
     auto job = publishQueue_.pop(100ms);
     if (!job) {
       if (publishQueue_.closed() && publishQueue_.size() == 0) break;
       continue;
     }
-    Job& j = **job;
-    PartResult& p = j.result;
-    p.partId = j.partId;
-    p.time = std::chrono::system_clock::now();
-    if (j.inspection) {
-      const auto& recipe = j.inspection->recipe();
-      p.recipeId = recipe.id;
-      p.recipeName = recipe.name;
-      p.recipeVersion = recipe.contentHash;
-    }
-    p.frameId = j.frame.id;
-    p.source = j.frame.source;
-    p.serial = sidecarValue(j.frame.metadata, "serial");
-    p.expectedVerdict = sidecarValue(j.frame.metadata, "expected_verdict");
-    const auto t0 = Clock::now();
-    // 1. The PLC first: it is what the line waits for.
-    if (plc_) {
-      plc::InspectionResult r;
-      r.partId = std::to_string(p.partId);
-      r.pass = p.verdict == Verdict::Pass;
-      for (const auto& m : p.measurements) r.values[m.name] = m.value;
-      r.onlyGivenValues = true;  // other recipes' outputs keep their registers
-      r.errorCode = p.verdict == Verdict::Error ? 1 : 0;
-      r.triggerSequence = j.trigger ? j.trigger->sequence : 0;
-      if (!plc_->publish(std::move(r)))
-        spdlog::error("part {} recipe {}: result not delivered to the PLC (queue full)", p.partId,
-                      p.recipeId);
-    }
-    // 2. The results store: a part that cannot be stored is counted and logged, never silent.
-    try {
-      std::lock_guard lock(storeMutex_);
-      store_->store(p);
-    } catch (const std::exception& e) {
-      metrics_.counter("facet_store_errors_total", "Parts that could not be stored").increment();
-      spdlog::error("part {} recipe {}: not stored: {}", p.partId, p.recipeId, e.what());
-      std::lock_guard lock(recentMutex_);
-      lastStoreError_ = e.what();
-    }
-    publish(p, j.frame.image, j.overlay);
-    const double publishMs = msSince(t0);
-    metrics_
-        .histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"publish\"")
-        .observe(publishMs);
-    metrics_.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"total\"")
-        .observe(msSince(j.acquiredAt));
-    metrics_
-        .counter("facet_parts_total", "Parts by verdict",
-                 std::string("verdict=\"") + verdictName(p.verdict) + "\"")
-        .increment();
-    metrics_.gauge("facet_queue_depth", "Items waiting per queue", "queue=\"publish\"")
-        .set(static_cast<double>(publishQueue_.size()));
-    if (p.verdict == Verdict::Error)
-      spdlog::warn("part={} recipe={} verdict=error cause=\"{}\"", p.partId, p.recipeId, p.error);
-    else
-      spdlog::info("part={} recipe={} verdict={} inspect_ms={:.2f}{}", p.partId, p.recipeId,
-                   verdictName(p.verdict), p.inspectionMs,
-                   p.failedChecks.empty() ? "" : " failed=" + p.failedChecks.front());
-    if (options_.onPart) options_.onPart(p);
+    const std::uint64_t id = (*job)->partId;
+    waiting.emplace(id, std::move(*job));
+    publishReady(false);
   }
+  publishReady(true);
   drained_ = true;
+}
+
+void Station::publishPart(Job& j) {
+  PartResult& p = j.result;
+  p.partId = j.partId;
+  p.time = std::chrono::system_clock::now();
+  if (j.inspection) {
+    const auto& recipe = j.inspection->recipe();
+    p.recipeId = recipe.id;
+    p.recipeName = recipe.name;
+    p.recipeVersion = recipe.contentHash;
+  }
+  p.frameId = j.frame.id;
+  p.source = j.frame.source;
+  p.serial = sidecarValue(j.frame.metadata, "serial");
+  p.expectedVerdict = sidecarValue(j.frame.metadata, "expected_verdict");
+  const auto t0 = Clock::now();
+  // 1. The PLC first: it is what the line waits for.
+  if (plc_) {
+    plc::InspectionResult r;
+    r.partId = std::to_string(p.partId);
+    r.pass = p.verdict == Verdict::Pass;
+    for (const auto& m : p.measurements) r.values[m.name] = m.value;
+    r.onlyGivenValues = true;  // other recipes' outputs keep their registers
+    r.errorCode = p.verdict == Verdict::Error ? 1 : 0;
+    r.triggerSequence = j.trigger ? j.trigger->sequence : 0;
+    if (!plc_->publish(std::move(r)))
+      spdlog::error("part {} recipe {}: result not delivered to the PLC (queue full)", p.partId,
+                    p.recipeId);
+  }
+  // 2. The results store: a part that cannot be stored is counted and logged, never silent.
+  try {
+    std::lock_guard lock(storeMutex_);
+    store_->store(p);
+  } catch (const std::exception& e) {
+    metrics_.counter("facet_store_errors_total", "Parts that could not be stored").increment();
+    spdlog::error("part {} recipe {}: not stored: {}", p.partId, p.recipeId, e.what());
+    std::lock_guard lock(recentMutex_);
+    lastStoreError_ = e.what();
+  }
+  publish(p, j.frame.image, j.overlay);
+  const double publishMs = msSince(t0);
+  metrics_.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"publish\"")
+      .observe(publishMs);
+  metrics_.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"total\"")
+      .observe(msSince(j.acquiredAt));
+  metrics_
+      .counter("facet_parts_total", "Parts by verdict",
+               std::string("verdict=\"") + verdictName(p.verdict) + "\"")
+      .increment();
+  metrics_.gauge("facet_queue_depth", "Items waiting per queue", "queue=\"publish\"")
+      .set(static_cast<double>(publishQueue_.size()));
+  if (p.verdict == Verdict::Error)
+    spdlog::warn("part={} recipe={} verdict=error cause=\"{}\"", p.partId, p.recipeId, p.error);
+  else
+    spdlog::info("part={} recipe={} verdict={} inspect_ms={:.2f}{}", p.partId, p.recipeId,
+                 verdictName(p.verdict), p.inspectionMs,
+                 p.failedChecks.empty() ? "" : " failed=" + p.failedChecks.front());
+  if (options_.onPart) options_.onPart(p);
 }
 
 void Station::publish(PartResult part, const cv::Mat& image, const Overlay& overlay) {

@@ -72,6 +72,8 @@ class Station : public StationView {
   [[nodiscard]] bool recipesChangedOnDisk() const { return library_.changedOnDisk(); }
   // Liveness of the acquisition and inspection loops (for the systemd watchdog).
   [[nodiscard]] bool loopsAlive(std::chrono::milliseconds within) const;
+  // Whether the PLC link is connected (true when the station runs without a PLC).
+  [[nodiscard]] bool plcConnected() const { return !plc_ || plc_->stats().connected; }
 
   // StationView
   [[nodiscard]] nlohmann::json health() const override;
@@ -92,6 +94,7 @@ class Station : public StationView {
   void acquisitionLoop();
   void inspectionLoop();
   void publishingLoop();
+  void publishPart(Job& job);
   std::shared_ptr<const RecipeInspection> inspectionFor(int recipeId, std::string* error);
   std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
                                                         const plc::TriggerEvent* trigger);
@@ -124,6 +127,7 @@ class Station : public StationView {
   std::atomic<bool> drained_{false};
   bool scansEnded_ = false;  // the scan replay has delivered every file (acquisition thread)
   std::atomic<std::uint64_t> nextPartId_{1};
+  std::uint64_t firstPartId_ = 1;  // the first id of this run (the store may hold older ones)
   std::atomic<std::uint64_t> partsTaken_{0};
   std::atomic<std::int64_t> acquisitionBeat_{0}, inspectionBeat_{0};
   std::thread acquisition_, inspection_, publishing_;

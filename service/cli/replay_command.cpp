@@ -1,0 +1,222 @@
+// facet replay: runs one recipe over a recorded folder (the camera's replay backend, so sidecar
+// files give each part its serial and expected verdict) and writes the HTML replay report.
+#include <chrono>
+#include <ctime>
+#include <fstream>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "camera/camera_factory.hpp"
+#include "config/recipe_loader.hpp"
+#include "config/station_config.hpp"
+#include "service/cli/command_line.hpp"
+#include "service/daemon/inspection.hpp"
+#include "service/daemon/overlay.hpp"
+#include "service/daemon/process_capability.hpp"
+#include "service/daemon/replay_report.hpp"
+
+namespace facet::cli {
+namespace {
+
+struct ReplayOptions {
+  std::string recipeFile;
+  std::string imagesFolder;
+  std::string reportFile;
+  std::string stationFile;
+  double mmPerPixel = 0;
+  std::string glob;
+  int thumbnailWidth = 320;
+  bool json = false;
+};
+
+std::string utcNow() {
+  const std::time_t t = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+// A sidecar value: top-level, or inside "annotations" as the scene recorder writes them
+// (recipes/demo/*/part_*.png.json), which the camera passes on as JSON text.
+std::string sidecarValue(const std::map<std::string, std::string>& metadata,
+                         const std::string& key) {
+  if (auto it = metadata.find(key); it != metadata.end()) return it->second;
+  if (auto it = metadata.find("annotations"); it != metadata.end()) {
+    const auto annotations = nlohmann::json::parse(it->second, nullptr, false);
+    if (annotations.is_object() && annotations.contains(key) && annotations[key].is_string())
+      return annotations[key].get<std::string>();
+  }
+  return {};
+}
+
+std::vector<unsigned char> thumbnail(const cv::Mat& image, const service::InspectionOutcome& o,
+                                     const std::string& banner, int width) {
+  cv::Mat picture =
+      service::drawOverlay(image, o.overlay, banner, o.verdict == service::Verdict::Pass);
+  if (picture.cols > width) {
+    const double scale = static_cast<double>(width) / picture.cols;
+    cv::resize(picture, picture, {}, scale, scale, cv::INTER_AREA);
+  }
+  std::vector<unsigned char> png;
+  cv::imencode(".png", picture, png);
+  return png;
+}
+
+void runReplay(const ReplayOptions& opt) {
+  // The camera module logs through spdlog, whose default logger writes to stdout: keep stdout
+  // for the one JSON object.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("facet-replay"));
+  // Calibration and recipe root come from the station when one is given.
+  config::RecipeLoadOptions loadOptions;
+  double mmPerPixel = opt.mmPerPixel;
+  if (!opt.stationFile.empty()) {
+    const auto station = config::loadStationConfig(opt.stationFile);
+    if (!station.station)
+      throw InputError(station.diagnostics.text() + opt.stationFile +
+                       ": station config has errors");
+    loadOptions = station.station->recipeLoadOptions();
+    if (mmPerPixel <= 0) mmPerPixel = station.station->calibration.mmPerPixel;
+  }
+  if (mmPerPixel <= 0)
+    throw InputError("replay: give --station (for its calibration) or --mm-per-pixel > 0");
+  const auto loaded = config::loadRecipe(opt.recipeFile, loadOptions);
+  if (!loaded.recipe)
+    throw InputError(loaded.diagnostics.text() + opt.recipeFile + ": recipe has errors");
+  std::unique_ptr<service::RecipeInspection> inspection;
+  try {
+    inspection = std::make_unique<service::RecipeInspection>(
+        std::make_shared<const config::Recipe>(*loaded.recipe), mmPerPixel);
+  } catch (const service::InspectionSetupError& e) {
+    throw InputError(opt.recipeFile + ": " + e.what());
+  }
+
+  CameraSettings settings;
+  settings.backend = CameraBackend::Replay;
+  settings.replay.folder = opt.imagesFolder;
+  settings.replay.glob = opt.glob;
+  settings.replay.loop = false;
+  settings.replay.trigger = TriggerMode::FreeRun;
+  std::unique_ptr<Camera> camera;
+  try {
+    camera = makeCamera(settings);
+    camera->open();
+    camera->start();
+  } catch (const std::exception& e) {
+    throw InputError(opt.imagesFolder + ": " + e.what());
+  }
+
+  // Checked once recipe and folder are fine, before spending time on the folder.
+  std::ofstream out(opt.reportFile);
+  if (!out) throw InputError(opt.reportFile + ": cannot write the report");
+
+  service::ReplayReport report;
+  report.title = "recipe " + std::to_string(loaded.recipe->id) + " " + loaded.recipe->name;
+  report.recipeFile = opt.recipeFile;
+  report.imagesFolder = opt.imagesFolder;
+  report.mmPerPixel = mmPerPixel;
+  report.generatedAt = utcNow();
+  for (std::uint64_t partId = 1;; ++partId) {
+    auto grab = camera->grab(std::chrono::milliseconds(5000));
+    if (grab.status == GrabStatus::EndOfStream) break;
+    service::ReplayedPart part;
+    service::PartResult& p = part.result;
+    p.partId = partId;
+    p.time = std::chrono::system_clock::now();
+    p.recipeId = loaded.recipe->id;
+    p.recipeName = loaded.recipe->name;
+    p.recipeVersion = loaded.recipe->contentHash;
+    p.frameId = grab.frame.id;
+    p.source = grab.frame.source;
+    p.serial = sidecarValue(grab.frame.metadata, "serial");
+    p.expectedVerdict = sidecarValue(grab.frame.metadata, "expected_verdict");
+    if (!grab.ok()) {
+      // A file the replay could not use is a part that was not inspected.
+      p.verdict = service::Verdict::Error;
+      p.error = std::string(toString(grab.status)) + ": " + grab.message;
+      if (grab.status == GrabStatus::Timeout || grab.status == GrabStatus::NotStarted) break;
+      report.parts.push_back(std::move(part));
+      continue;
+    }
+    const auto outcome = inspection->inspect({.image = grab.frame.image, .scan = std::nullopt});
+    p.verdict = outcome.verdict;
+    p.measurements = outcome.measurements;
+    p.failedChecks = outcome.failedChecks;
+    p.error = outcome.error;
+    p.timings = outcome.timings;
+    p.inspectionMs = outcome.totalMs;
+    if (p.verdict != service::Verdict::Pass) {
+      std::string banner = std::string(service::verdictName(p.verdict)) + "  " + p.serial;
+      if (!p.failedChecks.empty()) banner += "  " + p.failedChecks.front();
+      part.thumbnailPng = thumbnail(grab.frame.image, outcome, banner, opt.thumbnailWidth);
+    }
+    report.parts.push_back(std::move(part));
+  }
+  camera->stop();
+  camera->close();
+  if (report.parts.empty()) throw InputError(opt.imagesFolder + ": no image to replay");
+
+  service::writeReplayReport(report, out);
+  out.close();
+  if (!out) throw InputError(opt.reportFile + ": writing the report failed");
+
+  std::map<std::string, int> counts{{"pass", 0}, {"fail", 0}, {"error", 0}};
+  int unexpected = 0;
+  std::vector<service::PartResult> results;
+  for (const auto& part : report.parts) {
+    ++counts[service::verdictName(part.result.verdict)];
+    unexpected += service::verdictUnexpected(part.result) ? 1 : 0;
+    results.push_back(part.result);
+  }
+  const auto caps = service::processCapability(results);
+  if (opt.json) {
+    nlohmann::json capability = nlohmann::json::array();
+    for (const auto& c : caps) {
+      nlohmann::json j{
+          {"name", c.name}, {"unit", c.unit}, {"n", c.count}, {"mean", c.mean}, {"sigma", c.sigma}};
+      j["cp"] = c.cp ? nlohmann::json(*c.cp) : nullptr;
+      j["cpk"] = c.cpk ? nlohmann::json(*c.cpk) : nullptr;
+      capability.push_back(j);
+    }
+    printJson({{"recipe", {{"id", loaded.recipe->id}, {"name", loaded.recipe->name}}},
+               {"images", report.parts.size()},
+               {"counts", counts},
+               {"unexpected", unexpected},
+               {"capability", capability},
+               {"report", opt.reportFile}});
+    return;
+  }
+  std::cout << report.title << ": " << report.parts.size() << " parts, pass " << counts["pass"]
+            << ", fail " << counts["fail"] << ", error " << counts["error"] << ", unexpected "
+            << unexpected << "\nreport: " << opt.reportFile << "\n";
+}
+
+}  // namespace
+
+void addReplayCommand(CLI::App& app) {
+  auto opt = std::make_shared<ReplayOptions>();
+  auto* cmd =
+      app.add_subcommand("replay", "Run a recipe over a recorded folder and write an HTML report");
+  cmd->add_option("--recipe", opt->recipeFile, "Recipe file (YAML)")->required();
+  cmd->add_option("--images", opt->imagesFolder, "Folder of recorded images (with sidecars)")
+      ->required();
+  cmd->add_option("--report", opt->reportFile, "HTML report to write")->required();
+  cmd->add_option("--station", opt->stationFile,
+                  "Station config: calibration, recipe root and registers");
+  cmd->add_option("--mm-per-pixel", opt->mmPerPixel,
+                  "Calibration when no station is given (overrides the station's)");
+  cmd->add_option("--glob", opt->glob, "File-name pattern in the folder (default: every image)");
+  cmd->add_option("--thumbnail-width", opt->thumbnailWidth, "Width of failed-part thumbnails, px")
+      ->check(CLI::Range(32, 4096));
+  cmd->add_flag("--json", opt->json, "Print a summary as one JSON object");
+  cmd->callback([opt] { runReplay(*opt); });
+}
+
+}  // namespace facet::cli

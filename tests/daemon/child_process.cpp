@@ -1,0 +1,126 @@
+#include "tests/daemon/child_process.hpp"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <stdexcept>
+
+namespace facet::daemon_test {
+
+ChildProcess::ChildProcess(std::vector<std::string> argv,
+                           std::map<std::string, std::string> environment, std::string stderrFile) {
+  int out[2];
+  if (::pipe2(out, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
+  ::signal(SIGPIPE, SIG_IGN);
+  pid_ = ::fork();
+  if (pid_ < 0) throw std::runtime_error("fork failed");
+  if (pid_ == 0) {
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // a crashed test leaves no camera or daemon behind
+    ::dup2(out[1], STDOUT_FILENO);
+    if (!stderrFile.empty()) {
+      const int fd = ::open(stderrFile.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
+      if (fd >= 0) ::dup2(fd, STDERR_FILENO);
+    }
+    // The test's blocked signals must not stay blocked in the child.
+    sigset_t none;
+    sigemptyset(&none);
+    ::sigprocmask(SIG_SETMASK, &none, nullptr);
+    for (const auto& [key, value] : environment) ::setenv(key.c_str(), value.c_str(), 1);
+    std::vector<char*> args;
+    for (auto& a : argv) args.push_back(a.data());
+    args.push_back(nullptr);
+    ::execv(args[0], args.data());
+    std::perror(args[0]);
+    ::_exit(127);
+  }
+  ::close(out[1]);
+  reader_ = std::thread([this, fd = out[0]] { readLoop(fd); });
+}
+
+ChildProcess::~ChildProcess() {
+  if (!exitCode_) {
+    ::kill(pid_, SIGKILL);
+    wait(std::chrono::seconds(10));
+  }
+  if (reader_.joinable()) reader_.join();
+}
+
+void ChildProcess::signal(int sig) const {
+  if (!exitCode_) ::kill(pid_, sig);
+}
+
+std::optional<int> ChildProcess::wait(std::chrono::milliseconds timeout) {
+  if (exitCode_) return exitCode_;
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    int status = 0;
+    const pid_t r = ::waitpid(pid_, &status, WNOHANG);
+    if (r == pid_) {
+      exitCode_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      return exitCode_;
+    }
+    if (std::chrono::steady_clock::now() > until) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+}
+
+std::optional<std::string> ChildProcess::waitForLine(
+    const std::function<bool(const std::string&)>& match, std::chrono::milliseconds timeout) {
+  std::unique_lock lock(mutex_);
+  std::size_t checked = 0;
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    for (; checked < lines_.size(); ++checked)
+      if (match(lines_[checked])) return lines_[checked];
+    if (eof_) return std::nullopt;
+    if (changed_.wait_until(lock, until) == std::cv_status::timeout) {
+      for (; checked < lines_.size(); ++checked)
+        if (match(lines_[checked])) return lines_[checked];
+      return std::nullopt;
+    }
+  }
+}
+
+std::vector<std::string> ChildProcess::lines() const {
+  std::lock_guard lock(mutex_);
+  return lines_;
+}
+
+void ChildProcess::readLoop(int fd) {
+  std::string pending;
+  char buf[4096];
+  while (true) {
+    const ssize_t n = ::read(fd, buf, sizeof buf);
+    if (n <= 0) break;
+    pending.append(buf, static_cast<std::size_t>(n));
+    std::size_t end;
+    while ((end = pending.find('\n')) != std::string::npos) {
+      std::lock_guard lock(mutex_);
+      lines_.push_back(pending.substr(0, end));
+      pending.erase(0, end + 1);
+      changed_.notify_all();
+    }
+  }
+  ::close(fd);
+  std::lock_guard lock(mutex_);
+  eof_ = true;
+  changed_.notify_all();
+}
+
+TempDir::TempDir() {
+  char name[] = "/tmp/facet-daemon-test-XXXXXX";
+  if (!::mkdtemp(name)) throw std::runtime_error("mkdtemp failed");
+  path_ = name;
+}
+
+TempDir::~TempDir() {
+  std::error_code ignored;
+  if (!std::getenv("FACET_KEEP_TEST_DIRS")) std::filesystem::remove_all(path_, ignored);
+}
+
+}  // namespace facet::daemon_test

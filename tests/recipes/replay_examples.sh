@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Every example recipe, replayed by facetd over its recorded demo folder, must give the verdict
+# recorded with each image (the sidecars' expected_verdict), and every image must be inspected.
+#   replay_examples.sh FACETD
+set -euo pipefail
+facetd=$1
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+# The example station, with the results and archive in a private folder and no fixed HTTP port.
+sed -e "s#/tmp/facet-demo-results.db#$work/results.db#" -e "s#/tmp/facet-demo-archive#$work/archive#" \
+    -e 's/port: 8080/port: 0/' recipes/station.yaml > recipes/.station-under-test.yaml
+trap 'rm -rf "$work" recipes/.station-under-test.yaml' EXIT
+status=0
+for run in 1:bracket_registration 2:bracket_shape 3:fiducial_board 4:scan_offset; do
+  id=${run%%:*}
+  folder=recipes/demo/${run#*:}
+  files=$(find "$folder" -maxdepth 1 \( -name '*.png' -o -name '*.csv' \) | wc -l)
+  summary=$("$facetd" --config recipes/.station-under-test.yaml --no-plc --recipe "$id" \
+              --replay "$folder" --print-parts | tee "$work/recipe-$id.log" | grep '^summary:')
+  inspected=$(grep -c '^part .* \(pass\|fail\) ' "$work/recipe-$id.log" || true)
+  echo "recipe $id ($folder, $files files): $summary; inspected $inspected"
+  if ! grep -q ' unexpected=0$' <<<"$summary"; then
+    echo "FAIL: recipe $id gave verdicts other than the recorded ones:"; grep UNEXPECTED "$work/recipe-$id.log" || true
+    status=1
+  fi
+  if [ "$inspected" -ne "$files" ]; then
+    echo "FAIL: recipe $id inspected $inspected of $files files"; status=1
+  fi
+done
+exit $status
