@@ -71,6 +71,11 @@ void ImageArchive::enforceQuota() {
 
 std::optional<ArchivedPart> ImageArchive::archive(const PartResult& part, const cv::Mat& raw,
                                                   const cv::Mat& overlay) {
+  return archive(part, raw, [&overlay] { return overlay; });
+}
+
+std::optional<ArchivedPart> ImageArchive::archive(const PartResult& part, const cv::Mat& raw,
+                                                  const std::function<cv::Mat()>& drawOverlay) {
   std::lock_guard lock(mutex_);
   if (!wanted(part) || raw.empty()) return std::nullopt;
   try {
@@ -85,7 +90,7 @@ std::optional<ArchivedPart> ImageArchive::archive(const PartResult& part, const 
         "part-" + std::to_string(part.partId) + "-" + verdictName(part.verdict);
     ArchivedPart out{dir / (stem + ".png"), dir / (stem + "-overlay.png")};
     writeFile(out.raw, raw);
-    if (!overlay.empty()) writeFile(out.overlay, overlay);
+    if (const cv::Mat overlay = drawOverlay(); !overlay.empty()) writeFile(out.overlay, overlay);
     enforceQuota();
     degraded_ = false;
     return out;

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <deque>
 #include <filesystem>
+#include <functional>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -37,6 +38,10 @@ class ImageArchive {
   // degraded (see degraded()) and nothing is returned.
   std::optional<ArchivedPart> archive(const PartResult& part, const cv::Mat& raw,
                                       const cv::Mat& overlay);
+  // The same, drawing the overlay picture only when the part is archived (drawing a large
+  // frame costs milliseconds that good, unarchived parts need not pay).
+  std::optional<ArchivedPart> archive(const PartResult& part, const cv::Mat& raw,
+                                      const std::function<cv::Mat()>& drawOverlay);
 
   [[nodiscard]] bool degraded() const;
   [[nodiscard]] std::string lastError() const;

@@ -35,12 +35,13 @@ using Clock = std::chrono::steady_clock;
 // What a step leaves for the checks and for later steps.
 struct StepResult {
   bool ok = true;
-  std::string cause;                      // why !ok
-  std::optional<cv::Matx33d> refToImage;  // pose steps: reference pixels -> live pixels
-  std::optional<cv::Point2d> point;       // a position in the live image
-  std::optional<double> angleDeg;         // an orientation in the live image
-  std::map<std::string, double> values;   // by check name; lengths in px (or mm, see below)
-  bool lengthsInMm = false;               // scan_align measures metric scans, not pixels
+  std::string cause;                        // why !ok
+  std::optional<cv::Matx33d> refToImage;    // pose steps: reference pixels -> live pixels
+  std::optional<cv::Rect2d> referenceView;  // pose steps: the reference's extent, its pixels
+  std::optional<cv::Point2d> point;         // a position in the live image
+  std::optional<double> angleDeg;           // an orientation in the live image
+  std::map<std::string, double> values;     // by check name; lengths in px (or mm, see below)
+  bool lengthsInMm = false;                 // scan_align measures metric scans, not pixels
 };
 
 StepResult failed(std::string cause) {
@@ -174,11 +175,10 @@ class StepRunner {
       if (matches.empty())
         return failed("part not found (no match above min score " + std::to_string(a.minScore) +
                       ")");
-      Pose2D pose = matches[0].pose();
-      pose.x += search.x, pose.y += search.y;
       const cv::Point2d home = res_.modelHomes.at(step.id);
       r.refToImage = translation(cv::Point2d(search.tl())) * poseMap(matches[0].pose(), home);
       r.values["score"] = matches[0].score;
+      r.referenceView = cv::Rect2d(home - model.referencePoint, cv::Size2d(model.templateSize));
       drawContour(matches[0].contour, search.tl(), true);
       return withPoseValues(std::move(r), home);
     }
@@ -191,6 +191,7 @@ class StepRunner {
     const RegistrationResult reg = registerImages(ref, live, params);
     if (!reg.ok) return failed("alignment failed: " + reg.failureCause);
     r.refToImage = translation(cv::Point2d(search.tl())) * reg.H;
+    r.referenceView = cv::Rect2d(region);
     r.values["score"] =
         reg.matches.empty() ? 0.0 : static_cast<double>(reg.inliers.size()) / reg.matches.size();
     std::vector<cv::Point2d> outline;
@@ -261,12 +262,27 @@ class StepRunner {
 
   StepResult shape(const Step& step, const std::map<std::string, StepResult>& done) {
     const auto& s = step.as<config::ShapeStep>();
-    const cv::Rect search = clampRect(s.searchRegion, grey_.size());
+    cv::Rect search = clampRect(s.searchRegion, grey_.size());
+    config::AngleRange angles = s.angleRange;
+    if (s.relativeTo) {
+      // Relative to an earlier pose: search only where that step's reference view lies in the
+      // live image, with the angle range turned by that step's rotation.
+      const StepResult& base = done.at(*s.relativeTo);
+      if (base.referenceView) {
+        std::vector<cv::Point2f> mapped;
+        for (const auto& c : corners(cv::Rect(*base.referenceView)))
+          mapped.emplace_back(apply(*base.refToImage, c));
+        const int margin = 8;
+        search &=
+            cv::boundingRect(mapped) + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin);
+      }
+      if (base.angleDeg) angles = {angles.low + *base.angleDeg, angles.high + *base.angleDeg};
+    }
     if (search.empty()) return failed("search region outside the image");
     overlay_.polygon(corners(search), true, true);
     const auto& model = res_.models.at(step.id);
-    const auto matches = findShapeModel(
-        grey_(search), model, findParams(s.minScore, s.numMatches, s.maxOverlap, s.angleRange));
+    const auto matches = findShapeModel(grey_(search), model,
+                                        findParams(s.minScore, s.numMatches, s.maxOverlap, angles));
     StepResult r;
     r.values["count"] = static_cast<double>(matches.size());
     for (const auto& m : matches) drawContour(m.contour, search.tl(), true);
@@ -286,6 +302,7 @@ class StepRunner {
     r.values["angle"] = *r.angleDeg;
     r.values["score"] = best.score;
     r.refToImage = translation(cv::Point2d(search.tl())) * poseMap(best.pose(), home);
+    r.referenceView = cv::Rect2d(home - model.referencePoint, cv::Size2d(model.templateSize));
     r.point = at;
     overlay_.cross(at, 8, true);
     return r;

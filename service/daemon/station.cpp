@@ -513,21 +513,23 @@ void Station::publishPart(Job& j) {
 }
 
 void Station::publish(PartResult part, const cv::Mat& image, const Overlay& overlay) {
-  cv::Mat picture;
+  LastPicture last;
   if (!image.empty()) {
-    std::string banner = "part " + std::to_string(part.partId) + "  " + verdictName(part.verdict);
-    if (!part.failedChecks.empty()) banner += "  " + part.failedChecks.front();
-    if (part.verdict == Verdict::Error) banner += "  " + part.error;
-    picture = drawOverlay(image, overlay, banner, part.verdict == Verdict::Pass);
+    last.image = image;
+    last.overlay = overlay;
+    last.banner = "part " + std::to_string(part.partId) + "  " + verdictName(part.verdict);
+    if (!part.failedChecks.empty()) last.banner += "  " + part.failedChecks.front();
+    if (part.verdict == Verdict::Error) last.banner += "  " + part.error;
+    last.pass = part.verdict == Verdict::Pass;
+    if (archive_) archive_->archive(part, image, [&last] { return last.draw(); });
   }
-  if (archive_ && !image.empty()) archive_->archive(part, image, picture);
   metrics_.gauge("facet_archive_degraded", "1 while the image archive cannot write")
       .set(archive_ && archive_->degraded() ? 1 : 0);
   std::lock_guard lock(recentMutex_);
   ++shiftCounts_[verdictName(part.verdict)];
   recent_.push_back(std::move(part));
   while (recent_.size() > 200) recent_.pop_front();
-  if (!picture.empty()) lastOverlay_ = picture;
+  if (!last.image.empty()) lastPicture_ = std::move(last);
 }
 
 config::ReloadReport Station::reloadRecipes() {
@@ -631,13 +633,13 @@ std::vector<PartResult> Station::storedParts(std::uint64_t afterPartId, std::siz
 }
 
 std::vector<unsigned char> Station::lastOverlayPng() const {
-  cv::Mat picture;
+  LastPicture last;
   {
     std::lock_guard lock(recentMutex_);
-    picture = lastOverlay_;
+    last = lastPicture_;
   }
   std::vector<unsigned char> png;
-  if (!picture.empty()) cv::imencode(".png", picture, png);
+  if (!last.image.empty()) cv::imencode(".png", last.draw(), png);
   return png;
 }
 

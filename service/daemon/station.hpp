@@ -134,7 +134,15 @@ class Station : public StationView {
 
   mutable std::mutex recentMutex_;
   std::deque<PartResult> recent_;
-  cv::Mat lastOverlay_;
+  // The last inspected image and what to draw on it; drawn when asked for (/api/last.png).
+  struct LastPicture {
+    cv::Mat image;
+    Overlay overlay;
+    std::string banner;
+    bool pass = false;
+    [[nodiscard]] cv::Mat draw() const { return drawOverlay(image, overlay, banner, pass); }
+  };
+  LastPicture lastPicture_;
   std::map<std::string, std::uint64_t> shiftCounts_;
   std::string lastStoreError_;
 };
