@@ -44,19 +44,6 @@ std::string utcNow() {
   return buf;
 }
 
-// A sidecar value: top-level, or inside "annotations" as the scene recorder writes them
-// (recipes/demo/*/part_*.png.json), which the camera passes on as JSON text.
-std::string sidecarValue(const std::map<std::string, std::string>& metadata,
-                         const std::string& key) {
-  if (auto it = metadata.find(key); it != metadata.end()) return it->second;
-  if (auto it = metadata.find("annotations"); it != metadata.end()) {
-    const auto annotations = nlohmann::json::parse(it->second, nullptr, false);
-    if (annotations.is_object() && annotations.contains(key) && annotations[key].is_string())
-      return annotations[key].get<std::string>();
-  }
-  return {};
-}
-
 std::vector<unsigned char> thumbnail(const cv::Mat& image, const service::InspectionOutcome& o,
                                      const std::string& banner, int width) {
   cv::Mat picture =
@@ -135,8 +122,10 @@ void runReplay(const ReplayOptions& opt) {
     p.recipeVersion = loaded.recipe->contentHash;
     p.frameId = grab.frame.id;
     p.source = grab.frame.source;
-    p.serial = sidecarValue(grab.frame.metadata, "serial");
-    p.expectedVerdict = sidecarValue(grab.frame.metadata, "expected_verdict");
+    if (auto it = grab.frame.metadata.find("serial"); it != grab.frame.metadata.end())
+      p.serial = it->second;
+    if (auto it = grab.frame.metadata.find("expected_verdict"); it != grab.frame.metadata.end())
+      p.expectedVerdict = it->second;
     if (!grab.ok()) {
       // A file the replay could not use is a part that was not inspected.
       p.verdict = service::Verdict::Error;

@@ -55,19 +55,6 @@ plc::RegisterMap fullRegisterMap(
   return map;
 }
 
-// A sidecar value: a top-level key, or one under "annotations" (where the scene generator that
-// records test and demo folders keeps what it was told about the part).
-std::string sidecarValue(const std::map<std::string, std::string>& metadata,
-                         const std::string& key) {
-  if (auto it = metadata.find(key); it != metadata.end()) return it->second;
-  if (auto it = metadata.find("annotations"); it != metadata.end()) {
-    const auto annotations = nlohmann::json::parse(it->second, nullptr, false);
-    if (annotations.is_object() && annotations.contains(key) && annotations[key].is_string())
-      return annotations[key].get<std::string>();
-  }
-  return {};
-}
-
 // A recipe whose every step works on range scans needs no camera frame.
 bool scanOnly(const config::Recipe& recipe) {
   return !recipe.steps.empty() &&
@@ -465,8 +452,10 @@ void Station::publishPart(Job& j) {
   }
   p.frameId = j.frame.id;
   p.source = j.frame.source;
-  p.serial = sidecarValue(j.frame.metadata, "serial");
-  p.expectedVerdict = sidecarValue(j.frame.metadata, "expected_verdict");
+  if (auto it = j.frame.metadata.find("serial"); it != j.frame.metadata.end())
+    p.serial = it->second;
+  if (auto it = j.frame.metadata.find("expected_verdict"); it != j.frame.metadata.end())
+    p.expectedVerdict = it->second;
   const auto t0 = Clock::now();
   // 1. The PLC first: it is what the line waits for.
   if (plc_) {
