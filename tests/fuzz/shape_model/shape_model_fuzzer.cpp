@@ -2,7 +2,8 @@
 // The file's FNV-1a checksum would stop nearly every mutation at "checksum mismatch", so inputs
 // whose first byte is odd are taken as a payload and wrapped in a valid header and checksum
 // (reaching the payload parser); even ones are written as they are (testing the header checks).
-// Expected outcome for bad input: ShapeModelFileError. A model that loads must be usable.
+// Expected outcome for bad input: ShapeModelFileError. A model that loads must be usable: it is
+// searched for in a small image, which must end (libFuzzer's -timeout) without a sanitizer report.
 
 #include <array>
 #include <cstddef>
@@ -10,6 +11,10 @@
 #include <cstdlib>
 #include <vector>
 
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
@@ -54,6 +59,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   try {
     const facet::ShapeModel model = facet::loadShapeModel(file);
     if (model.empty() || model.levels.empty() || model.finePoints.empty()) std::abort();
+    static const cv::Mat image = [] {
+      cv::Mat m(40, 48, CV_8UC1, cv::Scalar(30));
+      cv::rectangle(m, {12, 10}, {34, 28}, cv::Scalar(220), cv::FILLED);
+      return m;
+    }();
+    facet::FindParams params;
+    params.minScore = 0.3;
+    (void)facet::findShapeModel(image, model, params);
   } catch (const facet::ShapeModelFileError&) {
   }
   return 0;
