@@ -11,6 +11,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "config/recipe_loader.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
