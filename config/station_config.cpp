@@ -11,6 +11,18 @@
 namespace facet::config {
 namespace {
 
+// Non-throwing file checks: a name too long for the file system, a loop of links or a folder
+// we may not read mean "not there", reported as such, never an exception out of the loader.
+bool isFile(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(p, ec);
+}
+
+bool isFolder(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_directory(p, ec);
+}
+
 // "file:line:column" as the PLC module writes origins and messages.
 SourceLocation parseOrigin(const std::string& origin) {
   static const std::regex pattern(R"(^(.*):(\d+):(\d+)$)");
@@ -76,7 +88,7 @@ class StationReader {
   }
   std::optional<std::filesystem::path> folderPath(const YAML::Node& n, const std::string& key) {
     const auto p = pathOf(n);
-    if (p && !std::filesystem::is_directory(*p)) {
+    if (p && !isFolder(*p)) {
       error(n, "'" + key + "' folder '" + n.Scalar() + "' does not exist (looked for " +
                    p->string() + ")");
       return std::nullopt;
@@ -200,7 +212,7 @@ class StationReader {
     const auto db = pathOf(r["database"]);
     if (!db) return;
     station_.results.database = *db;
-    if (!std::filesystem::is_directory(db->parent_path()))
+    if (!isFolder(db->parent_path()))
       error(r["database"],
             "the folder of 'database' (" + db->parent_path().string() + ") does not exist");
   }
@@ -213,7 +225,7 @@ class StationReader {
     s.keep = keep == "all"    ? ArchiveSettings::Keep::All
              : keep == "none" ? ArchiveSettings::Keep::None
                               : ArchiveSettings::Keep::Failed;
-    if (!s.folder.empty() && !std::filesystem::is_directory(s.folder.parent_path()))
+    if (!s.folder.empty() && !isFolder(s.folder.parent_path()))
       error(a["folder"], "the folder containing 'folder' (" + s.folder.parent_path().string() +
                              ") does not exist");
   }
@@ -224,7 +236,7 @@ class StationReader {
     if (c["file"]) {
       const auto p = pathOf(c["file"]);
       if (!p) return;
-      if (!std::filesystem::is_regular_file(*p)) {
+      if (!isFile(*p)) {
         error(c["file"], "calibration file '" + c["file"].Scalar() + "' does not exist");
         return;
       }

@@ -1,5 +1,5 @@
-// loadRecipe reports problems as diagnostics and never throws, whatever the YAML holds. Found by
-// the recipe fuzz target: reading a key that a mapping does not have (a PLC output without
+// loadRecipe reports problems as diagnostics and never throws, whatever the YAML holds. First
+// found by the recipe fuzz target: reading a key that a mapping does not have (a PLC output without
 // `factor`, a step without `kind`) threw yaml-cpp's InvalidNode out of loadRecipe, so the
 // example recipes themselves could not be loaded.
 
@@ -88,6 +88,18 @@ TEST_F(RecipeLoading, MissingKeysEverywhereGiveDiagnosticsNotExceptions) {
     EXPECT_FALSE(r.recipe.has_value()) << text;
     EXPECT_TRUE(r.diagnostics.hasErrors()) << text;
   }
+}
+
+// Found by the recipe fuzz target: std::filesystem::is_regular_file threw "File name too long"
+// out of loadRecipe (and out of loadStationConfig for a calibration file).
+TEST_F(RecipeLoading, FileNameTooLongIsReportedNotThrown) {
+  const std::string name = std::string(300, 'n') + ".png";
+  RecipeLoadResult r;
+  ASSERT_NO_THROW(r = load("schema_version: 1\nid: 1\nname: x\nsteps:\n  - id: part\n"
+                           "    kind: align\n    method: registration\n    reference: " +
+                           name + "\n"));
+  EXPECT_FALSE(r.recipe.has_value());
+  EXPECT_NE(r.diagnostics.text().find("does not exist"), std::string::npos) << r.diagnostics.text();
 }
 
 }  // namespace
