@@ -17,9 +17,9 @@ constexpr std::array<char, 8> kMagic = {'F', 'A', 'C', 'E', 'T', 'S', 'H', 'M'};
 constexpr std::size_t kHeaderSize = kMagic.size() + sizeof(std::uint32_t) + sizeof(std::uint64_t);
 constexpr std::uint32_t kMaxPoints = 10'000'000;  // far above any real model: guards bad counts
 constexpr std::uint32_t kMaxLevels = 16;
-constexpr int kMaxTemplateSide = 1 << 16;   // pixels
-constexpr double kMaxCoordinate = 1 << 17;  // pixels, |x| and |y| of model points
-constexpr double kMaxSearchSamples = 1e6;   // angle or scale steps per search range
+constexpr int kMaxTemplateSide = 1 << 14;  // pixels
+constexpr double kMaxScale = 10.0;         // the search's border grows with radius * scale
+constexpr double kMaxSearchSamples = 1e6;  // angle or scale steps per search range
 
 std::uint64_t fnv1a(const char* data, std::size_t size) {
   std::uint64_t h = 14695981039346656037ull;
@@ -89,9 +89,11 @@ bool finitePoint(const cv::Point2f& p, double limit) {
          std::abs(p.y) <= limit;
 }
 
-bool finitePoints(const std::vector<ShapePoint>& points) {
-  return std::all_of(points.begin(), points.end(), [](const ShapePoint& p) {
-    return finitePoint(p.position, kMaxCoordinate) && finitePoint(p.direction, 2.0);
+// Model points lie on the template, relative to the reference point: farther out than the
+// template's size from it is not a trained model.
+bool finitePoints(const std::vector<ShapePoint>& points, double extent) {
+  return std::all_of(points.begin(), points.end(), [extent](const ShapePoint& p) {
+    return finitePoint(p.position, extent) && finitePoint(p.direction, 2.0);
   });
 }
 
@@ -108,16 +110,19 @@ std::string implausibility(const ShapeModel& m) {
                    m.scaleMax, m.minContrast, m.contrastLow, m.contrastHigh})
     if (!std::isfinite(v)) return "a value is not a finite number";
   if (!(m.angleExtent >= 0.0 && m.angleExtent <= kTwoPi + 1e-6)) return "angle extent";
-  if (!(m.scaleMin > 0.0) || !(m.scaleMax >= m.scaleMin)) return "scale range";
+  if (!(m.scaleMin > 0.0) || !(m.scaleMax >= m.scaleMin) || m.scaleMax > kMaxScale)
+    return "scale range";
+  const double extent = m.templateSize.width + m.templateSize.height +
+                        std::abs(m.referencePoint.x) + std::abs(m.referencePoint.y);
   for (const auto& level : m.levels) {
     if (!(level.angleStep > 0.0) || !(kTwoPi / level.angleStep <= kMaxSearchSamples))
       return "angle step";
     if (!(level.scaleStep >= 0.0) || !std::isfinite(level.scaleStep) ||
         (level.scaleStep > 0.0 && (m.scaleMax - m.scaleMin) / level.scaleStep > kMaxSearchSamples))
       return "scale step";
-    if (!finitePoints(level.points)) return "point coordinates";
+    if (!finitePoints(level.points, extent)) return "point coordinates";
   }
-  if (!finitePoints(m.finePoints)) return "point coordinates";
+  if (!finitePoints(m.finePoints, extent)) return "point coordinates";
   return "";
 }
 

@@ -177,6 +177,10 @@ TEST_F(ShapeModelFile, UnusableValuesBehindAValidChecksumAreRefused) {
     m.levels.front().points.front().position.x = std::numeric_limits<float>::quiet_NaN();
   });
   refusal("far_point", [](ShapeModel& m) { m.finePoints.back().position.y = 1e30f; });
+  // A point far off the template with a large scale made the search allocate 284 GB for its
+  // border (found by the fuzz target).
+  refusal("point_off_template", [](ShapeModel& m) { m.levels.back().points[0].position.x = 9e4f; });
+  refusal("huge_scale", [](ShapeModel& m) { m.scaleMax = 1e6; });
   // The trained model itself is fine.
   saveShapeModel(trained, dir_ / "trained.model");
   EXPECT_NO_THROW(loadShapeModel(dir_ / "trained.model"));

@@ -68,8 +68,11 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     // visits every angle at every position. Only models of bounded top-level work are searched,
     // so that a timeout means a hang, not a legitimately expensive model.
     const auto& top = model.levels.back();
-    const double work = (model.angleExtent / top.angleStep + 1.0) * top.points.size();
-    if (work <= 2e5) {
+    const double scales =
+        top.scaleStep > 0.0 ? (model.scaleMax - model.scaleMin) / top.scaleStep + 1.0 : 1.0;
+    const double work = (model.angleExtent / top.angleStep + 1.0) * scales * top.points.size();
+    const double border = model.radius() * model.scaleMax;  // the search pads the image by this
+    if (work <= 2e5 && border <= 2000.0) {
       facet::FindParams params;
       params.minScore = 0.3;
       (void)facet::findShapeModel(image, model, params);
