@@ -35,7 +35,8 @@ struct Frame {
   // Device clock in nanoseconds when the device gives one (0 otherwise).
   std::uint64_t device_timestamp_ns = 0;
   // False when pixel data is missing (lost packets, short V4L2 buffer). Such a frame must never
-  // be inspected as a good part; backends return it only with GrabStatus::Incomplete.
+  // be inspected as a good part; backends return it only with GrabStatus::Incomplete, with
+  // id, timestamp and source set and `image` empty.
   bool complete = true;
   // Where the frame came from: the image file path for replay, the camera id otherwise.
   std::string source;
@@ -87,9 +88,11 @@ class CameraError : public std::runtime_error {
 };
 
 // Life cycle: open() -> start() -> grab()* -> stop() -> close(); start/stop may repeat.
-// grab() and softwareTrigger() may be called from different threads; health() from any thread;
-// the other calls from one controlling thread. Runtime trouble (timeouts, lost devices, bad
-// files) is reported by grab()'s status, never thrown.
+// Threads: grab() runs on one acquisition thread; softwareTrigger() may be called from another
+// thread meanwhile; health() and name() from any thread. open/start/stop/close come from one
+// controlling thread and never while grab() is running (grab returns within its timeout, so
+// stop the acquisition loop first). Runtime trouble (timeouts, lost devices, bad files) is
+// reported by grab()'s status, never thrown.
 class Camera {
  public:
   virtual ~Camera() = default;

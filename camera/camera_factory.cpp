@@ -13,10 +13,9 @@ std::unique_ptr<Camera> makeCamera(const CameraSettings& settings) {
     case CameraBackend::Aravis:
       return std::make_unique<AravisCamera>(settings.aravis);
     case CameraBackend::V4l2:
-      break;
+      return std::make_unique<V4l2Camera>(settings.v4l2);
   }
-  throw CameraError("camera backend \"" + std::string(toString(settings.backend)) +
-                    "\" is not available in this build");
+  throw CameraError("unknown camera backend");
 }
 
 }  // namespace facet

@@ -88,34 +88,40 @@ GrabResult ReplayCamera::grab(std::chrono::milliseconds timeout) {
         std::chrono::duration<double>(1.0 / settings_.fps));
     next_due_ = std::max(due + period, std::chrono::steady_clock::now() - period);
   }
-  return readNext();
+  return readNext(lock);
 }
 
-GrabResult ReplayCamera::readNext() {
+GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
   // At most one pass over the folder per grab: a folder of only broken files must end.
   for (std::size_t attempts = 0; attempts < files_.size(); ++attempts) {
     if (next_file_ >= files_.size()) {
       if (!settings_.loop) return {GrabStatus::EndOfStream, {}, "replay finished"};
       next_file_ = 0;
     }
-    const auto& file = files_[next_file_++];
+    const std::filesystem::path file = files_[next_file_++];
+    // Decode without the lock: health() and softwareTrigger() must not wait for a PNG.
+    lock.unlock();
     ImageFileContent content = readImageFile(file, settings_.max_pixels);
+    Frame frame;
+    std::string sidecar_error;
+    if (content.ok()) {
+      frame.image = std::move(content.image);
+      frame.format = content.format;
+      applyColourConversion(frame.image, frame.format, settings_.colour);
+      frame.timestamp = std::chrono::system_clock::now();
+      frame.source = file.string();
+      frame.metadata = sidecar_.forImage(file, &sidecar_error);
+    } else {
+      spdlog::error("replay: skipping {}", content.error);
+    }
+    lock.lock();
     if (!content.ok()) {
       ++health_.skipped_files;
       health_.last_error = content.error;
-      spdlog::error("replay: skipping {}", content.error);
       continue;
     }
-    Frame frame;
-    frame.image = std::move(content.image);
-    frame.format = content.format;
-    applyColourConversion(frame.image, frame.format, settings_.colour);
-    frame.id = next_id_++;
-    frame.timestamp = std::chrono::system_clock::now();
-    frame.source = file.string();
-    std::string sidecar_error;
-    frame.metadata = sidecar_.forImage(file, &sidecar_error);
     if (!sidecar_error.empty()) health_.last_error = sidecar_error;
+    frame.id = next_id_++;
     ++health_.frames;
     return {GrabStatus::Ok, std::move(frame), {}};
   }

@@ -34,7 +34,7 @@ class ReplayCamera final : public Camera {
   std::vector<std::filesystem::path> files() const;
 
  private:
-  GrabResult readNext();
+  GrabResult readNext(std::unique_lock<std::mutex>& lock);
 
   ReplaySettings settings_;
   mutable std::mutex mutex_;

@@ -32,7 +32,6 @@ enum class FieldType {
   Object,      // a mapping described by `object`
   ObjectList,  // a sequence of mappings described by `object`
   StepList,    // the recipe's ordered steps; each item's `kind` chooses its ObjectSpec
-  Map,         // a mapping from free keys to values described by `object` (e.g. named registers)
 };
 
 // What a checked value measures. It decides the allowed units and whether the nominal value is
@@ -48,7 +47,7 @@ struct FieldSpec {
   std::optional<double> maximum;
   bool exclusiveMinimum = false;       // minimum itself is not allowed (e.g. a diameter > 0)
   std::vector<std::string> choices;    // Enum
-  const ObjectSpec* object = nullptr;  // Object, ObjectList, Map
+  const ObjectSpec* object = nullptr;  // Object, ObjectList
   std::size_t minItems = 0;            // ObjectList, PointList, StepList
   nlohmann::json defaultValue;         // documented default, null when none
   std::optional<Quantity> quantity;    // set for the entries of a step's `checks`

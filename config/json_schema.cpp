@@ -1,5 +1,7 @@
 #include "config/json_schema.hpp"
 
+#include <map>
+
 #include "config/recipe_format.hpp"
 #include "config/station_format.hpp"
 
@@ -20,9 +22,46 @@ json tuple(const FieldSpec& f, std::size_t n) {
       {"type", "array"}, {"items", numberSchema(f, "number")}, {"minItems", n}, {"maxItems", n}};
 }
 
+std::string definitionName(const ObjectSpec& spec) {
+  std::string name = spec.name;
+  for (char& c : name)
+    if (c == ' ') c = '_';
+  return name;
+}
+
+// Objects used by several fields (a checked value, a register location) are written once under
+// "definitions" and referenced, which keeps the schema small enough to read.
 class Generator {
  public:
-  explicit Generator(const std::vector<StepKindSpec>& stepKinds) : stepKinds_(stepKinds) {}
+  Generator(const ObjectSpec& root, const std::vector<StepKindSpec>& stepKinds)
+      : stepKinds_(stepKinds) {
+    count(root);
+    for (const auto& k : stepKinds) count(k.object);
+  }
+
+  json document(const ObjectSpec& root) const {
+    json s = object(root);
+    json definitions = json::object();
+    for (const auto& [spec, uses] : uses_)
+      if (uses > 1) definitions[definitionName(*spec)] = object(*spec);
+    if (!definitions.empty()) s["definitions"] = definitions;
+    return s;
+  }
+
+ private:
+  void count(const ObjectSpec& spec) {
+    for (const auto& f : spec.fields) {
+      if (!f.object) continue;
+      if (++uses_[f.object] == 1) count(*f.object);
+    }
+  }
+
+  json reference(const ObjectSpec& spec) const {
+    const auto it = uses_.find(&spec);
+    if (it != uses_.end() && it->second > 1)
+      return {{"$ref", "#/definitions/" + definitionName(spec)}};
+    return object(spec);
+  }
 
   json object(const ObjectSpec& spec) const {
     json s{{"type", "object"}, {"additionalProperties", false}};
@@ -38,7 +77,6 @@ class Generator {
     return s;
   }
 
- private:
   json field(const FieldSpec& f) const {
     json s = value(f);
     if (!f.description.empty()) s["description"] = f.description;
@@ -72,28 +110,27 @@ class Generator {
       case FieldType::Rect:
         return tuple(f, 4);
       case FieldType::Object:
-        return object(*f.object);
+        return reference(*f.object);
       case FieldType::ObjectList:
-        return {{"type", "array"}, {"items", object(*f.object)}, {"minItems", f.minItems}};
+        return {{"type", "array"}, {"items", reference(*f.object)}, {"minItems", f.minItems}};
       case FieldType::StepList: {
         json kinds = json::array();
         for (const auto& k : stepKinds_) kinds.push_back(object(k.object));
         return {{"type", "array"}, {"items", {{"oneOf", kinds}}}, {"minItems", f.minItems}};
       }
-      case FieldType::Map:
-        return {{"type", "object"}, {"additionalProperties", object(*f.object)}};
     }
     return json::object();
   }
 
   const std::vector<StepKindSpec>& stepKinds_;
+  std::map<const ObjectSpec*, int> uses_;
 };
 
 }  // namespace
 
 nlohmann::json jsonSchema(const ObjectSpec& root, const std::vector<StepKindSpec>& stepKinds,
                           const std::string& id) {
-  json s = Generator(stepKinds).object(root);
+  json s = Generator(root, stepKinds).document(root);
   json head{{"$schema", "http://json-schema.org/draft-07/schema#"},
             {"$id", id},
             {"title", "facet " + root.name}};

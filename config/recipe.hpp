@@ -3,9 +3,29 @@
 // (recipe_loader.hpp). Recipes are immutable once loaded; the daemon holds them through
 // shared_ptr<const Recipe> (recipe_library.hpp) and switches between them only between parts.
 //
-// Units: image positions (centre, marks, regions) are pixels of the image the step refers to;
-// lengths of the part (diameters, search widths, distances) are millimetres and become pixels
-// through the station's calibration; angles are degrees.
+// Units: image positions (centre, marks, regions) are pixels; lengths of the part (diameters,
+// search widths, distances) are millimetres and become pixels through the station's calibration;
+// angles are degrees. A check's `unit` says how its measured value is expressed.
+//
+// What the steps give and how later steps use it (the contract for the recipe engine):
+// - Every step with a pose (align, fiducials, shape) maps positions written in its frame into
+//   the live image. The frame of an align step is its reference image's pixels: registration
+//   gives the similarity reference -> live; a shape match gives the model pose, applied to
+//   p - r where r is the model's reference point in reference pixels (the centre of `region`,
+//   or of the whole template). The frame of a fiducials step is that of its nominal `marks`
+//   (its relative_to step's frame, or the live image's pixels without one); its pose is the
+//   similarity that takes the nominal marks onto the found ones.
+// - A step with `relative_to` writes its positions (circle centre, search regions) in that
+//   step's frame, and its angle range is relative to that step's angle. Without `relative_to`
+//   they are pixels of the live image.
+// - Position checks (x, y, position) are offsets from nominal in millimetres along the axes of
+//   the relative_to step's frame (of the live image without one).
+// - For `distance`: the point of a step is the image of its reference point (align: the centre
+//   of its region, r for method shape; shape: r of the best match), the circle's centre, or the
+//   centroid of the found marks (fiducials); the line of a pose step runs through its point
+//   along its x axis.
+// - scan_align reports the pose that takes the live scan onto the reference scan's frame; its x
+//   and y checks are millimetres, angle degrees.
 
 #include <filesystem>
 #include <optional>

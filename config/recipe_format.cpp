@@ -1,9 +1,5 @@
 #include "config/recipe_format.hpp"
 
-// The tables use designated initializers and leave the other members at their defaults on
-// purpose; GCC 12 warns about that under -Wextra.
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-
 namespace facet::config {
 namespace {
 
@@ -39,7 +35,9 @@ FieldSpec minScore() {
 FieldSpec angleRange() {
   return {.name = "angle_range",
           .type = F::Range,
-          .description = "[low, high] rotation searched, degrees, within [-180, 180].",
+          .description =
+              "[low, high] rotation searched, degrees, within [-180, 180]; relative to "
+              "the relative_to step's angle when the step has one.",
           .minimum = -180.0,
           .maximum = 180.0,
           .defaultValue = {-180.0, 180.0}};

@@ -55,13 +55,15 @@ ReloadReport RecipeLibrary::reload() {
       const Stamps& old = it->second.stamps;
       const bool same = std::all_of(old.begin(), old.end(),
                                     [](const auto& kv) { return stamp(kv.first) == kv.second; });
-      if (same) continue;
+      // A file that lost an id to another one is read again: the other one may be gone.
+      if (same && !it->second.lostIdClaim) continue;
     }
     RecipeLoadResult result = loadRecipe(file, options_);
     Entry& entry = entries[file];
     entry.stamps.clear();
     for (const auto& f : result.files) entry.stamps[f] = stamp(f);
     entry.problems = result.diagnostics;
+    entry.lostIdClaim = false;
     report.diagnostics.append(result.diagnostics);
     if (result.recipe) {
       fresh[file] = std::make_shared<const Recipe>(std::move(*result.recipe));
@@ -94,6 +96,7 @@ ReloadReport RecipeLibrary::reload() {
       duplicate.error(recipe->idWhere, "recipe id " + std::to_string(recipe->id) +
                                            " is already used by " + claim->second.string());
       entry.problems.append(duplicate);
+      entry.lostIdClaim = true;
       report.diagnostics.append(duplicate);
       report.rejected.push_back(file);
       continue;

@@ -24,10 +24,10 @@ namespace facet::config {
 inline constexpr std::string_view kRecipeFileSuffix = ".recipe.yaml";
 
 struct ReloadReport {
-  std::vector<int> loaded;   // ids of recipes that are new or changed, and valid
-  std::vector<int> removed;  // ids whose file is gone
+  std::vector<int> loaded;                      // ids of recipes that are new or changed, and valid
+  std::vector<int> removed;                     // ids whose file is gone
   std::vector<std::filesystem::path> rejected;  // files with errors (an older version may stay)
-  Diagnostics diagnostics;                       // every message of this reload
+  Diagnostics diagnostics;                      // every message of this reload
 
   [[nodiscard]] bool changed() const { return !loaded.empty() || !removed.empty(); }
 };
@@ -64,6 +64,7 @@ class RecipeLibrary {
     std::shared_ptr<const Recipe> good;  // last valid version, may be null
     Stamps stamps;                       // of the files read at the last attempt
     Diagnostics problems;                // of the last attempt when it failed
+    bool lostIdClaim = false;            // rejected only because another file has its id
   };
 
   static FileStamp stamp(const std::filesystem::path& file);
@@ -71,8 +72,8 @@ class RecipeLibrary {
 
   RecipeLoadOptions options_;
   std::filesystem::path root_;
-  std::mutex reloadMutex_;    // one reload at a time
-  mutable std::mutex mutex_;  // guards entries_
+  std::mutex reloadMutex_;                          // one reload at a time
+  mutable std::mutex mutex_;                        // guards entries_
   std::map<std::filesystem::path, Entry> entries_;  // by recipe file
 };
 

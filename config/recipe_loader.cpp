@@ -7,6 +7,7 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "algorithms/shape/shape_model_file.hpp"
 #include "config/closest_name.hpp"
 #include "config/confined_path.hpp"
 #include "config/content_hash.hpp"
@@ -93,6 +94,9 @@ class RecipeReader {
     recipe_.baseFolder = recipe_.file.parent_path();
     root_ = options.root ? std::filesystem::absolute(*options.root) : recipe_.baseFolder;
   }
+
+  [[nodiscard]] int id() const { return recipe_.id; }
+  [[nodiscard]] const SourceLocation& idWhere() const { return recipe_.idWhere; }
 
   // Every file looked at so far (valid after read(), also when it failed).
   std::vector<std::filesystem::path> files() const {
@@ -514,6 +518,12 @@ class RecipeReader {
     const std::string what = "model " + inQuotes(item["model"].Scalar()) + " ";
     switch (status.state) {
       case ModelState::Fresh:
+        // Also refuses a model written by another (incompatible) version of facet.
+        try {
+          loadShapeModel(*model);
+        } catch (const std::exception& e) {
+          error(item["model"], what + "cannot be loaded: " + e.what() + advice);
+        }
         break;
       case ModelState::Untracked:
         out_.warning(where(item["model"]),
@@ -585,6 +595,8 @@ RecipeLoadResult loadRecipe(const std::filesystem::path& file, const RecipeLoadO
   RecipeReader reader(file, options, result.diagnostics);
   result.recipe = reader.read();
   result.files = reader.files();
+  result.id = reader.id();
+  result.idWhere = reader.idWhere();
   return result;
 }
 

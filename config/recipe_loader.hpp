@@ -39,6 +39,10 @@ struct RecipeLoadResult {
   // The recipe file and every file it names that lies inside the root, absolute, also when the
   // recipe has errors: a change to any of them is a reason to load it again.
   std::vector<std::filesystem::path> files;
+  // The recipe's id and where it is written, also when the recipe has errors (0 when unreadable),
+  // so that duplicate ids across a folder can be reported in the same run.
+  int id = 0;
+  SourceLocation idWhere;
 };
 
 RecipeLoadResult loadRecipe(const std::filesystem::path& file,

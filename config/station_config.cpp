@@ -1,6 +1,6 @@
 #include "config/station_config.hpp"
 
-#include <regex>
+#include <cctype>
 #include <sstream>
 
 #include "config/station_format.hpp"
@@ -23,13 +23,33 @@ bool isFolder(const std::filesystem::path& p) {
   return std::filesystem::is_directory(p, ec);
 }
 
-// "file:line:column" as the PLC module writes origins and messages.
+// Reads "<digits>" at `text[pos]`, moving `pos` past it.
+std::optional<int> digitsAt(const std::string& text, std::size_t& pos) {
+  const std::size_t start = pos;
+  while (pos < text.size() && std::isdigit(static_cast<unsigned char>(text[pos]))) ++pos;
+  if (pos == start || pos - start > 9) return std::nullopt;
+  return std::stoi(text.substr(start, pos - start));
+}
+
+// Splits "file:line:column<rest>" as the PLC module writes origins and messages; `rest` is what
+// follows the column. (Hand-written: std::regex trips GCC 12's -Wmaybe-uninitialized.)
+std::optional<std::pair<SourceLocation, std::string>> splitLocation(const std::string& text) {
+  for (std::size_t colon = text.find(':'); colon != std::string::npos;
+       colon = text.find(':', colon + 1)) {
+    std::size_t pos = colon + 1;
+    const auto line = digitsAt(text, pos);
+    if (!line || pos >= text.size() || text[pos] != ':') continue;
+    ++pos;
+    const auto column = digitsAt(text, pos);
+    if (!column) continue;
+    return std::pair{SourceLocation{text.substr(0, colon), *line, *column}, text.substr(pos)};
+  }
+  return std::nullopt;
+}
+
 SourceLocation parseOrigin(const std::string& origin) {
-  static const std::regex pattern(R"(^(.*):(\d+):(\d+)$)");
-  std::smatch m;
-  if (std::regex_match(origin, m, pattern))
-    return {m[1].str(), std::stoi(m[2].str()), std::stoi(m[3].str())};
-  return {origin};
+  const auto split = splitLocation(origin);
+  return split && split->second.empty() ? split->first : SourceLocation{origin};
 }
 
 class StationReader {
@@ -84,7 +104,8 @@ class StationReader {
   // belongs to the administrator, not to recipe authors).
   std::optional<std::filesystem::path> pathOf(const YAML::Node& n) const {
     if (!n || !n.IsScalar() || n.Scalar().empty()) return std::nullopt;
-    return (base_ / n.Scalar()).lexically_normal();
+    const auto p = (base_ / n.Scalar()).lexically_normal();
+    return p.has_filename() ? p : p.parent_path();  // "a/." normalises to "a/"
   }
   std::optional<std::filesystem::path> folderPath(const YAML::Node& n, const std::string& key) {
     const auto p = pathOf(n);
@@ -197,11 +218,10 @@ class StationReader {
     } catch (const plc::RegisterMapError& e) {
       std::istringstream lines(e.what());
       std::string line;
-      static const std::regex located(R"(^(.*?):(\d+):(\d+): (.*)$)");
       while (std::getline(lines, line)) {
-        std::smatch match;
-        if (std::regex_match(line, match, located) && match[1].str() == file_.string())
-          out_.error({file_, std::stoi(match[2].str()), std::stoi(match[3].str())}, match[4].str());
+        const auto split = splitLocation(line);
+        if (split && split->first.file == file_ && split->second.starts_with(": "))
+          out_.error(split->first, split->second.substr(2));
         else
           error(m, "register map: " + line);
       }
@@ -304,6 +324,12 @@ RecipeLoadOptions StationConfig::recipeLoadOptions() const {
   options.reservedRegisters = reservedRegisters();
   options.defaultWordOrder = wordOrder;
   return options;
+}
+
+plc::RegisterMap StationConfig::registerMapFor(const Recipe& recipe) const {
+  plc::RegisterMap map = registerMap;
+  for (const auto& [check, step] : recipe.plcOutputs()) map.results.push_back(check->plc->output);
+  return map;
 }
 
 StationLoadResult loadStationConfig(const std::filesystem::path& file) {

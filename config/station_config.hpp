@@ -62,6 +62,9 @@ struct StationConfig {
   // How recipes of this station are loaded: confined to its recipes folder, its registers
   // reserved, its word order the default.
   [[nodiscard]] RecipeLoadOptions recipeLoadOptions() const;
+  // The register map while `recipe` is active: the station's map with the recipe's check
+  // outputs added to its results (named "<step id>.<check>").
+  [[nodiscard]] plc::RegisterMap registerMapFor(const Recipe& recipe) const;
 };
 
 struct StationLoadResult {

@@ -1,9 +1,5 @@
 #include "config/station_format.hpp"
 
-// The tables use designated initializers and leave the other members at their defaults on
-// purpose; GCC 12 warns about that under -Wextra.
-#pragma GCC diagnostic ignored "-Wmissing-field-initializers"
-
 namespace facet::config {
 namespace {
 
@@ -132,7 +128,8 @@ StationFormat::StationFormat() {
             flag("loop", "Start again after the last file.", false),
             {.name = "max_range_m",
              .type = F::Number,
-             .description = "Readings at or beyond this range are dropped, metres; 0 = keep all.",
+             .description =
+                 "Ranges at or beyond this are dropped, metres; 0 = the readers' default (80 m).",
              .minimum = 0.0,
              .defaultValue = 0.0}}};
   camera = {"camera",

@@ -9,9 +9,9 @@ namespace facet::config {
 namespace {
 
 bool isPlainScalar(const YAML::Node& node) {
-  // yaml-cpp tags quoted scalars with "!": the user meant text. A missing key of a const node
-  // is an "invalid" node whose IsScalar() throws; IsDefined() is false for it and does not.
-  return node.IsDefined() && node.IsScalar() && node.Tag() != "!";
+  // yaml-cpp tags quoted scalars with "!": the user meant text. A missing key gives an invalid
+  // node, on which every query but operator bool throws.
+  return node && node.IsScalar() && node.Tag() != "!";
 }
 
 }  // namespace
@@ -41,7 +41,7 @@ std::optional<YamlFile> readYamlFile(const std::filesystem::path& file, Diagnost
 }
 
 SourceLocation locate(const std::filesystem::path& file, const YAML::Node& node) {
-  if (!node.IsDefined()) return {file};  // Mark() throws for a missing key of a const node
+  if (!node) return {file};
   const YAML::Mark mark = node.Mark();
   if (mark.is_null() || mark.line < 0) return {file};
   return {file, mark.line + 1, mark.column + 1};
@@ -76,12 +76,12 @@ std::optional<bool> readBoolean(const YAML::Node& node) {
 }
 
 std::optional<std::string> readString(const YAML::Node& node) {
-  if (!node.IsDefined() || !node.IsScalar()) return std::nullopt;
+  if (!node || !node.IsScalar()) return std::nullopt;
   return node.Scalar();
 }
 
 std::string describe(const YAML::Node& node) {
-  if (!node.IsDefined() || node.IsNull()) return "nothing";
+  if (!node || node.IsNull()) return "an empty value";
   if (node.IsSequence()) return "a list";
   if (node.IsMap()) return "a mapping";
   return "\"" + node.Scalar() + "\"";

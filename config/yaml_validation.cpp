@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <map>
-#include <regex>
 
 #include "config/closest_name.hpp"
 #include "config/yaml_document.hpp"
@@ -21,9 +20,12 @@ std::string joined(const std::vector<std::string>& names) {
   return out;
 }
 
+// [a-z][a-z0-9_]*
 bool isIdentifier(const std::string& s) {
-  static const std::regex pattern("[a-z][a-z0-9_]*");
-  return std::regex_match(s, pattern);
+  if (s.empty() || s[0] < 'a' || s[0] > 'z') return false;
+  return std::all_of(s.begin(), s.end(), [](char c) {
+    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+  });
 }
 
 // "must be between 0 and 1 (got 1.5)", or nothing when `value` is in the field's range.
@@ -166,7 +168,7 @@ class Validator {
           std::string message = "unknown " + f.name + " " + inQuotes(*s);
           if (const auto near = closestName(*s, f.choices))
             message += " (did you mean " + inQuotes(*near) + "?)";
-          error(v, message + "; expected one of " + joined(f.choices));
+          error(at(v, key), message + "; expected one of " + joined(f.choices));
         }
         break;
       }
@@ -208,13 +210,6 @@ class Validator {
           else
             object(item, *f.object, what + " item");
         }
-        break;
-      case FieldType::Map:
-        if (!v.IsMap()) {
-          error(at(v, key), what + " must be a mapping, not " + describe(v));
-          break;
-        }
-        for (const auto& entry : v) object(entry.second, *f.object, inQuotes(entry.first.Scalar()));
         break;
     }
   }

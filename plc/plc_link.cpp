@@ -5,6 +5,7 @@
 #include <condition_variable>
 #include <deque>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <stdexcept>
 #include <thread>
@@ -117,7 +118,8 @@ struct PlcLink::State {
   void step();
   void pollTrigger(bool triggerLevel);
   void deliverHead();
-  void writeResult(const Pending& pending);
+  void writeResult(const Pending& pending, bool clearBusy);
+  void writeResultFlags(bool pass, bool error, bool clearBusy, bool withVerdict);
   void writeDaemonStatus();
   void beat();
 
@@ -347,18 +349,21 @@ void PlcLink::State::pollTrigger(bool level) {
   triggerArrived.notify_all();
 }
 
-void PlcLink::State::writeResult(const Pending& pending) {
+void PlcLink::State::writeResult(const Pending& pending, bool clearBusy) {
   const InspectionResult& r = pending.result;
   std::vector<RegisterWrite> writes;
   for (const auto& output : map.results) {
     const auto found = r.values.find(output.name);
     double value = std::numeric_limits<double>::quiet_NaN();
+    // Outputs of another recipe: their registers keep what that recipe last wrote.
+    if (found == r.values.end() && r.onlyGivenValues) continue;
     if (found == r.values.end())
       spdlog::error("PLC: part '{}' has no value for mapped result '{}'", r.partId, output.name);
     else
       value = found->second;
     const EncodedValue encoded = encodeValue(output, value);
-    if (encoded.clamped && found != r.values.end())
+    // NaN is "not measured" (its step failed): written as NaN / 0 without complaint.
+    if (encoded.clamped && found != r.values.end() && !std::isnan(value))
       spdlog::error("PLC: part '{}': {} = {} does not fit {} at register {}; written saturated",
                     r.partId, output.name, value, toString(output.type), output.address);
     const int wire = map.wireAddress(output.address);
@@ -369,13 +374,76 @@ void PlcLink::State::writeResult(const Pending& pending) {
     writes.push_back({map.wireAddress(map.status.errorCode->address),
                       static_cast<std::uint16_t>(r.errorCode), "status.error_code"});
   writeRegisterRuns(std::move(writes));
-  writeFlag("status.pass", map.status.pass, r.pass);
-  writeFlag("status.error", map.status.error, r.errorCode != 0);
-  // The counter and the toggle go last: a PLC watching them (free run) finds the values in place.
+  // What the PLC watches goes last, so that it finds everything else in place: in free run the
+  // counter (the verdict before it), when triggered result valid (the counter before it).
+  const bool freeRun = settings.mode == HandshakeMode::FreeRun;
+  if (freeRun) {
+    writeFlag("status.pass", map.status.pass, r.pass);
+    writeFlag("status.error", map.status.error, r.errorCode != 0);
+  }
   writeNumber("status.inspection_counter", map.status.inspectionCounter, pending.counter);
   toggle = !toggle;
-  writeFlag("status.completed_toggle", map.status.completedToggle, toggle);
-  writeFlag("status.result_valid", map.status.resultValid, true);
+  writeResultFlags(r.pass, r.errorCode != 0, clearBusy, /*withVerdict=*/!freeRun);
+}
+
+// [pass, error,] completed toggle, result valid (and busy = 0 when this result answers the open
+// trigger). When these are coils that, together with the daemon's other status coils as filler,
+// form one contiguous block, a single request writes them all at once; otherwise one request
+// each, result valid (then busy) last.
+void PlcLink::State::writeResultFlags(bool pass, bool error, bool clearBusy, bool withVerdict) {
+  struct Flag {
+    const char* name;
+    const std::optional<Location>* at;
+    bool value;
+  };
+  const auto& s = map.status;
+  std::vector<Flag> flags;
+  if (withVerdict) {
+    flags.push_back({"status.pass", &s.pass, pass});
+    flags.push_back({"status.error", &s.error, error});
+  }
+  flags.push_back({"status.completed_toggle", &s.completedToggle, toggle});
+  flags.push_back({"status.result_valid", &s.resultValid, true});
+  if (clearBusy) flags.push_back({"status.busy", &s.busy, false});
+  bool isReady = true;
+  {
+    std::lock_guard lock(mutex);
+    isReady = ready;
+  }
+  std::vector<Flag> fillers = {{"status.ready", &s.ready, isReady},
+                               {"status.missed_trigger", &s.missedTrigger, missedLatched}};
+  if (!clearBusy) fillers.push_back({"status.busy", &s.busy, busy});
+
+  std::map<int, std::pair<bool, std::string>> block;  // wire -> value, name
+  bool allCoils = true;
+  for (const auto& f : flags) {
+    if (!*f.at) continue;
+    if ((*f.at)->table != Table::Coil) allCoils = false;
+    block.emplace(map.wireAddress((*f.at)->address), std::make_pair(f.value, f.name));
+  }
+  if (allCoils && block.size() > 1) {
+    const int first = block.begin()->first;
+    const int last = block.rbegin()->first;
+    for (const auto& f : fillers) {
+      if (!*f.at || (*f.at)->table != Table::Coil) continue;
+      const int wire = map.wireAddress((*f.at)->address);
+      if (wire > first && wire < last) block.emplace(wire, std::make_pair(f.value, f.name));
+    }
+    if (static_cast<int>(block.size()) == last - first + 1) {
+      std::vector<std::uint8_t> values;
+      std::string names;
+      for (const auto& [wire, entry] : block) {
+        values.push_back(entry.first ? 1 : 0);
+        names += (names.empty() ? "" : ", ") + entry.second;
+      }
+      request(names,
+              "writing coils " + std::to_string(first + map.addressBase) + ".." +
+                  std::to_string(last + map.addressBase) + " for",
+              [&] { bus->writeCoils(first, static_cast<int>(values.size()), values.data()); });
+      return;
+    }
+  }
+  for (const auto& f : flags) writeFlag(f.name, *f.at, f.value);
 }
 
 void PlcLink::State::deliverHead() {
@@ -385,14 +453,14 @@ void PlcLink::State::deliverHead() {
     if (queue.empty()) return;
     head = queue.front();
   }
-  writeResult(head);
+  const bool answersTrigger = busy;
+  writeResult(head, answersTrigger);
   headValidAt = Clock::now();
   headWritten = true;
-  if (busy) {
+  if (answersTrigger) {
     busy = false;
     headTrigger = openTrigger;
     openTrigger.reset();
-    writeFlag("status.busy", map.status.busy, false);
   }
   std::lock_guard lock(mutex);
   ++stats.written;
@@ -499,7 +567,7 @@ PlcLink::PlcLink(RegisterMap map, PlcSettings settings) : state_(std::make_uniqu
   const auto issues = map.validate();
   if (!issues.empty()) {
     std::string message = "invalid PLC register map:";
-    for (const auto& issue : issues) message += "\n  " + issue.message;
+    for (const auto& issue : issues) message += "\n  " + describe(issue);
     throw std::invalid_argument(message);
   }
   const std::string missing = missingSignals(map, settings.mode);
@@ -515,6 +583,8 @@ PlcLink::PlcLink(RegisterMap map, PlcSettings settings) : state_(std::make_uniqu
     RegisterServerOptions options;
     options.host = state_->settings.host;
     options.port = state_->settings.port;
+    options.coils = 65536;  // the whole address space: any valid map fits
+    options.holdingRegisters = 65536;
     state_->server = std::make_unique<RegisterServer>(options);
     state_->bus = makeServerBus(*state_->server);
   } else {

@@ -8,14 +8,18 @@
 //
 // Triggered handshake (RegisterMap names; the daemon is the Modbus client):
 //   PLC trigger 0->1          -> busy = 1, a TriggerEvent is queued for the daemon
-//   daemon publish(result)    -> all result registers, pass, error code, inspection counter are
-//                                written, then result valid = 1 and completed toggle flipped,
-//                                busy = 0
+//   daemon publish(result)    -> all result registers, error code, inspection counter are
+//                                written, then pass, error, completed toggle (flipped),
+//                                result valid = 1 and busy = 0 (one request when these are
+//                                adjacent coils, else in this order)
 //   PLC result ack 0->1       -> result valid = 0
 //   PLC result ack 1->0       -> the next queued result may follow (four-phase handshake)
 //   trigger 0->1 while busy   -> missed trigger = 1 (latched until the next accepted trigger)
 // Free-run handshake: each result is written with the next inspection counter and the toggle
-// flipped; no trigger, no acknowledge.
+// flipped (the verdict before the counter, the counter last but for toggle and result valid);
+// no trigger, no acknowledge. Results wait for the acknowledge without a time limit: a PLC that
+// never acknowledges fills the queue, and the overflow is reported part by part.
+// The PLC must hold the trigger (and the acknowledge) low and high for a few poll periods.
 //
 // A result leaves the queue only once acknowledged (triggered) or written (free run); after a
 // reconnect the head result is written again with the same inspection counter, so a PLC that
@@ -45,6 +49,9 @@ struct InspectionResult {
                                          // missing is written as NaN/0 and logged
   int errorCode = 0;                     // 0 = inspection ran; sets status.error when non-zero
   std::uint64_t triggerSequence = 0;     // TriggerEvent::sequence it answers; 0 = none
+  // Mapped outputs missing from `values` are left unwritten instead of written as NaN/0 and
+  // logged: a station with several recipes maps every recipe's outputs, a part has only its own.
+  bool onlyGivenValues = false;
 };
 
 // A trigger the PLC raised and the link accepted (busy is already written when it is queued).

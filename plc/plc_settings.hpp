@@ -45,7 +45,8 @@ struct PlcSettings {
   // Time to wait for the PLC's answer to one request before the link counts as lost.
   std::chrono::milliseconds responseTimeout{500};
   // Period at which the daemon reads the control signals (trigger, acknowledge, recipe, enable).
-  // Bounds the trigger-to-busy latency from above.
+  // An edge is seen only if the level holds for a poll: the PLC should keep the trigger low (and
+  // high) for at least a few periods.
   std::chrono::milliseconds pollPeriod{2};
   // Period of the heartbeat counter; 0 disables the heartbeat.
   std::chrono::milliseconds heartbeatPeriod{1000};

@@ -70,7 +70,10 @@ int tableSize(const RegisterMap& map, Table table) {
   if (table == Table::HoldingRegister)
     for (const auto& output : map.results)
       highest = std::max(highest, map.wireAddress(output.address) + registerCount(output.type) - 1);
-  return highest + 1;
+  // Like a real PLC's data block, the tables are larger than the station's own signals: recipe
+  // outputs (which the simulator does not know) land above them.
+  constexpr int kMinimumTable = 1024;
+  return std::max(highest + 1, kMinimumTable);
 }
 
 }  // namespace
@@ -85,12 +88,17 @@ struct PlcSimulator::State {
   mutable std::mutex mutex;  // guards stats and callback
   PlcSimulatorStats stats;
   std::function<void(const ReceivedResult&)> callback;
+  // Free run: the counter and toggle when start() was called; a change after that is a result
+  // (read before the scan thread runs, so a result written right after start() is not missed).
+  int initialCounter = -1;
+  bool initialToggle = false;
 
   void scan();
 };
 
 void PlcSimulator::State::scan() {
   Tables tables(*server, map);
+  tables.setFlag(map.control.enable, true);  // a running line enables inspections
   const bool triggered = options.mode == HandshakeMode::Triggered;
   const auto ratePeriod = options.triggerRate > 0
                               ? std::chrono::duration_cast<SteadyClock::duration>(
@@ -99,25 +107,29 @@ void PlcSimulator::State::scan() {
   auto nextTrigger = SteadyClock::now() + ratePeriod;
   // Plain time points with flags: GCC 12 warns about std::optional<time_point> here.
   bool triggerHigh = false;
+  bool raisePending = false;
+  SteadyClock::time_point triggerLoweredAt{};
   bool busyAtRaise = false;  // raised while busy: hold the full pulse so the daemon sees it
   SteadyClock::time_point triggerRaisedAt{};
   bool ackPending = false;
   SteadyClock::time_point validSince{};
   bool lastValid = false;
   bool lastMissed = false;
-  bool lastToggle = tables.flag(map.status.completedToggle);
-  int lastCounter = tables.number(map.status.inspectionCounter);
+  bool lastToggle = initialToggle;
+  int lastCounter = initialCounter;
 
   while (!stopping) {
     const auto now = SteadyClock::now();
     if (triggered) {
-      // Trigger: raised on request or at the rate; cleared once busy shows or after the pulse.
-      bool raise = triggerRequested.exchange(false);
+      // Trigger: raised on request or at the rate.
+      if (triggerRequested.exchange(false)) raisePending = true;
       if (ratePeriod > SteadyClock::duration::zero() && now >= nextTrigger) {
-        raise = true;
+        raisePending = true;
         nextTrigger += ratePeriod;
       }
-      if (raise && !triggerHigh) {
+      // A polling daemon sees an edge only if the trigger stayed low for a few of its polls.
+      if (raisePending && !triggerHigh && now - triggerLoweredAt >= options.triggerGap) {
+        raisePending = false;
         tables.setFlag(map.control.trigger, true);
         triggerHigh = true;
         busyAtRaise = tables.flag(map.status.busy);
@@ -125,14 +137,17 @@ void PlcSimulator::State::scan() {
         std::lock_guard lock(mutex);
         ++stats.triggersRaised;
       }
-      if (triggerHigh && ((tables.flag(map.status.busy) && !busyAtRaise) ||
-                          now - triggerRaisedAt >= options.triggerPulse)) {
-        tables.setFlag(map.control.trigger, false);
-        triggerHigh = false;
-      }
       // Result valid: read everything, acknowledge after the delay, release the ack when the
       // daemon clears result valid.
       const bool valid = tables.flag(map.status.resultValid);
+      // The trigger is held until the daemon answers (busy, or a result when the inspection was
+      // quicker than a scan), at the latest until the pulse ends.
+      if (triggerHigh && ((tables.flag(map.status.busy) && !busyAtRaise) || (valid && !lastValid) ||
+                          now - triggerRaisedAt >= options.triggerPulse)) {
+        tables.setFlag(map.control.trigger, false);
+        triggerHigh = false;
+        triggerLoweredAt = now;
+      }
       if (valid && !lastValid) {
         const ReceivedResult result = tables.readResult();
         validSince = now;
@@ -177,7 +192,7 @@ PlcSimulator::PlcSimulator(RegisterMap map, PlcSimulatorOptions options)
   const auto issues = map.validate();
   if (!issues.empty()) {
     std::string message = "invalid PLC register map:";
-    for (const auto& issue : issues) message += "\n  " + issue.message;
+    for (const auto& issue : issues) message += "\n  " + describe(issue);
     throw std::invalid_argument(message);
   }
   state_->map = std::move(map);
@@ -206,6 +221,9 @@ void PlcSimulator::onResult(std::function<void(const ReceivedResult&)> callback)
 void PlcSimulator::start() {
   if (state_->thread.joinable()) return;
   state_->stopping = false;
+  const Tables tables(*state_->server, state_->map);
+  state_->initialCounter = tables.number(state_->map.status.inspectionCounter);
+  state_->initialToggle = tables.flag(state_->map.status.completedToggle);
   state_->thread = std::thread([s = state_.get()] { s->scan(); });
 }
 

@@ -21,8 +21,11 @@ struct PlcSimulatorOptions {
   double triggerRate = 0.0;                       // triggers per second; 0: only raiseTrigger()
   HandshakeMode mode = HandshakeMode::Triggered;  // FreeRun: watch the counter, never ack
   std::chrono::milliseconds ackDelay{0};          // wait after result valid before acknowledging
-  std::chrono::milliseconds triggerPulse{50};  // trigger is cleared when busy shows or after this
-  std::chrono::microseconds scanPeriod{500};   // the simulated PLC's scan cycle
+  std::chrono::milliseconds triggerPulse{1000};   // trigger is cleared when busy (or a result)
+                                                  // shows, at the latest after this
+  std::chrono::milliseconds triggerGap{5};    // the trigger stays low at least this long between
+                                              // pulses (a polling daemon must see it low)
+  std::chrono::microseconds scanPeriod{500};  // the simulated PLC's scan cycle
 };
 
 // A result as the simulator read it from its registers.

@@ -68,6 +68,9 @@ class ClientBus final : public RegisterBus {
   void writeCoil(int wire, bool value) override {
     if (modbus_write_bit(live(), wire, value ? 1 : 0) != 1) raise("writing a coil");
   }
+  void writeCoils(int wire, int count, const std::uint8_t* values) override {
+    if (modbus_write_bits(live(), wire, count, values) != count) raise("writing coils");
+  }
   void writeRegisters(int wire, int count, const std::uint16_t* values) override {
     const int written = count == 1 ? modbus_write_register(live(), wire, values[0])
                                    : modbus_write_registers(live(), wire, count, values);
@@ -101,7 +104,7 @@ class ServerBus final : public RegisterBus {
   void connect() override {}
   void close() override {}
   std::string describe() const override {
-    return "Modbus server on port " + std::to_string(server_.port());
+    return "the daemon's Modbus server (port " + std::to_string(server_.port()) + ")";
   }
   void readCoils(int wire, int count, std::uint8_t* out) override {
     for (int i = 0; i < count; ++i) out[i] = guard([&] { return server_.coil(wire + i); });
@@ -117,6 +120,13 @@ class ServerBus final : public RegisterBus {
       server_.setCoil(wire, value);
       return true;
     });
+  }
+  void writeCoils(int wire, int count, const std::uint8_t* values) override {
+    for (int i = 0; i < count; ++i)
+      guard([&] {
+        server_.setCoil(wire + i, values[i] != 0);
+        return true;
+      });
   }
   void writeRegisters(int wire, int count, const std::uint16_t* values) override {
     for (int i = 0; i < count; ++i)

@@ -37,6 +37,7 @@ class RegisterBus {
   virtual void readCoils(int wire, int count, std::uint8_t* out) = 0;
   virtual void readRegisters(int wire, int count, std::uint16_t* out) = 0;
   virtual void writeCoil(int wire, bool value) = 0;
+  virtual void writeCoils(int wire, int count, const std::uint8_t* values) = 0;  // one request
   virtual void writeRegisters(int wire, int count, const std::uint16_t* values) = 0;
 };
 

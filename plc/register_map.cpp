@@ -39,26 +39,29 @@ std::string addressText(const RegisterMap& map, const Location& location) {
 void checkSignal(const RegisterMap& map, const NamedLocation& signal, std::vector<Claim>& claims,
                  std::vector<MapIssue>& issues) {
   const Location& at = *signal.location;
-  const std::string who = describeEntry(signal.name, at.origin);
+  const std::string& who = signal.name;
   const int wire = map.wireAddress(at.address);
   bool ok = true;
   if (wire < 0 || wire > 0xFFFF) {
     issues.push_back({who + ": address " + std::to_string(at.address) + " is outside " +
-                      std::to_string(map.addressBase) + ".." +
-                      std::to_string(0xFFFF + map.addressBase)});
+                          std::to_string(map.addressBase) + ".." +
+                          std::to_string(0xFFFF + map.addressBase),
+                      at.origin});
     ok = false;
   }
   if (at.table == Table::Coil && at.bit >= 0) {
-    issues.push_back({who + ": a coil has no bits (bit " + std::to_string(at.bit) + ")"});
+    issues.push_back(
+        {who + ": a coil has no bits (bit " + std::to_string(at.bit) + ")", at.origin});
     ok = false;
   }
   if (at.bit < -1 || at.bit > 15) {
-    issues.push_back({who + ": bit " + std::to_string(at.bit) + " is outside 0..15"});
+    issues.push_back({who + ": bit " + std::to_string(at.bit) + " is outside 0..15", at.origin});
     ok = false;
   }
   if (signal.isNumber && (at.table != Table::HoldingRegister || at.bit >= 0)) {
     issues.push_back(
-        {who + ": a number needs a whole holding register, not " + addressText(map, at)});
+        {who + ": a number needs a whole holding register, not " + addressText(map, at),
+         at.origin});
     ok = false;
   }
   if (!ok) return;
@@ -71,20 +74,22 @@ void checkSignal(const RegisterMap& map, const NamedLocation& signal, std::vecto
 void checkResult(const RegisterMap& map, const ResultOutput& output, std::vector<Claim>& claims,
                  std::vector<MapIssue>& issues) {
   const std::string name = "result." + output.name;
-  const std::string who = describeEntry(name, output.origin);
-  if (output.name.empty()) issues.push_back({who + ": the result has no name"});
+  const std::string& who = name;
+  if (output.name.empty()) issues.push_back({who + ": the result has no name", output.origin});
   const bool scaled =
       output.type == ValueType::ScaledInt16 || output.type == ValueType::ScaledInt32;
   if (scaled && (!std::isfinite(output.factor) || output.factor == 0.0))
     issues.push_back(
-        {who + ": scale factor " + std::to_string(output.factor) + " must be finite and non-zero"});
+        {who + ": scale factor " + std::to_string(output.factor) + " must be finite and non-zero",
+         output.origin});
   const int count = registerCount(output.type);
   const int wire = map.wireAddress(output.address);
   if (wire < 0 || wire + count - 1 > 0xFFFF) {
     issues.push_back({who + ": " + toString(output.type) + " at address " +
-                      std::to_string(output.address) + " does not fit in " +
-                      std::to_string(map.addressBase) + ".." +
-                      std::to_string(0xFFFF + map.addressBase)});
+                          std::to_string(output.address) + " does not fit in " +
+                          std::to_string(map.addressBase) + ".." +
+                          std::to_string(0xFFFF + map.addressBase),
+                      output.origin});
     return;
   }
   for (int i = 0; i < count; ++i)
@@ -180,10 +185,14 @@ std::vector<NamedLocation> namedSignals(const RegisterMap& map) {
   return signals;
 }
 
+std::string describe(const MapIssue& issue) {
+  return issue.origin.empty() ? issue.message : issue.origin + ": " + issue.message;
+}
+
 std::vector<MapIssue> RegisterMap::validate() const {
   std::vector<MapIssue> issues;
   if (addressBase != 0 && addressBase != 1)
-    issues.push_back({"address_base " + std::to_string(addressBase) + " must be 0 or 1"});
+    issues.push_back({"address_base " + std::to_string(addressBase) + " must be 0 or 1", ""});
 
   std::vector<Claim> claims;
   for (const auto& signal : namedSignals(*this)) checkSignal(*this, signal, claims, issues);
@@ -191,9 +200,9 @@ std::vector<MapIssue> RegisterMap::validate() const {
   for (const auto& output : results) {
     if (!output.name.empty() && !names.insert(output.name).second) {
       const ResultOutput* first = findResult(output.name);
-      issues.push_back({describeEntry("result." + output.name, output.origin) +
-                        ": duplicate name, first defined as " +
-                        describeEntry("result." + first->name, first->origin)});
+      issues.push_back({"result." + output.name + ": duplicate name, first defined as " +
+                            describeEntry("result." + first->name, first->origin),
+                        output.origin});
     }
     checkResult(*this, output, claims, issues);
   }
@@ -216,7 +225,8 @@ std::vector<MapIssue> RegisterMap::validate() const {
                                    ? "coil " + std::to_string(a.wire + addressBase)
                                    : "holding register " + std::to_string(a.wire + addressBase);
       issues.push_back({describeEntry(a.name, a.origin) + " and " +
-                        describeEntry(b.name, b.origin) + " overlap at " + what});
+                            describeEntry(b.name, b.origin) + " overlap at " + what,
+                        b.origin.empty() ? a.origin : b.origin});
     }
   }
   return issues;

@@ -96,7 +96,12 @@ std::optional<WordOrder> parseWordOrder(const std::string& name);  // case-insen
 // One problem found by RegisterMap::validate().
 struct MapIssue {
   std::string message;  // names every entry involved, with its origin when known
+  std::string origin;   // origin of the entry the issue is reported at (for two entries: the
+                        // later one); empty when unknown
 };
+
+// "origin: message", or the message alone when the origin is unknown.
+std::string describe(const MapIssue& issue);
 
 struct RegisterMap {
   int addressBase = 0;  // 0: addresses are wire addresses; 1: address 1 is wire address 0

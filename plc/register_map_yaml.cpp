@@ -175,7 +175,12 @@ RegisterMap parseRegisterMap(const YAML::Node& node, const std::string& fileName
   const auto issues = map.validate();
   if (!issues.empty()) {
     std::string message;
-    for (const auto& issue : issues) message += (message.empty() ? "" : "\n") + issue.message;
+    // "file:line:column: message" per issue, like every other error of the parser.
+    for (const auto& issue : issues) {
+      if (!message.empty()) message.push_back('\n');
+      if (issue.origin.empty()) message.append(fileName).append(": ");
+      message.append(describe(issue));
+    }
     throw RegisterMapError(message);
   }
   return map;

@@ -94,7 +94,7 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
       const double nextCost = cost(next);
       if (nextCost <= current) {
         improved = true;
-        const bool converged = step.norm() < 1e-6;  // pixels: far below the accuracy sought
+        const bool converged = step.norm() < 1e-5;  // pixels: far below the accuracy sought
         c = next;
         current = nextCost;
         lambda = std::max(lambda * 0.1, 1e-12);
@@ -145,6 +145,11 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
     return "the nominal radius must be positive (got " + std::to_string(p.radius) + ")";
   if (!(p.width > 0.0) || !std::isfinite(p.width))
     return "the search width must be positive (got " + std::to_string(p.width) + ")";
+  if (p.radius + p.width > 1e5)
+    return "the annulus (radius + width = " + std::to_string(p.radius + p.width) +
+           " px) is larger than any image";
+  if (std::abs(p.centre.x) > 1e7 || std::abs(p.centre.y) > 1e7)
+    return "the expected centre lies absurdly far outside the image";
   if (!(p.directionToleranceDeg > 0.0 && p.directionToleranceDeg <= 90.0))
     return "the direction tolerance must be in (0, 90] degrees";
   if (!(p.ransacThreshold > 0.0)) return "the RANSAC threshold must be positive";
@@ -155,6 +160,53 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
   if (p.cannyLow && p.cannyHigh && *p.cannyLow > *p.cannyHigh)
     return "the low Canny threshold exceeds the high one";
   return {};
+}
+
+// Geometric fit of the rim: twice, collect the points within the RANSAC threshold of the current
+// circle and fit them (plain least squares, then reweighted). `in` receives the final inliers.
+std::optional<Circle> fitRim(const std::vector<Eigen::Vector2d>& pts, Circle circle,
+                             const CircleMeasureParams& params, std::vector<Eigen::Vector2d>& in) {
+  std::vector<double> w;
+  for (int round = 0; round < 2; ++round) {
+    in.clear();
+    for (const auto& p : pts)
+      if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
+    if (static_cast<int>(in.size()) < params.minInliers) break;
+    w.assign(in.size(), 1.0);
+    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 2;
+    for (int k = 0; k < irls; ++k) {
+      if (k > 0) {
+        std::vector<double> a;
+        a.reserve(in.size());
+        for (const auto& p : in) a.push_back(std::abs(residual(circle, p)));
+        std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+        const double sigma = std::max(1.4826 * a[a.size() / 2], 0.01);
+        for (std::size_t i = 0; i < in.size(); ++i)
+          w[i] = robustWeight(params.robustWeight, residual(circle, in[i]), sigma);
+      }
+      auto refined = fitGeometric(in, w, circle);
+      if (!refined) return std::nullopt;
+      circle = *refined;
+    }
+  }
+  return circle;
+}
+
+// Strong edge points that are not the rim: off the circle or not radial with the rim's polarity
+// (rimSign +1: gradient outwards). Weak ones (below the high threshold) are mostly noise and must
+// not punch holes into the grey-value fit.
+std::vector<cv::Point2d> foreignEdges(const AnnulusEdges& edges, const Circle& circle, int rimSign,
+                                      double cosTol) {
+  std::vector<cv::Point2d> foreign;
+  for (const EdgePoint& e : edges.points) {
+    const Eigen::Vector2d radial = Eigen::Vector2d{e.position.x, e.position.y} - circle.centre;
+    const double d = radial.norm();
+    if (d == 0.0) continue;
+    const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
+    if (e.magnitude >= edges.highThreshold && (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
+      foreign.push_back(e.position);
+  }
+  return foreign;
 }
 
 // Edge point relative to the expected centre, with its radial alignment.
@@ -234,8 +286,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   if (m.candidates < params.minInliers)
     return failed(m, CircleFailure::TooFewPoints,
                   std::to_string(m.candidates) +
-                      " edge points with a radial gradient in the "
-                      "annulus, fewer than the " +
+                      " edge points with a radial gradient in the annulus, fewer than the " +
                       std::to_string(params.minInliers) + " required");
 
   // RANSAC, once per polarity when either is allowed: a circle's rim has one polarity.
@@ -245,6 +296,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::optional<Circle> best;
   std::vector<Eigen::Vector2d> bestPts;
   std::size_t bestCount = 0;
+  int rimSign = +1;  // +1: gradient points outwards (dark inside), -1: inwards
   for (int sign : {+1, -1}) {
     std::vector<Eigen::Vector2d> pts;
     for (const Candidate& c : candidates)
@@ -263,6 +315,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     auto found = ransac<Circle>(pts.size(), 3, fit, res, rp);
     if (found && found->inliers.size() > bestCount) {
       bestCount = found->inliers.size();
+      rimSign = sign;
       best = found->model;
       bestPts = std::move(pts);
     }
@@ -274,32 +327,11 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
 
   // Geometric fit on the RANSAC inliers, then re-collect the inliers around the refined circle
   // and refit with the robust weight.
-  Circle circle = *best;
   std::vector<Eigen::Vector2d> in;
-  std::vector<double> w;
-  for (int round = 0; round < 2; ++round) {
-    in.clear();
-    for (const auto& p : bestPts)
-      if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
-    if (static_cast<int>(in.size()) < params.minInliers) break;
-    w.assign(in.size(), 1.0);
-    const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 3;
-    for (int k = 0; k < irls; ++k) {
-      if (k > 0) {
-        std::vector<double> a;
-        a.reserve(in.size());
-        for (const auto& p : in) a.push_back(std::abs(residual(circle, p)));
-        std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
-        const double sigma = std::max(1.4826 * a[a.size() / 2], 0.01);
-        for (std::size_t i = 0; i < in.size(); ++i)
-          w[i] = robustWeight(params.robustWeight, residual(circle, in[i]), sigma);
-      }
-      auto refined = fitGeometric(in, w, circle);
-      if (!refined)
-        return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
-      circle = *refined;
-    }
-  }
+  const std::optional<Circle> fitted = fitRim(bestPts, *best, params, in);
+  if (!fitted)
+    return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
+  const Circle circle = *fitted;
   m.inliers = static_cast<int>(in.size());
   m.inlierPoints.reserve(in.size());
   double sum2 = 0, lo = 0, hi = 0;
@@ -315,14 +347,6 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   m.coverageDeg = coverageDeg(in, circle);
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
-  if (params.refineWithGreyValues && m.inliers >= params.minInliers) {
-    if (auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints)) {
-      m.centre = fine->centre;
-      m.radius = fine->radius;
-      m.blur = fine->blur;
-      m.greyRefined = true;
-    }
-  }
   m.diameter = 2.0 * m.radius;
 
   if (m.inliers < params.minInliers)
@@ -337,6 +361,18 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     return failed(
         m, CircleFailure::FitTooPoor,
         "the fit's rms " + std::to_string(m.rms) + " px exceeds " + std::to_string(params.maxRms));
+
+  if (params.refineWithGreyValues) {
+    if (auto fine =
+            fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints,
+                             foreignEdges(edges, circle, rimSign, cosTol), edges.noiseSigma)) {
+      m.centre = fine->centre;
+      m.radius = fine->radius;
+      m.diameter = 2.0 * m.radius;
+      m.blur = fine->blur;
+      m.greyRefined = true;
+    }
+  }
   if (std::abs(m.radius - params.radius) > params.width ||
       std::hypot(m.centre.x - c0.x, m.centre.y - c0.y) > params.width)
     return failed(m, CircleFailure::FitTooPoor, "the fitted circle leaves the search annulus");

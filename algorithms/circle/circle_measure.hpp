@@ -4,11 +4,18 @@
 //
 // Pipeline (seed dissertation, part 2):
 //   1. annulus [radius - width, radius + width] around the expected centre;
-//   2. Canny inside the annulus, both hysteresis thresholds chosen from that annulus alone;
-//   3. subpixel Facet-model edge points (algorithms/edges), with the curvature bias corrected;
+//   2. Canny inside the annulus, both hysteresis thresholds chosen from that annulus alone
+//      (annulus_edges.hpp);
+//   3. subpixel Facet-model edge points (algorithms/edges);
 //   4. outliers removed by gradient direction: near-radial within a tolerance, expected polarity;
 //   5. RANSAC circle, then a geometric (orthogonal distance) least-squares fit on the inliers by
-//      Levenberg-Marquardt, optionally with a robust Huber/Tukey weight (IRLS).
+//      Levenberg-Marquardt, optionally with a robust Huber/Tukey weight (IRLS); the curvature
+//      bias of second-derivative edges (-k / r) is corrected with a measured k;
+//   6. (default) a grey-value refinement on the rim the inliers cover (circle_profile_fit.hpp):
+//      a blurred-disc model fitted to every pixel of a band around the rim. It reaches the
+//      Cramer-Rao bound where edge points stay about 2x above it (small circles) and corrects the
+//      curvature bias from the fitted blur instead of a constant.
+// RMS, roundness, inliers and coverage always describe the edge points of step 5.
 //
 // Failures are reported as flags with a cause and a message, never as a bogus circle: when
 // `ok()` is false the centre, radius and diameter are NaN.

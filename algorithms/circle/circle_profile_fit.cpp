@@ -15,10 +15,20 @@ constexpr double kPi = std::numbers::pi;
 // One pixel of the band, relative to the starting centre.
 struct Sample {
   double x, y, grey;
+  int bin;  // angular bin
 };
 
 using Vector8 = Eigen::Matrix<double, 8, 1>;
 using Matrix8 = Eigen::Matrix<double, 8, 8>;
+
+// A monotonic stand-in for the polar angle, in [0, 4) (no atan2 in the pixel loops); bins of
+// equal width in it are within a factor 1.5 of equal angles.
+double diamondAngle(double dx, double dy) {
+  const double sum = std::abs(dx) + std::abs(dy);
+  if (sum == 0.0) return 0.0;
+  const double q = dy / sum;
+  return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
+}
 
 // Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): Abramowitz & Stegun
 // 7.1.26 for erfc (absolute error below 1.5e-7), which reuses the exponential the Jacobian needs.
@@ -43,15 +53,15 @@ double medianOf(std::vector<double> v) {
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
-                                                 double maxShift) {
+                                                 const std::vector<cv::Point2d>& foreignPoints,
+                                                 double noiseSigma, double maxShift) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
 
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
   const int bins = std::max(16, static_cast<int>(2.0 * kPi * radius / 2.0));
   auto binOf = [&](double dx, double dy) {
-    const double a = std::atan2(dy, dx) + kPi;  // 0..2pi
-    return std::min(bins - 1, static_cast<int>(a / (2.0 * kPi) * bins));
+    return std::min(bins - 1, static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins));
   };
   std::vector<std::uint8_t> covered(bins, 0);
   for (const auto& q : rimPoints) covered[binOf(q.x - centre.x, q.y - centre.y)] = 1;
@@ -69,14 +79,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       covered[i] = inside ? 1 : 0;
     }
   }
-  // Large circles have far more pixels than the accuracy needs: keep an evenly spread share of
-  // the bins so that about kMaxPixels pixels take part (bounds the time of big circles).
-  constexpr double kBand = 3.0;
-  constexpr double kMaxPixels = 2500.0;
-  const double share = std::min(1.0, kMaxPixels / (2.0 * kPi * radius * 2.0 * kBand));
-  if (share < 1.0)
-    for (int i = 0; i < bins; ++i)
-      if (std::floor((i + 1) * share) == std::floor(i * share)) covered[i] = 0;
+  constexpr double kBand = 4.0;
 
   // The band |rho - R| <= kBand inside the image.
   std::vector<Sample> samples;
@@ -85,6 +88,18 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
   const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - rOut)));
   const int y1 = std::min(image.rows - 1, static_cast<int>(std::ceil(centre.y + rOut)));
+  // Pixels within 2 px of a foreign edge (clutter, an occluder's border) stay out of the fit.
+  cv::Mat tainted;
+  if (!foreignPoints.empty() && x1 >= x0 && y1 >= y0) {
+    tainted = cv::Mat::zeros(y1 - y0 + 1, x1 - x0 + 1, CV_8U);
+    for (const auto& q : foreignPoints) {
+      const int qx = static_cast<int>(std::lround(q.x)), qy = static_cast<int>(std::lround(q.y));
+      for (int v = std::max(y0, qy - 2); v <= std::min(y1, qy + 2); ++v)
+        for (int u = std::max(x0, qx - 2); u <= std::min(x1, qx + 2); ++u)
+          if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= 4.0)
+            tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
+    }
+  }
   for (int y = y0; y <= y1; ++y) {
     const double dy = y - centre.y;
     if (dy * dy > rOut * rOut) continue;
@@ -99,10 +114,11 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
         x = static_cast<int>(std::ceil(centre.x + inner)) - 1;  // jump over the inner disc
         continue;
       }
-      if (!covered[binOf(dx, dy)]) continue;
+      const int bin = binOf(dx, dy);
+      if (!covered[bin] || (!tainted.empty() && tainted.at<std::uint8_t>(y - y0, x - x0))) continue;
       const double grey = image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
                                                   : image.at<std::uint8_t>(y, x);
-      samples.push_back({dx, dy, grey});
+      samples.push_back({dx, dy, grey, bin});
     }
   }
   if (samples.size() < 30) return std::nullopt;
@@ -118,6 +134,22 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   Vector8 p;
   p << 0.0, 0.0, radius, 1.2, medianOf(outside), 0.0, 0.0, 0.0;
   p(7) = medianOf(inside) - p(4);
+
+  // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
+  // bins, enough for a centre precision of about kTargetSigma px per axis by the Cramer-Rao bound
+  // (information per band pixel about (b / noise)^2 / (2 sqrt(pi) s) / (2 * 2 kBand)); this
+  // bounds the time of big, high-contrast circles and keeps every pixel of faint ones.
+  constexpr double kTargetSigma = 0.0035;
+  if (noiseSigma > 0.0) {
+    const double snr = p(7) / noiseSigma;
+    const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * kBand);
+    const double needed = std::max(1000.0, 1.0 / (kTargetSigma * kTargetSigma * infoPerPixel));
+    const double share = needed / static_cast<double>(samples.size());
+    if (share < 1.0)
+      std::erase_if(samples, [&](const Sample& e) {
+        return std::floor((e.bin + 1) * share) == std::floor(e.bin * share);
+      });
+  }
 
   // One pass over the band at parameters q: residuals (grey - model) and Jacobian rows.
   const std::size_t m = samples.size();
@@ -148,12 +180,21 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   auto normalEquations = [&] {
     jtj.setZero();
     jtr.setZero();
+    double h[8][8] = {}, g[8] = {};
     for (std::size_t i = 0; i < m; ++i) {
-      if (weight[i] == 0.0) continue;
-      jtj.selfadjointView<Eigen::Lower>().rankUpdate(jac[i], weight[i]);
-      jtr += (weight[i] * r[i]) * jac[i];
+      const double w = weight[i];
+      if (w == 0.0) continue;
+      const double* j = jac[i].data();
+      for (int u = 0; u < 8; ++u) {
+        const double wu = w * j[u];
+        g[u] += wu * r[i];
+        for (int v = 0; v <= u; ++v) h[u][v] += wu * j[v];
+      }
     }
-    jtj.triangularView<Eigen::StrictlyUpper>() = jtj.transpose();
+    for (int u = 0; u < 8; ++u) {
+      jtr(u) = g[u];
+      for (int v = 0; v <= u; ++v) jtj(u, v) = jtj(v, u) = h[u][v];
+    }
   };
   auto tukeyWeights = [&] {
     std::vector<double> absR(m);
@@ -216,17 +257,30 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     return true;
   };
 
-  // With the illumination ramp first; in a thin band a ramp resembles a shifted rim, so keeping
-  // it costs about half the precision of a small circle: drop it unless it is significant
-  // (chi-square of the two slopes, 2 degrees of freedom, 99.9%).
-  if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
+  // Without the illumination ramp first: in a thin band a ramp resembles a shifted rim, and
+  // fitting one costs about half the precision of a small circle. A score test at that solution
+  // (chi-square of the ramp's gradient, 2 degrees of freedom, 99.9%) decides whether the image
+  // has a ramp worth fitting.
+  if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
   normalEquations();
-  const Matrix8 cov = jtj.inverse() * (sigma * sigma);
-  const Eigen::Vector2d slope = p.segment<2>(5);
-  const Eigen::Matrix2d slopeCov = cov.block<2, 2>(5, 5);
-  if (slopeCov.allFinite() && slope.dot(slopeCov.ldlt().solve(slope)) < 13.8) {
-    p(5) = p(6) = 0.0;
-    if (!solve({true, true, true, true, true, false, false, true}, 6, false)) return std::nullopt;
+  {
+    constexpr int kRamp[2] = {5, 6};
+    constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
+    Eigen::Matrix2d hgg;
+    Eigen::Matrix<double, 2, 6> hgo;
+    Eigen::Matrix<double, 6, 6> hoo;
+    Eigen::Vector2d score;
+    for (int u = 0; u < 2; ++u) {
+      score(u) = jtr(kRamp[u]);
+      for (int v = 0; v < 2; ++v) hgg(u, v) = jtj(kRamp[u], kRamp[v]);
+      for (int v = 0; v < 6; ++v) hgo(u, v) = jtj(kRamp[u], kRest[v]);
+    }
+    for (int u = 0; u < 6; ++u)
+      for (int v = 0; v < 6; ++v) hoo(u, v) = jtj(kRest[u], kRest[v]);
+    const Eigen::Matrix2d schur = hgg - hgo * hoo.ldlt().solve(hgo.transpose());
+    const double statistic = score.dot(schur.ldlt().solve(score)) / std::max(sigma * sigma, 1e-12);
+    if (std::isfinite(statistic) && statistic > 13.8)
+      if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
   }
 
   const double blur = p(3);

@@ -6,10 +6,11 @@
 // enough. This fit instead uses every pixel of a band around the rim and fits the grey values
 // directly with the model of a blurred disc,
 //   I(x, y) = a(theta) + b(theta) * Phi(-(|p - c| - R) / s),
-// where Phi is the standard normal CDF, s the blur (PSF sigma and pixel size combined), and
-// a (outside grey) and b (inside minus outside) vary smoothly around the rim (linear between
-// sector nodes), so illumination gradients and uneven contrast do not bias the centre.
-// Gauss-Newton with Levenberg damping; Tukey weights on the grey residuals reject clutter.
+// where Phi is the standard normal CDF, s the blur (PSF sigma and pixel size combined), b the
+// contrast (inside minus outside) and a(x, y) = a0 + g . (p - c0) the outside grey with an
+// illumination ramp g. In a thin band a ramp looks much like a shifted rim (it would cost half
+// the precision of a small circle), so g is kept only when it is significant (chi-square, 99.9%).
+// Levenberg-Marquardt; Tukey weights on the grey residuals reject clutter.
 //
 // The 50% level of a blurred disc lies s^2 / (2 R) inside its true rim (the disc is convex, so
 // it covers less than half of the PSF centred on its rim); the fitted s corrects that bias
@@ -32,11 +33,15 @@ struct CircleProfileFit {
 
 // `image`: CV_8UC1 or CV_16UC1. `centre`, `radius`: the geometric fit of the edge points.
 // `rimPoints`: its inlier edge points; only the parts of the rim they cover are used (occluded or
-// cluttered sectors stay out). Returns nothing when the fit does not converge to a plausible
-// circle (moves farther than `maxShift` pixels, blur outside (0.2, 5) px).
+// cluttered sectors stay out). `foreignPoints`: edge points that are not the rim (clutter, an
+// occluder's border); pixels within 2 px of them stay out. `noiseSigma` (grey levels, 8-bit scale;
+// 0 = unknown) lets a clean, large rim use only the share of its pixels the precision needs.
+// Returns nothing when the fit does not converge to a plausible circle (moves farther than
+// `maxShift` pixels, blur outside (0.2, 5) px).
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
-                                                 double maxShift = 1.0);
+                                                 const std::vector<cv::Point2d>& foreignPoints = {},
+                                                 double noiseSigma = 0.0, double maxShift = 1.0);
 
 }  // namespace facet

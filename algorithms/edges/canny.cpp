@@ -41,14 +41,15 @@ void magnitudeOf(const cv::Mat& gx, const cv::Mat& gy, float scale, cv::Mat& mag
 // one pixel. state: 0 = no, 1 = candidate, 2 = edge.
 template <typename T>
 void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask, cv::Rect area,
-              cv::Mat& state, std::vector<cv::Point>& strong) {
+              int gradientRow0, cv::Mat& state, std::vector<cv::Point>& strong) {
   // Signed: m[x - step] with an unsigned step wraps around before the pointer addition, which is
   // undefined behaviour (UBSan's pointer-overflow check) even though it lands on the row above.
   const auto step = static_cast<std::ptrdiff_t>(g.magnitude.step1());
   for (int y = area.y; y < area.y + area.height; ++y) {
-    const float* m = g.magnitude.ptr<float>(y);
-    const T* gx = g.gx.ptr<T>(y);
-    const T* gy = g.gy.ptr<T>(y);
+    const int gy0 = y - gradientRow0;  // the gradient maps may cover a strip only
+    const float* m = g.magnitude.ptr<float>(gy0);
+    const T* gx = g.gx.ptr<T>(gy0);
+    const T* gy = g.gy.ptr<T>(gy0);
     const uchar* k = mask.empty() ? nullptr : mask.ptr<uchar>(y);
     uchar* s = state.ptr<uchar>(y);
     for (int x = area.x; x < area.x + area.width; ++x) {
@@ -65,6 +66,31 @@ void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask,
       }
     }
   }
+}
+
+// Hysteresis: grow the strong pixels through 8-connected candidates (state 0 on the border, so
+// the neighbours are always inside), then 2 -> 255 and everything else -> 0.
+void hysteresis(cv::Mat& state, std::vector<cv::Point>& stack) {
+  while (!stack.empty()) {
+    const cv::Point p = stack.back();
+    stack.pop_back();
+    for (int dy = -1; dy <= 1; ++dy) {
+      auto* s = state.ptr<uchar>(p.y + dy);
+      for (int dx = -1; dx <= 1; ++dx) {
+        if (s[p.x + dx] == 1) {
+          s[p.x + dx] = 2;
+          stack.emplace_back(p.x + dx, p.y + dy);
+        }
+      }
+    }
+  }
+  cv::compare(state, 2, state, cv::CMP_EQ);
+}
+
+cv::Rect candidateArea(cv::Size size, cv::Rect candidates) {
+  const cv::Rect inside(1, 1, size.width - 2, size.height - 2);
+  return candidates.empty() ? cv::Rect(2, 2, size.width - 4, size.height - 4) & inside
+                            : candidates & inside;
 }
 
 }  // namespace
@@ -102,34 +128,45 @@ cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,
   if (size.empty()) return state;
   if (!mask.empty() && (mask.size() != size || mask.type() != CV_8UC1))
     throw std::invalid_argument("edges: the mask must be CV_8UC1 of the region's size");
-  const cv::Rect inside(1, 1, size.width - 2, size.height - 2);
-  candidates = candidates.empty() ? cv::Rect(2, 2, size.width - 4, size.height - 4) & inside
-                                  : candidates & inside;
+  candidates = candidateArea(size, candidates);
   const auto lowF = static_cast<float>(low);
   const auto highF = static_cast<float>(std::max(low, high));
-
   std::vector<cv::Point> stack;
   if (gradient.gx.depth() == CV_16S)
-    suppress<short>(gradient, lowF, highF, mask, candidates, state, stack);
+    suppress<short>(gradient, lowF, highF, mask, candidates, 0, state, stack);
   else
-    suppress<float>(gradient, lowF, highF, mask, candidates, state, stack);
-  // Hysteresis: grow the strong pixels through 8-connected candidates (state 0 at the border of
-  // `inside`, so the neighbours are always in the image).
-  while (!stack.empty()) {
-    const cv::Point p = stack.back();
-    stack.pop_back();
-    for (int dy = -1; dy <= 1; ++dy) {
-      auto* s = state.ptr<uchar>(p.y + dy);
-      for (int dx = -1; dx <= 1; ++dx) {
-        if (s[p.x + dx] == 1) {
-          s[p.x + dx] = 2;
-          stack.emplace_back(p.x + dx, p.y + dy);
-        }
-      }
-    }
+    suppress<float>(gradient, lowF, highF, mask, candidates, 0, state, stack);
+  hysteresis(state, stack);
+  return state;
+}
+
+cv::Mat cannyInStrips(const cv::Mat& image, cv::Rect area, double low, double high,
+                      const cv::Mat& mask, cv::Rect candidates) {
+  requireGreyImage(image);
+  area &= cv::Rect(0, 0, image.cols, image.rows);
+  cv::Mat state = cv::Mat::zeros(area.size(), CV_8U);
+  if (area.empty()) return state;
+  if (!mask.empty() && (mask.size() != area.size() || mask.type() != CV_8UC1))
+    throw std::invalid_argument("edges: the mask must be CV_8UC1 of the region's size");
+  candidates = candidateArea(area.size(), candidates);
+  const auto lowF = static_cast<float>(low);
+  const auto highF = static_cast<float>(std::max(low, high));
+  std::vector<cv::Point> stack;
+  // Strips of 16 rows keep the gradient maps small (below malloc's mmap threshold, so they are
+  // reused instead of being mapped and faulted in afresh for every image).
+  constexpr int kStrip = 16;
+  for (int r0 = candidates.y; r0 < candidates.y + candidates.height; r0 += kStrip) {
+    const int r1 = std::min(r0 + kStrip, candidates.y + candidates.height);
+    // Gradient rows r0 - 1 .. r1 (suppression looks one row up and down).
+    const cv::Rect strip(area.x, area.y + r0 - 1, area.width, r1 - r0 + 2);
+    const EdgeGradient g = computeEdgeGradient(image, strip);
+    const cv::Rect rows(candidates.x, r0, candidates.width, r1 - r0);
+    if (g.gx.depth() == CV_16S)
+      suppress<short>(g, lowF, highF, mask, rows, r0 - 1, state, stack);
+    else
+      suppress<float>(g, lowF, highF, mask, rows, r0 - 1, state, stack);
   }
-  // 2 -> 255, everything else -> 0.
-  cv::compare(state, 2, state, cv::CMP_EQ);
+  hysteresis(state, stack);
   return state;
 }
 

@@ -34,6 +34,12 @@ EdgeGradient computeEdgeGradient(const cv::Mat& image, cv::Rect area = {});
 cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,
                           const cv::Mat& mask = {}, cv::Rect candidates = {});
 
+// The same as cannyFromGradient(computeEdgeGradient(image, area), ...), computed in strips of
+// rows so that no full-size gradient maps are allocated (faster on large images). `mask` and
+// `candidates` are relative to `area`, which must lie inside the image.
+cv::Mat cannyInStrips(const cv::Mat& image, cv::Rect area, double low, double high,
+                      const cv::Mat& mask = {}, cv::Rect candidates = {});
+
 // Convenience: gradient and Canny over `roi` (empty = whole image); result has the ROI's size.
 cv::Mat cannyEdges(const cv::Mat& image, double low, double high, cv::Rect roi = {},
                    const cv::Mat& mask = {});

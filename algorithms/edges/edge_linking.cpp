@@ -1,19 +1,45 @@
 #include "algorithms/edges/edge_linking.hpp"
 
 #include <algorithm>
-#include <unordered_map>
+#include <cmath>
+#include <vector>
 
 namespace facet {
 namespace {
 
+// Points come in raster order of their pixels (detectSubpixelEdges scans row by row); an index
+// of where each row starts finds a pixel's point by a short search within its row. Any other
+// order is sorted first.
 struct PixelIndex {
-  std::unordered_map<long long, int> map;
-  static long long key(cv::Point p) {
-    return (static_cast<long long>(p.y) << 32) ^ static_cast<unsigned int>(p.x);
+  int firstRow = 0;
+  std::vector<int> rowStart;  // into `order`, one per row + 1
+  std::vector<int> order;     // point indices sorted by (y, x)
+  const std::vector<cv::Point>* pixels = nullptr;
+
+  explicit PixelIndex(const std::vector<cv::Point>& px) : pixels(&px) {
+    order.resize(px.size());
+    for (size_t i = 0; i < px.size(); ++i) order[i] = static_cast<int>(i);
+    auto before = [&](int a, int b) {
+      return px[a].y != px[b].y ? px[a].y < px[b].y : px[a].x < px[b].x;
+    };
+    if (!std::is_sorted(order.begin(), order.end(), before))
+      std::sort(order.begin(), order.end(), before);
+    if (px.empty()) return;
+    firstRow = px[order.front()].y;
+    const int rows = px[order.back()].y - firstRow + 1;
+    rowStart.assign(rows + 1, 0);
+    for (int i : order) ++rowStart[px[i].y - firstRow + 1];
+    for (int r = 0; r < rows; ++r) rowStart[r + 1] += rowStart[r];
   }
   int find(cv::Point p) const {
-    const auto it = map.find(key(p));
-    return it == map.end() ? -1 : it->second;
+    const int r = p.y - firstRow;
+    if (r < 0 || r + 1 >= static_cast<int>(rowStart.size())) return -1;
+    for (int k = rowStart[r]; k < rowStart[r + 1]; ++k) {
+      const int x = (*pixels)[order[k]].x;
+      if (x == p.x) return order[k];
+      if (x > p.x) break;
+    }
+    return -1;
   }
 };
 
@@ -32,7 +58,7 @@ int nextPoint(int i, double sign, const std::vector<EdgePoint>& points,
       if (j < 0 || visited[j]) continue;
       if (points[j].normal.dot(p.normal) < params.minNormalAgreement) continue;
       const cv::Point2d d = points[j].position - p.position;
-      const double ahead = d.dot(t) / std::max(1e-9, std::hypot(d.x, d.y));
+      const double ahead = d.dot(t) / std::max(1e-9, std::sqrt(d.x * d.x + d.y * d.y));
       if (ahead > bestAhead) {
         bestAhead = ahead;
         best = j;
@@ -46,10 +72,7 @@ int nextPoint(int i, double sign, const std::vector<EdgePoint>& points,
 std::vector<std::vector<int>> linkEdgePoints(const std::vector<EdgePoint>& points,
                                              const std::vector<cv::Point>& pixels,
                                              const EdgeLinkParams& params) {
-  PixelIndex index;
-  index.map.reserve(points.size() * 2);
-  for (int i = 0; i < static_cast<int>(points.size()); ++i)
-    index.map[PixelIndex::key(pixels[i])] = i;
+  const PixelIndex index(pixels);
 
   std::vector<char> visited(points.size(), 0);
   std::vector<std::vector<int>> contours;

@@ -4,9 +4,11 @@
 #include <array>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <numbers>
+#include <type_traits>
 #include <vector>
 
 namespace facet {
@@ -68,12 +70,17 @@ constexpr int kApertureAngles = 46;
 struct ApertureProfiles {
   double sigma = 0;
   bool gridBlur = false;
-  std::vector<NormalTable::Interval> rows;  // kApertureAngles x kApertureSize
+  std::vector<NormalTable::Interval> rows;  // kApertureAngles x kApertureSize, built on use
+  std::unique_ptr<std::once_flag[]> built;
 
-  ApertureProfiles(double psfSigma, bool blurOnGrid) : sigma(psfSigma), gridBlur(blurOnGrid) {
+  ApertureProfiles(double psfSigma, bool blurOnGrid)
+      : sigma(psfSigma), gridBlur(blurOnGrid), built(new std::once_flag[kApertureAngles]) {
     rows.resize(static_cast<size_t>(kApertureAngles) * kApertureSize);
+  }
+
+  void buildRow(int k) {
     std::vector<double> value(kApertureSize), slope(kApertureSize);
-    for (int k = 0; k < kApertureAngles; ++k) {
+    {
       const double angle = k * std::numbers::pi / 180.0;
       const double c = std::cos(angle), sn = std::sin(angle);
       for (int i = 0; i < kApertureSize; ++i) {
@@ -92,12 +99,20 @@ struct ApertureProfiles {
     }
   }
 
-  ProfileView view(cv::Point2d normal) const {
+  ProfileView view(cv::Point2d normal) {
     const double lo = std::min(std::abs(normal.x), std::abs(normal.y));
     const double hi = std::max(std::abs(normal.x), std::abs(normal.y));
-    const int k =
-        std::clamp(static_cast<int>(std::lround(std::atan2(lo, hi) * 180 / std::numbers::pi)), 0,
-                   kApertureAngles - 1);
+    // The nearest whole degree of atan(lo / hi), by comparing with tan(k + 1/2 degree).
+    static const std::array<double, kApertureAngles> tanHalf = [] {
+      std::array<double, kApertureAngles> t{};
+      for (int k = 0; k < kApertureAngles; ++k) t[k] = std::tan((k + 0.5) * std::numbers::pi / 180);
+      return t;
+    }();
+    const double ratio = hi > 0 ? lo / hi : 0.0;
+    const int k = std::min(
+        static_cast<int>(std::lower_bound(tanHalf.begin(), tanHalf.end(), ratio) - tanHalf.begin()),
+        kApertureAngles - 1);
+    std::call_once(built[k], [this, k] { buildRow(k); });
     return {&rows[static_cast<size_t>(k) * kApertureSize],
             kApertureSize,
             1.0f,
@@ -144,6 +159,15 @@ struct ApertureProfiles {
     double sum = 0;
     for (int k = -r; k <= r; ++k) sum += kernel[k + r] = std::exp(-0.5 * k * k / (sigma * sigma));
     value = slope = 0;
+    if (s < 1e-9) {  // axis-aligned: the kernel's rows all project to the same offsets
+      for (int kx = -r; kx <= r; ++kx) {
+        double v, d;
+        sharpStep(u - kx * c, c, s, v, d);
+        value += kernel[kx + r] / sum * v;
+        slope += kernel[kx + r] / sum * d;
+      }
+      return;
+    }
     for (int ky = -r; ky <= r; ++ky)
       for (int kx = -r; kx <= r; ++kx) {
         double v, d;
@@ -170,15 +194,15 @@ struct ApertureProfiles {
 
 // Profiles are pure functions of sigma; keep the last few so that a camera's images (whose blur
 // estimate varies little) build them once.
-std::shared_ptr<const ApertureProfiles> apertureProfiles(double sigma, bool gridBlur) {
+std::shared_ptr<ApertureProfiles> apertureProfiles(double sigma, bool gridBlur) {
   static std::mutex mutex;
-  static std::vector<std::shared_ptr<const ApertureProfiles>> cache;
+  static std::vector<std::shared_ptr<ApertureProfiles>> cache;
   const double key = std::round(sigma * 50) / 50;
   std::lock_guard lock(mutex);
   for (const auto& p : cache)
     if (p->sigma == key && p->gridBlur == gridBlur) return p;
-  auto made = std::make_shared<const ApertureProfiles>(key, gridBlur);
-  if (cache.size() >= 8) cache.erase(cache.begin());
+  auto made = std::make_shared<ApertureProfiles>(key, gridBlur);
+  if (cache.size() >= 24) cache.erase(cache.begin());
   cache.push_back(made);
   return made;
 }
@@ -237,13 +261,14 @@ bool solveSpd(std::array<std::array<double, N>, N>& a, std::array<double, N>& y)
   return true;
 }
 
-// The integer range of dx for which lo <= dx * k + c <= hi (all dx when k ~ 0 and c fits).
-void restrict(double k, double c, double lo, double hi, int& first, int& last) {
+// The integer range of dx for which lo <= dx * k + c <= hi, given invK = 1 / k (all dx when k ~ 0
+// and c fits).
+void restrict(double k, double invK, double c, double lo, double hi, int& first, int& last) {
   if (std::abs(k) < 1e-12) {
     if (c < lo || c > hi) last = first - 1;
     return;
   }
-  double x0 = (lo - c) / k, x1 = (hi - c) / k;
+  double x0 = (lo - c) * invK, x1 = (hi - c) * invK;
   if (x0 > x1) std::swap(x0, x1);
   first = std::max(first, static_cast<int>(std::ceil(x0 - 1e-9)));
   last = std::min(last, static_cast<int>(std::floor(x1 + 1e-9)));
@@ -254,24 +279,36 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
             const EdgeProfileParams& params, float scale, Samples& out) {
   const int reach = edgeProfileReach(params);
   out.count = 0;
-  double sum = 0;
+  float sum = 0;
+  const auto nx = static_cast<float>(n.x), ny = static_cast<float>(n.y);
+  const double invX = std::abs(n.x) < 1e-12 ? 0.0 : 1.0 / n.x;
+  const double invY = std::abs(n.y) < 1e-12 ? 0.0 : -1.0 / n.y;
   for (int dy = -reach; dy <= reach; ++dy) {
     int first = -reach, last = reach;
     // s = dx nx + dy ny within offset +- halfAcross; t = -dx ny + dy nx within +- halfAlong.
-    restrict(n.x, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first, last);
-    restrict(-n.y, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
+    restrict(n.x, invX, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first,
+             last);
+    restrict(-n.y, invY, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
+    last = std::min(last, first + (kCapacity - 4 - out.count) - 1);
     const T* row = image.ptr<T>(c.y + dy) + c.x;
-    for (int dx = first; dx <= last && out.count < kCapacity - 4; ++dx) {
-      const int i = out.count++;
-      out.s[i] = static_cast<float>(dx * n.x + dy * n.y);
-      out.t[i] = static_cast<float>(-dx * n.y + dy * n.x);
-      out.v[i] = static_cast<float>(row[dx]) * scale;
-      out.weight[i] = 1.0f;
-      sum += out.v[i];
+    const float sRow = static_cast<float>(dy) * ny, tRow = static_cast<float>(dy) * nx;
+    float* ps = &out.s[out.count];
+    float* pt = &out.t[out.count];
+    float* pv = &out.v[out.count];
+    float* pw = &out.weight[out.count];
+    for (int dx = first; dx <= last; ++dx) {
+      const auto fx = static_cast<float>(dx);
+      *ps++ = fx * nx + sRow;
+      *pt++ = tRow - fx * ny;
+      const float v = static_cast<float>(row[dx]) * scale;
+      *pv++ = v;
+      *pw++ = 1.0f;
+      sum += v;
     }
+    out.count += std::max(0, last - first + 1);
   }
   const int real = out.count;
-  out.mean = real ? static_cast<float>(sum / real) : 0.0f;
+  out.mean = real ? sum / static_cast<float>(real) : 0.0f;
   for (int i = 0; i < real; ++i) out.v[i] -= out.mean;
   while (out.count % 4) {
     const int i = out.count++;
@@ -341,6 +378,58 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
   return true;
 }
 
+// Residual sum of squares after two (a, b, e) steps of the fixed-profile model.
+double fitResidual(const Samples& smp, const ProfileView& view, double offset) {
+  double a = 0, b = 0, e = offset, w = 1, phi = 0;
+  if (!step<Extra::None>(smp, view, a, b, e, w, phi) ||
+      !step<Extra::None>(smp, view, a, b, e, w, phi))
+    return std::numeric_limits<double>::infinity();
+  double rss = 0;
+  for (int i = 0; i < smp.count; ++i) {
+    if (smp.weight[i] == 0) continue;
+    const double f = std::clamp((static_cast<double>(smp.s[i]) - e) * view.coordScale + view.range,
+                                0.0, static_cast<double>(view.size - 1) / view.perUnit) *
+                     view.perUnit;
+    const int k = std::min(static_cast<int>(f), view.size - 1);
+    const double r = smp.v[i] - a - b * (view.data[k].cdf + (f - k) * view.data[k].cdfSlope);
+    rss += r * r;
+  }
+  return rss;
+}
+
+template <typename T>
+void gatherAny(const cv::Mat& image, const EdgeSeed& seed, const EdgeProfileParams& params,
+               Samples& out) {
+  gather<T>(image, seed.pixel, seed.normal, seed.offset, params,
+            std::is_same_v<T, ushort> ? 1.0f / 256 : 1.0f, out);
+}
+
+// Axis-aligned edges show the profile at one subpixel phase only, which biases the erf width by
+// up to +-0.05 px depending on that phase. When they dominate, the blur is chosen instead as the
+// one whose exact (pixel-grid) profile fits them best.
+double refineWidthOnAxisEdges(const cv::Mat& image, const std::vector<const EdgeSeed*>& axis,
+                              const EdgeProfileParams& params, double width) {
+  std::vector<Samples> samples(axis.size());
+  for (size_t i = 0; i < axis.size(); ++i) {
+    if (image.depth() == CV_16U)
+      gatherAny<ushort>(image, *axis[i], params, samples[i]);
+    else
+      gatherAny<uchar>(image, *axis[i], params, samples[i]);
+  }
+  const double sigma0 = std::round(std::sqrt(std::max(width * width - 1.0 / 12, 0.04)) * 50) / 50;
+  double best = std::numeric_limits<double>::infinity(), bestSigma = sigma0;
+  for (int step = -6; step <= 6; ++step) {
+    const double sigma = sigma0 + 0.02 * step;
+    if (sigma < 0.2) continue;
+    const auto profiles = apertureProfiles(sigma, true);
+    double rss = 0;
+    for (size_t i = 0; i < axis.size(); ++i)
+      rss += fitResidual(samples[i], profiles->view(axis[i]->normal), axis[i]->offset);
+    if (rss < best) best = rss, bestSigma = sigma;
+  }
+  return std::sqrt(bestSigma * bestSigma + 1.0 / 12);
+}
+
 }  // namespace
 
 double profileHalfAlong(double curvature, const EdgeProfileParams& params) {
@@ -350,13 +439,14 @@ double profileHalfAlong(double curvature, const EdgeProfileParams& params) {
   return std::clamp(std::sqrt(6 * params.maxCurvatureBias / k), params.minAlong, params.halfAlong);
 }
 
-double profileCurvatureBias(double curvature, const EdgeProfileParams& params) {
-  const double l = std::floor(profileHalfAlong(curvature, params));
-  return std::abs(curvature) * l * (l + 1) / 6;
+double profileWindowBias(const EdgeProfileParams& params) {
+  return params.halfAlong * params.halfAlong / 6;
 }
 
 int edgeProfileReach(const EdgeProfileParams& params) {
-  return static_cast<int>(std::ceil(std::hypot(params.halfAcross + 1.5, params.halfAlong)));
+  return static_cast<int>(
+      std::ceil(std::sqrt((params.halfAcross + 1.5) * (params.halfAcross + 1.5) +
+                          params.halfAlong * params.halfAlong)));
 }
 
 std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, cv::Point2d normal,
@@ -374,7 +464,7 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   const bool fitWidth = params.width <= 0;
   // A known width w is the erf width of the blur and the pixel aperture together; the aperture's
   // variance along any normal is (cos^2 + sin^2) / 12 = 1/12, the rest is the PSF.
-  std::shared_ptr<const ApertureProfiles> aperture;
+  std::shared_ptr<ApertureProfiles> aperture;
   if (!fitWidth)
     aperture = apertureProfiles(std::sqrt(std::max(params.width * params.width - 1.0 / 12, 0.04)),
                                 params.blurOnPixelGrid);
@@ -393,6 +483,19 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
     }
     if (!ok) return std::nullopt;
   }
+  // A seed normal off by more than a degree or two (noise, a corner nearby) needs more turn
+  // steps: the linearisation in phi is only good for small turns. Give up when they do not
+  // settle.
+  if (!fitWidth && std::abs(phi) > 0.03) {
+    const ProfileView view = aperture->view(normal);
+    double previous = phi;
+    for (int extra = 0; extra < 3; ++extra) {
+      if (!step<Extra::Turn>(smp, view, a, b, e, w, phi)) return std::nullopt;
+      if (std::abs(phi - previous) < 0.003) break;
+      previous = phi;
+    }
+    if (std::abs(phi - previous) >= 0.003) return std::nullopt;
+  }
   if (std::abs(e - offset) > 1.0) return std::nullopt;  // wandered off: not a clean edge
   if (fittedWidth) *fittedWidth = w;
 
@@ -400,8 +503,8 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   // e / |n + phi t| along the turned unit normal.
   const cv::Point2d t{-normal.y, normal.x};
   cv::Point2d n = normal + phi * t;
-  n /= std::hypot(n.x, n.y);
-  return EdgePoint{cv::Point2d(pixel) + e / std::hypot(1.0, phi) * n, n,
+  n /= std::sqrt(n.x * n.x + n.y * n.y);
+  return EdgePoint{cv::Point2d(pixel) + e / std::sqrt(1.0 + phi * phi) * n, n,
                    b / (w * std::sqrt(2 * std::numbers::pi))};
 }
 
@@ -412,6 +515,8 @@ double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seed
   fitParams.iterations = std::max(params.iterations, 3);
   const int reach = edgeProfileReach(fitParams);
   std::vector<double> widths;
+  std::vector<const EdgeSeed*> axis;    // seeds whose normal is within 0.5 deg of an axis
+  constexpr double kAxisSine = 0.0087;  // sin(0.5 deg)
   const size_t stride = std::max<size_t>(1, seeds.size() / std::max(1, maxSamples));
   for (size_t i = 0; i < seeds.size(); i += stride) {
     const EdgeSeed& s = seeds[i];
@@ -419,11 +524,20 @@ double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seed
         s.pixel.y >= image.rows - reach)
       continue;
     double w = 0;
-    if (fitEdgeProfile(image, s.pixel, s.normal, s.offset, fitParams, &w)) widths.push_back(w);
+    if (!fitEdgeProfile(image, s.pixel, s.normal, s.offset, fitParams, &w)) continue;
+    widths.push_back(w);
+    if (std::min(std::abs(s.normal.x), std::abs(s.normal.y)) < kAxisSine) axis.push_back(&s);
   }
   if (widths.empty()) return params.initialWidth;
   std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
-  return widths[widths.size() / 2];
+  const double width = widths[widths.size() / 2];
+  if (!params.blurOnPixelGrid || axis.empty() || axis.size() * 2 < widths.size()) return width;
+  if (axis.size() > 16) {
+    std::vector<const EdgeSeed*> fewer;
+    for (size_t i = 0; i < 16; ++i) fewer.push_back(axis[i * axis.size() / 16]);
+    axis.swap(fewer);
+  }
+  return refineWidthOnAxisEdges(image, axis, params, width);
 }
 
 }  // namespace facet

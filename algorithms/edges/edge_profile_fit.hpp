@@ -63,8 +63,9 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
 // towards the centre of curvature. To keep that bias small on tight curves the window is
 // shortened to L = sqrt(6 maxCurvatureBias / |kappa|), within [minAlong, halfAlong].
 double profileHalfAlong(double curvature, const EdgeProfileParams& params = {});
-// The resulting offset (pixels, towards the centre of curvature) for curvature `curvature`.
-double profileCurvatureBias(double curvature, const EdgeProfileParams& params = {});
+// The fit's offset towards the centre of curvature per unit curvature, for the window of
+// `params` (pixels^2): <t^2> / 2 = L^2 / 6 with L = halfAlong (t spread evenly over +-L).
+double profileWindowBias(const EdgeProfileParams& params = {});
 
 // The window radius (pixels) the fit reads around its pixel.
 int edgeProfileReach(const EdgeProfileParams& params = {});

@@ -52,7 +52,7 @@ FacetCoefficients fitCubicFacet(const cv::Mat& image, cv::Point p) {
 }
 
 std::optional<FacetZeroCrossing> facetZeroCrossing(const FacetCoefficients& k) {
-  const double g = std::hypot(k[1], k[2]);
+  const double g = std::sqrt(k[1] * k[1] + k[2] * k[2]);
   if (g <= 0) return std::nullopt;
   const double c = k[1] / g, s = k[2] / g;
   FacetZeroCrossing z;

@@ -23,6 +23,27 @@ bool crossesInsidePixel(const EdgePoint& point, cv::Point pixel) {
   return std::abs(rho) <= 0.5 * axis;
 }
 
+// The final one-point-per-crossing rule on the refined (and curvature-corrected) positions:
+// noise can make two pixels of a row local maxima whose facet points both pass; the refined
+// points, averaged over the whole window, cannot both cross the row inside their pixels.
+void dropPointsOutsideTheirPixel(EdgeContours& result, const std::vector<cv::Point>& pixels) {
+  std::vector<int> newIndex(result.points.size(), -1);
+  size_t kept = 0;
+  for (size_t i = 0; i < result.points.size(); ++i) {
+    if (!crossesInsidePixel(result.points[i], pixels[i])) continue;
+    newIndex[i] = static_cast<int>(kept);
+    result.points[kept++] = result.points[i];
+  }
+  result.points.resize(kept);
+  for (auto& contour : result.contours) {
+    size_t n = 0;
+    for (int index : contour)
+      if (newIndex[index] >= 0) contour[n++] = newIndex[index];
+    contour.resize(n);
+  }
+  std::erase_if(result.contours, [](const std::vector<int>& c) { return c.empty(); });
+}
+
 }  // namespace
 
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params) {
@@ -43,25 +64,28 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   // The gradient covers the ROI plus one pixel for suppression; edge pixels need the facet's
   // 5x5 window inside the image.
   const cv::Rect area = cv::Rect(roi.x - 1, roi.y - 1, roi.width + 2, roi.height + 2) & full;
-  const EdgeGradient gradient = computeEdgeGradient(image, area);
   const cv::Rect usable = cv::Rect(2, 2, image.cols - 4, image.rows - 4) & roi;
   if (usable.empty()) return result;
   const cv::Rect candidates = usable - area.tl();
   const cv::Mat mask = params.mask.empty() ? cv::Mat() : params.mask(area);
 
+  cv::Mat edges;
   if (params.low && params.high) {
     result.lowThreshold = *params.low;
     result.highThreshold = *params.high;
+    edges = cannyInStrips(image, area, result.lowThreshold, result.highThreshold, mask, candidates);
   } else {
+    // Automatic thresholds need the whole region's magnitudes first.
+    const EdgeGradient gradient = computeEdgeGradient(image, area);
     cv::Mat region = cv::Mat::zeros(area.size(), CV_8U);
     region(candidates).setTo(255);
     if (!mask.empty()) region &= mask;
     const CannyThresholds t = autoCannyThresholds(gradient.magnitude, region);
     result.lowThreshold = t.low;
     result.highThreshold = t.high;
+    edges =
+        cannyFromGradient(gradient, result.lowThreshold, result.highThreshold, mask, candidates);
   }
-  const cv::Mat edges =
-      cannyFromGradient(gradient, result.lowThreshold, result.highThreshold, mask, candidates);
 
   // Facet zero crossings of every Canny pixel.
   std::vector<EdgeSeed> seeds;
@@ -81,32 +105,60 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
 
   // Profile refinement where its window fits in the image, with one blur width per image.
   EdgeProfileParams profile;
+  if (params.fitProfile) {
+    profile.width = estimateEdgeWidth(image, seeds, profile);
+    result.blurSigma = std::sqrt(std::max(profile.width * profile.width - 1.0 / 12, 0.0));
+    // What separates the offset from the background level is the plateau on either side; keep
+    // about 4 widths of it in the window when the blur is wide.
+    profile.halfAcross = std::clamp(3.9 * profile.width, profile.halfAcross, 6.5);
+  }
   const int reach = edgeProfileReach(profile);
   const cv::Rect fitArea(reach, reach, image.cols - 2 * reach, image.rows - 2 * reach);
-  if (params.fitProfile) profile.width = estimateEdgeWidth(image, seeds, profile);
   std::vector<cv::Point> pixels;
+  std::vector<double> windowBias;  // per point: kappa coefficient of the fit's window bias
   result.points.reserve(seeds.size());
   pixels.reserve(seeds.size());
   for (size_t i = 0; i < seeds.size(); ++i) {
     const EdgeSeed& s = seeds[i];
     EdgePoint point{cv::Point2d(s.pixel) + s.offset * s.normal, s.normal, magnitudes[i]};
+    // The facet zero crossing decides which pixel carries the point (one per row/column
+    // crossing); the profile fit then refines its position, which may leave the pixel by a
+    // little on tight curves.
+    if (!crossesInsidePixel(point, s.pixel)) continue;
+    double bias = 0;
     if (params.fitProfile && fitArea.contains(s.pixel)) {
       EdgeProfileParams local = profile;
       local.halfAlong = profileHalfAlong(curvatures[i], profile);
       const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, local);
       if (!refined) continue;
       point = *refined;
+      bias = profileWindowBias(local);
     }
-    if (!crossesInsidePixel(point, s.pixel)) continue;
     result.points.push_back(point);
     pixels.push_back(s.pixel);
+    windowBias.push_back(bias);
   }
 
-  if (params.linkContours || params.correctCurvatureBias) {
-    result.contours = linkEdgePoints(result.points, pixels);
-    if (params.correctCurvatureBias) correctCurvatureBias(result.points, result.contours);
-    if (!params.linkContours) result.contours.clear();
+  const bool link = params.linkContours || params.correctCurvatureBias || params.fitProfile;
+  if (link) result.contours = linkEdgePoints(result.points, pixels);
+  if (params.fitProfile) {
+    // The straight-line fit returns the arc's mean offset over its window, kappa <t^2> / 2
+    // towards the centre of curvature: remove it with the contour's curvature.
+    // The curvature is shrunk by 0.001/px (r = 1000 px) so that the noise of straight contours'
+    // curvature (~0.0006/px) does not move their points.
+    const std::vector<double> kappa = contourCurvatures(result.points, result.contours, 8);
+    for (size_t i = 0; i < result.points.size(); ++i) {
+      const double k = std::copysign(std::max(0.0, std::abs(kappa[i]) - 0.001), kappa[i]);
+      result.points[i].position += windowBias[i] * k * result.points[i].normal;
+    }
   }
+  if (params.correctCurvatureBias) {
+    CurvatureBiasParams correction;
+    correction.coefficient = curvatureBiasCoefficient(result.blurSigma);
+    correctCurvatureBias(result.points, result.contours, correction);
+  }
+  if (params.fitProfile) dropPointsOutsideTheirPixel(result, pixels);
+  if (!params.linkContours) result.contours.clear();
   return result;
 }
 

@@ -34,8 +34,9 @@ struct EdgeParams {
   cv::Mat mask;
   // Link points into contours (EdgeContours::contours); off saves time when only points are needed.
   bool linkContours = false;
-  // Correct the systematic radial bias of second-derivative edges on curved contours
-  // (about -k/r pixels for curvature radius r); uses the local curvature along linked contours.
+  // Correct the systematic radial bias of the edges on curved contours (about -k/r pixels for
+  // curvature radius r, k growing with the blur; curvature_bias.hpp); uses the local curvature
+  // along the linked contours.
   bool correctCurvatureBias = false;
   // Refine each facet point by fitting a blurred-step model over a 7x7 px window along the edge
   // (edge_profile_fit.hpp): removes the cubic facet's shape bias and averages noise along the
@@ -48,6 +49,9 @@ struct EdgeContours {
   std::vector<EdgePoint> points;
   // Each contour lists indices into `points`, in order along the edge (filled when linkContours).
   std::vector<std::vector<int>> contours;
+  // Blur (Gaussian sigma, pixels, without the pixel aperture) estimated from the edges' profiles;
+  // 0 when the profile fit is off or there were no edges.
+  double blurSigma = 0;
   double lowThreshold = 0;  // thresholds actually used
   double highThreshold = 0;
 };

@@ -16,7 +16,7 @@
 namespace facet {
 
 struct HarrisAffineParams {
-  int maxIterations = 10;  // shape adaptation iterations
+  int maxIterations = 6;  // shape adaptation iterations
   double isotropyRatio =
       0.95;  // stop when min/max eigenvalue of M in the normalised frame exceeds it
   double maxAnisotropy = 6.0;  // regions more elongated than this are rejected

@@ -23,10 +23,13 @@ ScaleLevel computeLevel(const cv::Mat& img, double relScale, const HarrisParams&
   cv::GaussianBlur(img, smooth, cv::Size(), sd, sd, cv::BORDER_REFLECT);
   cv::Sobel(smooth, ix, CV_32F, 1, 0, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
   cv::Sobel(smooth, iy, CV_32F, 0, 1, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
-  cv::Mat ixx = ix.mul(ix), iyy = iy.mul(iy), ixy = ix.mul(iy);
-  cv::GaussianBlur(ixx, ixx, cv::Size(), si, si, cv::BORDER_REFLECT);
-  cv::GaussianBlur(iyy, iyy, cv::Size(), si, si, cv::BORDER_REFLECT);
-  cv::GaussianBlur(ixy, ixy, cv::Size(), si, si, cv::BORDER_REFLECT);
+  // The three products are smoothed as one 3-channel image (one filter pass).
+  cv::Mat products;
+  cv::merge(std::vector<cv::Mat>{ix.mul(ix), iy.mul(iy), ix.mul(iy)}, products);
+  cv::GaussianBlur(products, products, cv::Size(), si, si, cv::BORDER_REFLECT);
+  std::vector<cv::Mat> m;
+  cv::split(products, m);
+  const cv::Mat &ixx = m[0], &iyy = m[1], &ixy = m[2];
   ScaleLevel level;
   level.sigma = si;
   level.harris = ixx.mul(iyy) - ixy.mul(ixy) - p.k * (ixx + iyy).mul(ixx + iyy);
@@ -47,7 +50,26 @@ double parabolaPeak(float a, float b, float c) {
   return std::clamp(0.5 * (a - c) / d, -0.5, 0.5);
 }
 
-void detectAtLevel(const ScaleLevel& below, const ScaleLevel& level, const ScaleLevel& above,
+// The Laplacian of a neighbouring scale, possibly stored at another octave's resolution:
+// `shift` +1 = a finer octave (coordinates x2), -1 = a coarser one (coordinates /2).
+struct Neighbour {
+  const cv::Mat* laplacian = nullptr;
+  int shift = 0;
+  [[nodiscard]] float at(int x, int y) const {
+    if (shift > 0) {
+      x *= 2;
+      y *= 2;
+    } else if (shift < 0) {
+      x /= 2;
+      y /= 2;
+    }
+    x = std::clamp(x, 0, laplacian->cols - 1);
+    y = std::clamp(y, 0, laplacian->rows - 1);
+    return std::abs(laplacian->at<float>(y, x));
+  }
+};
+
+void detectAtLevel(const Neighbour& below, const ScaleLevel& level, const Neighbour& above,
                    double factor, int levelIndex, const HarrisParams& p,
                    std::vector<HarrisCorner>& out) {
   const cv::Mat& r = level.harris;
@@ -69,9 +91,7 @@ void detectAtLevel(const ScaleLevel& below, const ScaleLevel& level, const Scale
       // Characteristic scale: |Laplacian| must not be smaller than at the neighbouring scales.
       if (p.selectScale) {
         const float lap = std::abs(level.laplacian.at<float>(y, x));
-        if (lap < std::abs(below.laplacian.at<float>(y, x)) ||
-            lap < std::abs(above.laplacian.at<float>(y, x)))
-          continue;
+        if (lap < below.at(x, y) || lap < above.at(x, y)) continue;
       }
       const double dx = parabolaPeak(r1[x - 1], v, r1[x + 1]);
       const double dy = parabolaPeak(r0[x], v, r2[x]);
@@ -119,29 +139,92 @@ std::vector<HarrisCorner> spreadCorners(const std::vector<HarrisCorner>& corners
   return kept;
 }
 
+std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
+                                           const HarrisParams& params) {
+  CV_Assert(grey.type() == CV_32F && cell > 0);
+  HarrisParams p = params;
+  p.selectScale = false;
+  const ScaleLevel level = computeLevel(grey, 1.0, p);
+  double maxResponse = 0;
+  cv::minMaxLoc(level.harris, nullptr, &maxResponse);
+  const double threshold = std::max(p.absoluteThreshold, p.relativeThreshold * maxResponse);
+  std::vector<HarrisCorner> out;
+  const int b = std::max(p.border, 2);
+  for (int y0 = b; y0 < grey.rows - b; y0 += cell)
+    for (int x0 = b; x0 < grey.cols - b; x0 += cell) {
+      const cv::Rect r(x0, y0, std::min(cell, grey.cols - b - x0),
+                       std::min(cell, grey.rows - b - y0));
+      double best = 0;
+      cv::Point loc;
+      cv::minMaxLoc(level.harris(r), nullptr, &best, nullptr, &loc);
+      if (best <= threshold) continue;
+      HarrisCorner c;
+      c.pt = {static_cast<double>(x0 + loc.x), static_cast<double>(y0 + loc.y)};
+      c.scale = level.sigma;
+      c.response = best;
+      out.push_back(c);
+    }
+  return out;
+}
+
 std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisParams& params) {
   CV_Assert(grey.type() == CV_32F);
   std::vector<HarrisCorner> all;
-  cv::Mat octave = grey;
   const int L = std::max(1, params.levelsPerOctave);
+  auto relScale = [L](int j) { return std::pow(2.0, double(j) / L); };
+  // Levels 0..L-1 of every octave. Level L of octave o has the scale of level 0 of octave o+1
+  // and level -1 that of level L-1 of octave o-1, so the scale test reads its neighbours there;
+  // only the finest and the coarsest ends need an extra level.
+  std::vector<std::vector<ScaleLevel>> octaves;
+  cv::Mat octave = grey;
   for (int o = 0; o < params.octaves; ++o) {
     if (std::min(octave.rows, octave.cols) < 2 * params.border + 8) break;
-    const double factor = std::ldexp(1.0, o);
-    // Levels -1 and L only serve the scale test of their neighbours.
-    const int first = params.selectScale ? -1 : 0, last = params.selectScale ? L : L - 1;
     std::vector<ScaleLevel> levels;
-    for (int j = first; j <= last; ++j)
-      levels.push_back(computeLevel(octave, std::pow(2.0, double(j) / L), params));
-    const int offset = params.selectScale ? 1 : 0;
-    for (int j = 0; j < L; ++j)
-      detectAtLevel(levels[j + offset - (offset ? 1 : 0)], levels[j + offset],
-                    levels[j + offset + (offset ? 1 : 0)], factor, o * L + j, params, all);
-    cv::Mat next;
-    cv::pyrDown(octave, next);
-    octave = next;
+    for (int j = 0; j < L; ++j) levels.push_back(computeLevel(octave, relScale(j), params));
+    octaves.push_back(std::move(levels));
+    if (o + 1 < params.octaves) {
+      cv::Mat next;
+      cv::pyrDown(octave, next);
+      octave = next;
+    }
+  }
+  if (octaves.empty()) return {};
+  ScaleLevel finest, coarsest;
+  if (params.selectScale) {
+    finest = computeLevel(grey, relScale(-1), params);
+    cv::Mat last = grey;
+    for (std::size_t o = 1; o < octaves.size(); ++o) {
+      cv::Mat next;
+      cv::pyrDown(last, next);
+      last = next;
+    }
+    coarsest = computeLevel(last, relScale(L), params);
+  }
+  for (std::size_t o = 0; o < octaves.size(); ++o) {
+    const double factor = std::ldexp(1.0, static_cast<int>(o));
+    for (int j = 0; j < L; ++j) {
+      Neighbour below, above;
+      if (params.selectScale) {
+        if (j > 0)
+          below = {&octaves[o][j - 1].laplacian, 0};
+        else if (o > 0)
+          below = {&octaves[o - 1][L - 1].laplacian, +1};
+        else
+          below = {&finest.laplacian, 0};
+        if (j + 1 < L)
+          above = {&octaves[o][j + 1].laplacian, 0};
+        else if (o + 1 < octaves.size())
+          above = {&octaves[o + 1][0].laplacian, -1};
+        else
+          above = {&coarsest.laplacian, 0};
+      }
+      detectAtLevel(below, octaves[o][j], above, factor, static_cast<int>(o) * L + j, params, all);
+    }
   }
   // Keep a pool of the strongest before the quadratic-time spreading.
-  const std::size_t pool = static_cast<std::size_t>(params.maxCorners) * 6;
+  const std::size_t pool =
+      std::min<std::size_t>(static_cast<std::size_t>(params.maxCorners) * 6,
+                            static_cast<std::size_t>(params.maxCorners) + 4000);
   if (all.size() > pool) {
     std::nth_element(
         all.begin(), all.begin() + pool, all.end(),

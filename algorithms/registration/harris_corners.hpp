@@ -43,6 +43,13 @@ struct HarrisCorner {
 // `grey` is CV_32F scaled to [0, 1]. Returns at most params.maxCorners corners.
 std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisParams& params = {});
 
+// Single-scale Harris points spread on a grid: in every `cell` x `cell` block the strongest
+// response (above the thresholds of `params`) at the finest scale. Dense and even, for
+// re-matching around a known transform. Uses derivationSigma, integrationSigma, k, thresholds
+// and border of `params`.
+std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
+                                           const HarrisParams& params = {});
+
 // Adaptive non-maximal suppression: keeps `count` corners with the largest suppression radii.
 std::vector<HarrisCorner> spreadCorners(const std::vector<HarrisCorner>& corners, int count,
                                         double robustness = 0.9);

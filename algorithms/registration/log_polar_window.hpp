@@ -20,7 +20,7 @@ struct LogPolarParams {
   int ringShifts = 2;       // extra rings on each side: scale shifts of +-ringShifts rings
   double ringRatio = 1.19;  // radius ratio of consecutive rings (2^(1/4))
   // Radius of the innermost compared ring, in units of the region scale (shape matrix).
-  double innerRadius = 1.0;
+  double innerRadius = 0.6;
 };
 
 struct LogPolarWindow {

@@ -17,13 +17,22 @@ cv::Mat toGrey(const cv::Mat& image) {
     cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
   else if (image.channels() == 4)
     cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
-  double scale = 1.0;
-  if (grey.depth() == CV_8U)
+  double scale = 1.0, offset = 0.0;
+  if (grey.depth() == CV_8U) {
     scale = 1.0 / 255.0;
-  else if (grey.depth() == CV_16U)
+  } else if (grey.depth() == CV_16U) {
     scale = 1.0 / 65535.0;
+  } else {
+    // Other depths (float, signed): brought to [0, 1] by their own range when outside it.
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(grey, &lo, &hi);
+    if ((hi > 1.0 || lo < 0.0) && hi > lo) {
+      scale = 1.0 / (hi - lo);
+      offset = -lo * scale;
+    }
+  }
   cv::Mat out;
-  grey.convertTo(out, CV_32F, scale);
+  grey.convertTo(out, CV_32F, scale, offset);
   return out;
 }
 
@@ -34,23 +43,41 @@ bool isBlank(const cv::Mat& grey) {
 }
 
 struct Features {
+  std::vector<HarrisCorner> corners;  // detected, in spreading order
+  int described = 0;                  // corners [0, described) have been turned into windows
   std::vector<AffineRegion> regions;  // only those with a valid window
   std::vector<LogPolarWindow> windows;
+  std::vector<int> ranks;  // the corner's position in spreading order
 };
 
-Features describe(const cv::Mat& grey, const std::vector<cv::Mat>& pyramid,
-                  const RegistrationParams& params) {
-  const std::vector<HarrisCorner> corners = detectHarrisCorners(grey, params.corners);
-  const std::vector<AffineRegion> regions =
-      params.affineRegions ? adaptAffineRegions(pyramid, corners) : circularRegions(corners);
+Features detect(const cv::Mat& grey, const RegistrationParams& params, int budget) {
+  HarrisParams hp = params.corners;
+  hp.maxCorners = budget;
   Features f;
-  for (const AffineRegion& r : regions) {
+  f.corners = detectHarrisCorners(grey, hp);
+  return f;
+}
+
+// Regions (adapted when asked) and windows of the corners up to rank `count`; lazily, so that
+// the corners kept for escalation cost nothing unless it happens.
+void describeUpTo(Features& f, const std::vector<cv::Mat>& pyramid,
+                  const RegistrationParams& params, int count) {
+  const int end = std::min(count, static_cast<int>(f.corners.size()));
+  for (int i = f.described; i < end; ++i) {
+    const HarrisCorner& c = f.corners[i];
+    AffineRegion r{c.pt, cv::Matx22d(c.scale, 0, 0, c.scale), c.response};
+    if (params.affineRegions) {
+      const std::vector<AffineRegion> adapted = adaptAffineRegions(pyramid, {c});
+      if (adapted.empty()) continue;
+      r = adapted.front();
+    }
     LogPolarWindow w = sampleLogPolar(pyramid, r.pt, r.shape, params.window);
     if (!w.valid) continue;
     f.regions.push_back(r);
     f.windows.push_back(std::move(w));
+    f.ranks.push_back(i);
   }
-  return f;
+  f.described = std::max(f.described, end);
 }
 
 double rotationDegOf(const cv::Matx22d& L) {
@@ -127,7 +154,7 @@ double parabolaPeak(float a, float b, float c) {
 // corner's predicted position, with the image; the NCC peak (subpixel) gives the match.
 std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
                                   const std::vector<HarrisCorner>& corners, const cv::Matx33d& H,
-                                  const RegistrationParams& params) {
+                                  int R, const RegistrationParams& params) {
   const cv::Point2d centre((refGrey.cols - 1) / 2.0, (refGrey.rows - 1) / 2.0);
   const double s = std::sqrt(std::abs(cv::determinant(jacobianAt(H, centre))));
   // Match resolutions: blur whichever image is seen at the finer scale.
@@ -143,7 +170,7 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
   cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
   cv::Mat ones(refGrey.size(), CV_8U, cv::Scalar(255));
   cv::warpPerspective(ones, valid, H, imgGrey.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
-  const int r = params.refinePatchRadius, R = params.refineSearchRadius;
+  const int r = params.refinePatchRadius;
   const cv::Rect bounds(0, 0, imgGrey.cols, imgGrey.rows);
   std::vector<FeatureMatch> out;
   cv::Mat result;
@@ -186,6 +213,89 @@ RegistrationResult failure(RegistrationResult r, std::string cause, std::string 
   return r;
 }
 
+struct GlobalStage {
+  std::vector<FeatureMatch> matches;
+  std::vector<int> inliers;  // indices into matches
+  cv::Matx33d H = cv::Matx33d::eye();
+  int refCorners = 0, imageCorners = 0;
+  std::string failureCause, message;  // empty when a transform was found
+};
+
+// All-pairs window matching of the first `count` corners of each image, pruning by the matches'
+// own rotation/scale, robust fit seeded by their local maps.
+GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, double minScore,
+                          const RegistrationParams& params) {
+  GlobalStage g;
+  auto subset = [count](const Features& f) {
+    Features s;
+    for (std::size_t i = 0; i < f.windows.size(); ++i)
+      if (f.ranks[i] < count) {
+        s.regions.push_back(f.regions[i]);
+        s.windows.push_back(f.windows[i]);
+        s.ranks.push_back(f.ranks[i]);
+      }
+    return s;
+  };
+  const Features a = subset(fr), b = subset(fi);
+  g.refCorners = static_cast<int>(a.windows.size());
+  g.imageCorners = static_cast<int>(b.windows.size());
+  if (a.windows.size() < 4 || b.windows.size() < 4) {
+    g.failureCause = "too_few_corners";
+    g.message = "fewer than 4 usable corners (reference " + std::to_string(a.windows.size()) +
+                ", image " + std::to_string(b.windows.size()) + ")";
+    return g;
+  }
+  NccMatchParams mp = params.matching;
+  mp.minScore = minScore;
+  const std::vector<WindowMatch> wm =
+      matchWindows(a.windows, b.windows, params.window.ringShifts, mp);
+  std::vector<cv::Matx22d> maps;
+  for (const WindowMatch& w : wm) {
+    const AffineRegion& ra = a.regions[w.ref];
+    const AffineRegion& rb = b.regions[w.image];
+    const cv::Matx22d L = localMap(ra, rb, w.best, params.window);
+    g.matches.push_back(
+        {ra.pt, rb.pt, w.best.score, rotationDegOf(L), std::sqrt(std::abs(cv::determinant(L)))});
+    maps.push_back(L);
+  }
+  const std::vector<int> kept = pruneByRotationScale(g.matches, params);
+  std::vector<cv::Point2d> src, dst;
+  std::vector<cv::Matx22d> keptMaps;
+  for (int k : kept) {
+    src.push_back(g.matches[k].ref);
+    dst.push_back(g.matches[k].image);
+    keptMaps.push_back(maps[k]);
+  }
+  const int minimal = params.model == TransformModel::Similarity ? 2
+                      : params.model == TransformModel::Affine   ? 3
+                                                                 : 4;
+  const int needed = std::max(minimal, params.minInliers);
+  if (static_cast<int>(src.size()) < needed) {
+    g.failureCause = "too_few_matches";
+    g.message = std::to_string(src.size()) + " consistent matches, at least " +
+                std::to_string(needed) + " needed";
+    return g;
+  }
+  TransformFitParams fp;
+  fp.model = params.model;
+  fp.inlierThreshold = params.inlierThreshold;
+  const auto fit = fitTransformWithLocalMaps(src, dst, keptMaps, fp);
+  if (!fit) {
+    g.failureCause = "degenerate_transform";
+    g.message = "no non-degenerate transform fits the matches";
+    return g;
+  }
+  if (static_cast<int>(fit->inliers.size()) < params.minInliers) {
+    g.failureCause = "too_few_inliers";
+    g.message = std::to_string(fit->inliers.size()) + " inliers, at least " +
+                std::to_string(params.minInliers) + " needed";
+    return g;
+  }
+  g.H = fit->H;
+  for (int i : fit->inliers) g.inliers.push_back(kept[i]);
+  return g;
+}
+
 }  // namespace
 
 cv::Point2d mapPoint(const cv::Matx33d& H, cv::Point2d p) {
@@ -215,77 +325,71 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
 
   const std::vector<cv::Mat> refPyramid = buildSamplingPyramid(ref);
   const std::vector<cv::Mat> imgPyramid = buildSamplingPyramid(img);
-  const Features fr = describe(ref, refPyramid, params);
-  const Features fi = describe(img, imgPyramid, params);
-  result.refCorners = static_cast<int>(fr.windows.size());
-  result.imageCorners = static_cast<int>(fi.windows.size());
-  if (fr.windows.size() < 4 || fi.windows.size() < 4)
-    return failure(result, "too_few_corners",
-                   "fewer than 4 usable corners (reference " + std::to_string(fr.windows.size()) +
-                       ", image " + std::to_string(fi.windows.size()) + ")");
+  // Detected once with the larger budget: the corners come in spreading order, so the first
+  // maxCorners of them are what a smaller budget would have kept.
+  const int budget = std::max(params.corners.maxCorners, params.escalateCorners);
+  Features fr = detect(ref, params, budget);
+  Features fi = detect(img, params, budget);
+  describeUpTo(fr, refPyramid, params, params.corners.maxCorners);
+  describeUpTo(fi, imgPyramid, params, params.corners.maxCorners);
 
-  const std::vector<WindowMatch> wm =
-      matchWindows(fr.windows, fi.windows, params.window.ringShifts, params.matching);
-  std::vector<FeatureMatch> matches;
-  std::vector<cv::Matx22d> maps;
-  for (const WindowMatch& w : wm) {
-    const AffineRegion& a = fr.regions[w.ref];
-    const AffineRegion& b = fi.regions[w.image];
-    const cv::Matx22d L = localMap(a, b, w.best, params.window);
-    FeatureMatch m{a.pt, b.pt, w.best.score, rotationDegOf(L),
-                   std::sqrt(std::abs(cv::determinant(L)))};
-    matches.push_back(m);
-    maps.push_back(L);
+  GlobalStage stage =
+      matchGlobally(fr, fi, params.corners.maxCorners, params.matching.minScore, params);
+  if (params.escalateCorners > params.corners.maxCorners &&
+      static_cast<int>(stage.inliers.size()) < params.escalateBelowInliers) {
+    describeUpTo(fr, refPyramid, params, params.escalateCorners);
+    describeUpTo(fi, imgPyramid, params, params.escalateCorners);
+    GlobalStage wider =
+        matchGlobally(fr, fi, params.escalateCorners, params.escalateMinScore, params);
+    if (wider.inliers.size() > stage.inliers.size() ||
+        (!stage.failureCause.empty() && wider.failureCause.empty()))
+      stage = std::move(wider);
   }
-  const std::vector<int> kept = pruneByRotationScale(matches, params);
-  std::vector<cv::Point2d> src, dst;
-  std::vector<cv::Matx22d> keptMaps;
-  for (int k : kept) {
-    src.push_back(matches[k].ref);
-    dst.push_back(matches[k].image);
-    keptMaps.push_back(maps[k]);
-  }
-  result.matches = matches;
-  const int minimal = params.model == TransformModel::Similarity ? 2
-                      : params.model == TransformModel::Affine   ? 3
-                                                                 : 4;
-  if (static_cast<int>(src.size()) < std::max(minimal, params.minInliers))
-    return failure(result, "too_few_matches",
-                   std::to_string(src.size()) + " consistent matches, at least " +
-                       std::to_string(std::max(minimal, params.minInliers)) + " needed");
-  TransformFitParams fp;
-  fp.model = params.model;
-  fp.inlierThreshold = params.inlierThreshold;
-  const auto fit = fitTransformWithLocalMaps(src, dst, keptMaps, fp);
-  if (!fit)
-    return failure(result, "degenerate_transform", "no non-degenerate transform fits the matches");
-  if (static_cast<int>(fit->inliers.size()) < params.minInliers)
-    return failure(result, "too_few_inliers",
-                   std::to_string(fit->inliers.size()) + " inliers, at least " +
-                       std::to_string(params.minInliers) + " needed");
-  result.H = fit->H;
-  for (int i : fit->inliers) result.inliers.push_back(kept[i]);
+  result.refCorners = stage.refCorners;
+  result.imageCorners = stage.imageCorners;
+  result.matches = std::move(stage.matches);
+  if (!stage.failureCause.empty()) return failure(result, stage.failureCause, stage.message);
+  result.H = stage.H;
+  result.inliers = stage.inliers;
 
+  const std::size_t globalInliers = result.inliers.size();
   if (params.refineIterations > 0) {
-    HarrisParams hp = params.corners;
-    hp.maxCorners = params.refineCorners;
-    hp.octaves = 1;
-    hp.levelsPerOctave = 1;
-    hp.selectScale = false;
-    const std::vector<HarrisCorner> dense = detectHarrisCorners(ref, hp);
+    TransformFitParams tight;
+    tight.model = params.model;
+    tight.inlierThreshold = params.finalThreshold;
+    const std::vector<HarrisCorner> dense =
+        detectHarrisGrid(ref, params.refineCell, params.corners);
     for (int it = 0; it < params.refineIterations; ++it) {
-      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, params);
+      // Once H rests on the dense pairs, the prediction is within a pixel or two.
+      const int radius =
+          it == 0 ? params.refineSearchRadius : std::min(params.refineSearchRadius, 3);
+      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, radius, params);
       std::vector<cv::Point2d> s2, d2;
       for (const auto& m : rm) {
         s2.push_back(m.ref);
         d2.push_back(m.image);
       }
-      const auto refit = fitTransformRobust(s2, d2, fp);
-      if (!refit || refit->inliers.size() < result.inliers.size()) break;
+      // The re-matched pairs are subpixel: the consensus is sought at the tight threshold so that
+      // a cluster of slightly wrong pairs cannot bias H; inliers are then counted as usual.
+      const auto refit = fitTransformRobust(s2, d2, tight);
+      if (!refit) break;
+      std::vector<int> inliers;
+      for (std::size_t i = 0; i < s2.size(); ++i)
+        if (transferError(refit->H, s2[i], d2[i]) <= params.inlierThreshold)
+          inliers.push_back(static_cast<int>(i));
+      if (inliers.size() < result.inliers.size()) break;
       result.H = refit->H;
       result.matches = std::move(rm);
-      result.inliers = refit->inliers;
+      result.inliers = std::move(inliers);
     }
+    // A transform resting on very few global matches must be confirmed by the re-matching.
+    if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
+        static_cast<int>(result.inliers.size()) < params.confirmInliers)
+      return failure(result, "too_few_inliers",
+                     std::to_string(globalInliers) +
+                         " global inliers, not confirmed by re-matching (" +
+                         std::to_string(result.inliers.size()) + " inliers, " +
+                         std::to_string(params.confirmInliers) + " needed)");
   }
   result.ok = true;
   return result;

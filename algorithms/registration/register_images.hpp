@@ -28,18 +28,30 @@ struct RegistrationParams {
   LogPolarParams window;         // log-polar window sampled around each point
   NccMatchParams matching;       // minimum NCC, shift ranges and the three accelerations
   double inlierThreshold = 3.0;  // pixels; RANSAC reprojection threshold in the image
-  int minInliers = 8;            // fewer inliers than this -> failure "too_few_inliers"
+  int minInliers = 5;            // fewer global inliers than this -> failure "too_few_inliers"
+  // A global fit with fewer than `confirmBelowInliers` inliers is accepted only when the
+  // re-matching (refineIterations > 0) then finds at least `confirmInliers` inliers.
+  int confirmBelowInliers = 10;
+  int confirmInliers = 20;
   // Per-match rotation/scale estimates prune matches that disagree with the dominant rotation
   // (degrees) and log2-scale before RANSAC. <= 0 disables the pruning.
   double pruneRotationDeg = 40.0;
   double pruneLog2Scale = 1.0;
-  // Iterative refinement: warp the reference with the current H, re-match every corner of a
-  // larger detection budget around its predicted position (NCC of square patches within
-  // `refineSearchRadius` pixels), refit. 0 disables it.
+  // Escalation for hard pairs (large viewpoint change): when the first global matching gives
+  // fewer than `escalateBelowInliers` inliers, it is repeated with `escalateCorners` corners per
+  // image and the minimum NCC lowered to `escalateMinScore`. escalateCorners <= maxCorners
+  // disables it.
+  int escalateCorners = 650;
+  double escalateMinScore = 0.7;
+  int escalateBelowInliers = 12;
+  // Iterative refinement: warp the reference with the current H, re-match Harris points spread
+  // on a grid (the strongest per `refineCell` x `refineCell` block) around their predicted
+  // positions (NCC of square patches within `refineSearchRadius` pixels), refit. 0 disables it.
   int refineIterations = 2;
-  int refineCorners = 3000;     // corner budget of the reference for the re-matching
-  int refineSearchRadius = 8;   // pixels, in the image
+  int refineCell = 10;          // pixels of the reference
+  int refineSearchRadius = 8;   // pixels, in the image (3 after the first iteration)
   int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
+  double finalThreshold = 1.0;  // pixels; RANSAC threshold of the fit to the re-matched pairs
   double refineMinScore = 0.8;  // minimum NCC of a re-matched patch
 };
 

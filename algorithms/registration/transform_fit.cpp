@@ -53,7 +53,22 @@ std::optional<cv::Matx33d> fitNormalised(const std::vector<cv::Point2d>& src,
     b[i] = apply(Td, dst[i]);
   }
   cv::Matx33d Hn = cv::Matx33d::eye();
-  if (model == TransformModel::Homography) {
+  if (model == TransformModel::Homography && n == 4) {
+    // Minimal sample: h33 = 1 and an 8x8 linear system (much cheaper than the SVD).
+    Eigen::Matrix<double, 8, 8> M;
+    Eigen::Matrix<double, 8, 1> r;
+    for (int i = 0; i < 4; ++i) {
+      const double x = a[i].x, y = a[i].y, u = b[i].x, v = b[i].y;
+      M.row(2 * i) << x, y, 1, 0, 0, 0, -u * x, -u * y;
+      M.row(2 * i + 1) << 0, 0, 0, x, y, 1, -v * x, -v * y;
+      r(2 * i) = u;
+      r(2 * i + 1) = v;
+    }
+    const auto lu = M.fullPivLu();
+    if (!lu.isInvertible()) return std::nullopt;
+    const Eigen::Matrix<double, 8, 1> h = lu.solve(r);
+    Hn = {h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), 1};
+  } else if (model == TransformModel::Homography) {
     Eigen::MatrixXd M(2 * n, 9);
     for (int i = 0; i < n; ++i) {
       const double x = a[i].x, y = a[i].y, u = b[i].x, v = b[i].y;
@@ -190,7 +205,11 @@ std::optional<TransformFit> fitTransformWithLocalMaps(const std::vector<cv::Poin
                                                       const std::vector<cv::Point2d>& dst,
                                                       const std::vector<cv::Matx22d>& localMaps,
                                                       const TransformFitParams& params) {
-  std::optional<TransformFit> best = fitTransformRobust(src, dst, params);
+  // Plain RANSAC as one candidate; the seeded fits below do the heavy lifting when outliers
+  // dominate, so it gets a smaller iteration budget.
+  TransformFitParams plain = params;
+  plain.maxIterations = std::min(params.maxIterations, 1000);
+  std::optional<TransformFit> best = fitTransformRobust(src, dst, plain);
   const std::size_t n = src.size();
   const auto minimal = static_cast<std::size_t>(minimalSample(params.model));
   if (localMaps.size() != n || n < minimal) return best;
@@ -207,9 +226,10 @@ std::optional<TransformFit> fitTransformWithLocalMaps(const std::vector<cv::Poin
       const cv::Point2d d = src[i] - src[k];
       const cv::Point2d q(dst[k].x + L(0, 0) * d.x + L(0, 1) * d.y,
                           dst[k].y + L(1, 0) * d.x + L(1, 1) * d.y);
-      const double tolerance = 2.0 * params.inlierThreshold + 0.1 * std::hypot(d.x, d.y);
-      if (std::hypot(q.x - dst[i].x, q.y - dst[i].y) <= tolerance)
-        support.push_back(static_cast<int>(i));
+      const double tolerance =
+          2.0 * params.inlierThreshold + 0.1 * std::sqrt(d.x * d.x + d.y * d.y);
+      const double ex = q.x - dst[i].x, ey = q.y - dst[i].y;
+      if (ex * ex + ey * ey <= tolerance * tolerance) support.push_back(static_cast<int>(i));
     }
     if (support.size() >= minimal + 1) seeds.push_back({k, std::move(support)});
   }

@@ -38,9 +38,10 @@ struct FindParams {
   // Largest allowed overlap of two matches' oriented bounding boxes, as a fraction (0..1) of the
   // smaller box; of two matches that overlap more, the better one is kept. Default 0.5.
   double maxOverlap = 0.5;
-  // Early termination when scoring a pose, 0..1: 0 = safe (evaluate every point), 1 = fastest
-  // (abandon a pose as soon as it cannot reach minScore assuming the remaining points match
-  // at a rate close to the current one). Default 0.9.
+  // Early termination when scoring a pose on the levels below the top, 0..1: 0 = safe (abandon a
+  // pose only when it cannot reach minScore even if every remaining point matched perfectly),
+  // 1 = fastest (abandon it as soon as the points so far match at less than minScore). Higher
+  // values can miss heavily occluded parts. Default 0.9.
   double greediness = 0.9;
   // Angle range searched, radians: [angleStart, angleStart + angleExtent], intersected with the
   // model's trained range. Default: full circle.
@@ -56,7 +57,7 @@ struct FindParams {
   SubpixelMode subpixel = SubpixelMode::LeastSquares;
   // Number of pyramid levels used, 0 = all of the model's. Fewer levels = slower, more robust.
   int numLevels = 0;
-  // Worker threads for the top-level search (1..8). Default 2.
+  // Parallel stripes of the top-level search (1..8), run on OpenCV's worker pool. Default 2.
   int threads = 2;
 };
 
@@ -65,7 +66,9 @@ struct ShapeMatch {
   double y = 0.0;
   double angle = 0.0;  // radians, counter-clockwise on screen (wrapped to (-pi, pi])
   double scale = 1.0;  // unitless
-  double score = 0.0;  // 0..1, see above, on the level-0 pose grid before subpixel refinement
+  // 0..1, see above. With subpixel refinement: the similarity of the model's subpixel points at
+  // the refined pose (image directions interpolated bilinearly); without: on the level-0 grid.
+  double score = 0.0;
   // The model's subpixel edge points placed into the image at this pose, for overlays.
   std::vector<cv::Point2d> contour;
   // Least squares only: RMS point-to-line distance of the matched points, pixels (0 otherwise).

@@ -134,8 +134,9 @@ int main(int argc, char** argv) {
   for (int i = 1; i + 3 < argc; ++i)
     if (std::strcmp(argv[i], "--angle") == 0) {
       setenv("BENCH_EDGES_DUMP", "1", 1);
-      const StraightResult r = measureStraight(std::atof(argv[i + 1]), std::atof(argv[i + 2]),
-                                               std::atof(argv[i + 3]), 1, false);
+      const StraightResult r =
+          measureStraight(std::atof(argv[i + 1]), std::atof(argv[i + 2]), std::atof(argv[i + 3]),
+                          1000 + static_cast<std::uint64_t>(std::atof(argv[i + 1])), false);
       std::printf("rms %.4f points %d doubled %d\n", r.rms, r.points, r.doubled);
       return 0;
     }
@@ -218,7 +219,9 @@ int main(int argc, char** argv) {
   const double mo = median(ours), mc = median(opencv);
   const double co = median(oursCpu), cc = median(opencvCpu);
   std::printf("\nSpeed 1280x1024 (blur 1, noise 2), median of %d runs, one thread\n", runs);
-  std::printf("(cpu = the thread's CPU time, which other load on the machine does not inflate)\n");
+  std::printf(
+      "(cpu = the thread's CPU time: not inflated by waiting for a core, still by other load\n "
+      "sharing the core and its caches; check the machine load when reading it)\n");
   std::printf("%-28s %10s %10s %10s\n", "method", "wall ms", "cpu ms", "points");
   std::printf("%-28s %10.2f %10.2f %10zu\n", "facet subpixel edges", mo, co, nPoints);
   std::printf("%-28s %10.2f %10.2f %10d\n", "cv::Canny (pixel level)", mc, cc, nCanny);

@@ -2,9 +2,9 @@
 // sequence, synthetic similarity pairs from graf img1, and the NCC accelerations.
 //
 //   bench_registration [--smoke] [--data DIR] [--synthetic N]
-#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <random>
 #include <string>
@@ -22,9 +22,19 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+// Time is the calling thread's CPU time: the machine is shared by many jobs, and wall time
+// there measures the neighbours as much as the code. Everything here runs single-threaded
+// (cv::setNumThreads(1) in main), SIFT included.
+struct CpuTime {
+  double ms = 0;
+};
+CpuTime cpuNow() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return {t.tv_sec * 1e3 + t.tv_nsec * 1e-6};
+}
+double msSince(CpuTime t0) {
+  return cpuNow().ms - t0.ms;
 }
 
 cv::Matx33d readHomography(const std::string& path) {
@@ -58,7 +68,7 @@ struct Outcome {
 
 Outcome runOurs(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth,
                 const facet::RegistrationParams& params) {
-  const auto t0 = Clock::now();
+  const CpuTime t0 = cpuNow();
   const facet::RegistrationResult r = facet::registerImages(a, b, params);
   Outcome o;
   o.ms = msSince(t0);
@@ -76,7 +86,7 @@ Outcome runOurs(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth,
 }
 
 Outcome runSift(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth) {
-  const auto t0 = Clock::now();
+  const CpuTime t0 = cpuNow();
   cv::Ptr<cv::SIFT> sift = cv::SIFT::create();
   std::vector<cv::KeyPoint> ka, kb;
   cv::Mat da, db;
@@ -115,7 +125,7 @@ facet::RegistrationParams grafParams() {
   return p;
 }
 
-void grafTable(const std::string& dir, bool smoke) {
+void grafTable(const std::string& dir, bool smoke, int repeats) {
   const cv::Mat img1 = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
   if (img1.empty()) {
     std::fprintf(stderr, "bench_registration: cannot read %s/img1.png\n", dir.c_str());
@@ -123,7 +133,9 @@ void grafTable(const std::string& dir, bool smoke) {
   }
   std::printf(
       "\n== Oxford graf: img1 -> imgN (correct = match within 3 px under the true H; "
-      "corner error = mean |H_est - H_true| over img1's corners) ==\n");
+      "corner error = mean |H_est - H_true| over img1's corners;\n   ms = thread CPU time, best of "
+      "%d runs, both single-threaded) ==\n",
+      repeats);
   std::printf("%-5s | %7s %7s %8s %8s | %7s %7s %8s %8s | %8s %8s %s\n", "pair", "correct",
               "inliers", "corner", "ms", "correct", "inliers", "corner", "ms", "correct", "time",
               "");
@@ -135,8 +147,13 @@ void grafTable(const std::string& dir, bool smoke) {
     const cv::Mat imgN =
         cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
     const cv::Matx33d truth = readHomography(dir + "/H1to" + std::to_string(n) + "p");
-    const Outcome ours = runOurs(img1, imgN, truth, grafParams());
-    const Outcome sift = runSift(img1, imgN, truth);
+    // Best of `repeats` runs each, alternating, so that both see the same machine.
+    Outcome ours = runOurs(img1, imgN, truth, grafParams());
+    Outcome sift = runSift(img1, imgN, truth);
+    for (int k = 1; k < repeats; ++k) {
+      ours.ms = std::min(ours.ms, runOurs(img1, imgN, truth, grafParams()).ms);
+      sift.ms = std::min(sift.ms, runSift(img1, imgN, truth).ms);
+    }
     const bool good = ours.correct > sift.correct && ours.cornerError <= 3.0 && ours.ms <= sift.ms;
     met += good;
     std::printf("1-%d   | %7d %7d %8.2f %8.1f | %7d %7d %8.2f %8.1f | %8.2f %8.2f %s\n", n,
@@ -146,6 +163,19 @@ void grafTable(const std::string& dir, bool smoke) {
                 good ? "target met" : "TARGET MISSED");
   }
   std::printf("graf pairs meeting all targets: %d / %d\n", met, last - 1);
+  // Transparency: what the global log-polar matching finds on its own, before the
+  // warp-and-rematch refinement produces the final matches above.
+  std::printf("\nfacet global stage alone (log-polar NCC + robust fit, refineIterations = 0):\n");
+  std::printf("%-5s | %7s %7s %7s %10s\n", "pair", "matches", "correct", "inliers", "corner");
+  for (int n = 2; n <= last; ++n) {
+    const cv::Mat imgN =
+        cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
+    const cv::Matx33d truth = readHomography(dir + "/H1to" + std::to_string(n) + "p");
+    facet::RegistrationParams p = grafParams();
+    p.refineIterations = 0;
+    const Outcome g = runOurs(img1, imgN, truth, p);
+    std::printf("1-%d   | %7d %7d %7d %10.2f\n", n, g.matches, g.correct, g.inliers, g.cornerError);
+  }
 }
 
 void syntheticTable(const std::string& dir, int count) {
@@ -167,8 +197,16 @@ void syntheticTable(const std::string& dir, int count) {
     // image pixel q shows img1 at origin + truth^-1 q
     const cv::Matx33d shift(1, 0, -origin.x, 0, 1, -origin.y, 0, 0, 1);
     const cv::Matx33d full = truth * shift;
+    // A camera integrates over its pixels: when the view shrinks, low-pass first (no aliasing).
+    cv::Mat source;
+    if (s < 1) {
+      const double sigma = 0.5 * std::sqrt(1.0 / (s * s) - 1.0);
+      cv::GaussianBlur(img1, source, cv::Size(), sigma, sigma);
+    } else {
+      source = img1;
+    }
     cv::Mat image;
-    cv::warpAffine(img1, image,
+    cv::warpAffine(source, image,
                    cv::Mat(cv::Matx23d(full(0, 0), full(0, 1), full(0, 2), full(1, 0), full(1, 1),
                                        full(1, 2))),
                    cv::Size(320, 320), cv::INTER_LINEAR, cv::BORDER_CONSTANT, cv::Scalar(0));
@@ -180,7 +218,7 @@ void syntheticTable(const std::string& dir, int count) {
     noisy.convertTo(image, CV_8U);
     facet::RegistrationParams p;
     p.model = facet::TransformModel::Similarity;
-    const auto t0 = Clock::now();
+    const CpuTime t0 = cpuNow();
     const facet::RegistrationResult r = facet::registerImages(ref, image, p);
     const double ms = msSince(t0);
     totalMs += ms;
@@ -197,7 +235,8 @@ void syntheticTable(const std::string& dir, int count) {
       "\n== Synthetic similarity pairs (graf img1 crops 256x256 -> 320x320, any angle, scale "
       "0.33-3, noise sigma 3) ==\n");
   std::printf(
-      "pairs %d  success (corner error <= 2 px) %d = %.1f%% (target >= 95%%)  mean time %.1f ms\n",
+      "pairs %d  success (corner error <= 2 px) %d = %.1f%% (target >= 95%%)  mean CPU time %.1f "
+      "ms\n",
       count, success, 100.0 * success / count, totalMs / count);
 }
 
@@ -223,7 +262,7 @@ void nccTable(const std::string& dir, bool smoke) {
   std::printf(
       "\n== NCC accelerations: all-pairs matching of %zu x %zu log-polar windows (graf 1-2) ==\n",
       wa.size(), wb.size());
-  std::printf("%-26s %10s %9s %8s %s\n", "variant", "ms", "speed-up", "matches",
+  std::printf("%-26s %10s %9s %8s %s\n", "variant", "CPU ms", "speed-up", "matches",
               "identical to plain");
   struct Variant {
     const char* name;
@@ -239,7 +278,7 @@ void nccTable(const std::string& dir, bool smoke) {
   for (const auto& v : variants) {
     facet::NccMatchParams mp;
     mp.accelerations = v.acc;
-    const auto t0 = Clock::now();
+    const CpuTime t0 = cpuNow();
     const auto m = facet::matchWindows(wa, wb, lp.ringShifts, mp);
     const double ms = msSince(t0);
     bool same = true;
@@ -291,7 +330,7 @@ int main(int argc, char** argv) {
   }
   if (smoke) synthetic = std::min(synthetic, 6);
   cv::setNumThreads(1);  // single-threaded, like facet's algorithms
-  grafTable(dir, smoke);
+  grafTable(dir, smoke, smoke ? 1 : 3);
   syntheticTable(dir, synthetic);
   nccTable(dir, smoke);
   return 0;

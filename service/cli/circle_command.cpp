@@ -1,6 +1,7 @@
 // facet circle: measures one circle in an image around a given centre and nominal radius.
 #include <chrono>
 #include <cmath>
+#include <filesystem>
 #include <iostream>
 #include <sstream>
 
@@ -45,9 +46,13 @@ void run(const CircleOptions& o) {
   p.width = o.width;
   p.polarity = parsePolarity(o.polarity);
   p.minCoverageDeg = o.minCoverage;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(o.image, ec))
+    throw InputError(o.image + ": no such image file");
   // Grey, keeping 16-bit depth; colour images are converted to grey.
   const cv::Mat image = cv::imread(o.image, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (image.empty()) throw InputError(o.image + ": cannot read the image");
+  if (image.empty())
+    throw InputError(o.image + ": cannot read the image (unknown format or corrupt)");
 
   const auto t0 = std::chrono::steady_clock::now();
   const CircleMeasurement m = measureCircle(image, p);

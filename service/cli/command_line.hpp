@@ -31,11 +31,14 @@ void printJson(const nlohmann::json& object);
 // Every subcommand is added by a function of this shape, one file per subcommand.
 // The subcommand's callback does the work; `json` tells whether --json was given anywhere.
 void addVersionCommand(CLI::App& app);
+void addPlcSimCommand(CLI::App& app);
 void addCircleCommand(CLI::App& app);
 void addScanMatchCommand(CLI::App& app);
 void addResultsCommand(CLI::App& app);
 void addEdgesCommand(CLI::App& app);
 void addModelCommand(CLI::App& app);
 void addMatchCommand(CLI::App& app);
+void addRegisterCommand(CLI::App& app);
+void addRecipeCommand(CLI::App& app);
 
 }  // namespace facet::cli

@@ -17,12 +17,15 @@ int main(int argc, char** argv) {
   CLI::App app{"facet: machine-vision inspection tool", "facet"};
   app.require_subcommand(1);
   addVersionCommand(app);
+  addPlcSimCommand(app);
   addCircleCommand(app);
   addScanMatchCommand(app);
   addResultsCommand(app);
   addEdgesCommand(app);
   addModelCommand(app);
   addMatchCommand(app);
+  addRegisterCommand(app);
+  addRecipeCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";

@@ -95,29 +95,30 @@ TEST(AravisCamera, Mono8FramesArriveByteExactAndIdsCrossTheWrap) {
   // The fake camera starts its 16-bit block ids near 65400: 300 frames cross the wrap.
   std::uint64_t previous = 0;
   std::uint64_t first = 0;
+  int delivered = 0;  // frames with an id: good or incomplete
   int good = 0;
   for (int i = 0; i < 300; ++i) {
     GrabResult r = camera->grab(1s);
     ASSERT_NE(r.status, GrabStatus::Disconnected) << r.message;
+    if (r.status != GrabStatus::Ok && r.status != GrabStatus::Incomplete) continue;
+    if (delivered++ > 0)
+      ASSERT_GT(r.frame.id, previous);
+    else
+      first = r.frame.id;
+    previous = r.frame.id;
     if (!r.ok()) continue;
     ASSERT_EQ(r.frame.format, PixelFormat::Mono8);
     ASSERT_TRUE(sameImage(r.frame.image, expected)) << "frame " << r.frame.id;
-    if (good > 0) {
-      ASSERT_GT(r.frame.id, previous);
-    } else {
-      first = r.frame.id;
-    }
-    previous = r.frame.id;
     ++good;
   }
-  // Loopback on a busy machine drops the odd packet: such frames are Incomplete, not good.
-  EXPECT_GE(good, 240);
+  // Loopback on a busy machine drops the odd packet: such frames are Incomplete, never good.
+  EXPECT_GE(good, 150);
   EXPECT_GT(previous, 65535u) << "ids must keep growing across the 16-bit wrap";
   EXPECT_LT(first, 65535u);
   const CameraHealth health = camera->health();
   EXPECT_TRUE(health.connected);
   EXPECT_EQ(health.frames, static_cast<std::uint64_t>(good));
-  // Unwrapped ids: the span equals the frames received plus the ones the device says we lost.
+  // Unwrapped ids: the span equals the frames delivered plus the ones the device says we lost.
   EXPECT_EQ(previous - first + 1, health.frames + health.incomplete_frames + health.lost_frames);
   camera->stop();
   camera->close();
@@ -165,6 +166,40 @@ TEST(AravisCamera, Mono16RgbAndBayerFormats) {
     EXPECT_EQ(r.frame.format, PixelFormat::Bgr8);
     EXPECT_TRUE(sameImage(r.frame.image, bgr));
   }
+}
+
+TEST(AravisCamera, OpensBySerialThroughDiscovery) {
+  FakeGigECamera fake("FACETSN7");
+  ASSERT_TRUE(fake.running());
+  auto s = settingsFor();
+  s.address.clear();
+  s.serial = "FACETSN7";
+  AravisCamera camera(s);
+  camera.open();
+  camera.start();
+  GrabResult r = grabOk(camera);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_NE(r.frame.source.find("FACETSN7"), std::string::npos) << r.frame.source;
+  s.serial = "NO-SUCH-SERIAL";
+  AravisCamera missing(s);
+  EXPECT_THROW(missing.open(), CameraError);
+}
+
+TEST(AravisCamera, HardwareTriggerWaitsForTheLine) {
+  FakeGigECamera fake;
+  ASSERT_TRUE(fake.running());
+  auto s = settingsFor();
+  s.frame_rate_hz.reset();
+  s.trigger = TriggerMode::Hardware;
+  s.trigger_line = "Line0";  // the fake camera's only line: nothing ever drives it
+  AravisCamera camera(s);
+  camera.open();
+  camera.start();
+  EXPECT_EQ(camera.grab(400ms).status, GrabStatus::Timeout);
+  camera.softwareTrigger();  // ignored outside software-trigger mode
+  EXPECT_EQ(camera.grab(300ms).status, GrabStatus::Timeout);
+  EXPECT_EQ(camera.health().frames, 0u);
+  EXPECT_TRUE(camera.health().connected) << "a quiet triggered camera is not a lost camera";
 }
 
 TEST(AravisCamera, SoftwareTriggerGivesExactlyOneFramePerTrigger) {

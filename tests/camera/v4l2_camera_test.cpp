@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "camera/camera_factory.hpp"
 #include "camera/v4l2_camera.hpp"
 #include "scripted_v4l2_device.hpp"
 
@@ -69,14 +70,18 @@ TEST(V4l2Camera, NegotiatesGreyAndDeliversPaddedRowsByteExact) {
     images.push_back(randomImage(48, 64, CV_8UC1, i));
     device->push(rawFrame(images.back(), 64 + 16));
   }
+  std::vector<Frame> frames;
   for (int i = 0; i < 7; ++i) {
     GrabResult r = camera.grab(100ms);
     ASSERT_TRUE(r.ok()) << i << ": " << r.message;
     EXPECT_EQ(r.frame.format, PixelFormat::Mono8);
-    EXPECT_TRUE(sameImage(r.frame.image, images[i])) << i;
     EXPECT_EQ(r.frame.id, static_cast<std::uint64_t>(i));
     EXPECT_EQ(device->queued(), 3u) << "buffer queued again after each frame";
+    frames.push_back(std::move(r.frame));
   }
+  // Checked after the driver has refilled every buffer twice: a frame owns its pixels (the one
+  // copy out of the mmap buffer), it never aliases driver memory.
+  for (int i = 0; i < 7; ++i) EXPECT_TRUE(sameImage(frames[i].image, images[i])) << i;
   EXPECT_EQ(camera.grab(10ms).status, GrabStatus::Timeout);
   camera.close();
   EXPECT_EQ(device->live_mappings(), 0);
@@ -269,6 +274,20 @@ TEST(V4l2Camera, SurvivesTheDeviceDisappearingAndComingBack) {
   EXPECT_EQ(health.reconnects, 1u);
   EXPECT_EQ(device->live_mappings(), 3);
   EXPECT_GE(device->open_count, 2);
+}
+
+TEST(V4l2Camera, FactoryBuildsAKernelBackedCameraThatNamesAMissingDevice) {
+  CameraSettings settings;
+  settings.backend = CameraBackend::V4l2;
+  settings.v4l2.device = "/dev/facet-no-such-video-device";
+  auto camera = makeCamera(settings);
+  EXPECT_EQ(camera->name(), "v4l2:/dev/facet-no-such-video-device");
+  try {
+    camera->open();
+    FAIL() << "open() should throw";
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("/dev/facet-no-such-video-device"), std::string::npos);
+  }
 }
 
 }  // namespace

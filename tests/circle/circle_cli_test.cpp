@@ -96,6 +96,12 @@ TEST_F(CircleCli, BadInputNamesTheFileOrTheOption) {
   EXPECT_EQ(missing.exitCode, 1);
   EXPECT_NE(missing.err.find("nope.png"), std::string::npos) << missing.err;
 
+  const fs::path corrupt = dir_ / "corrupt.png";
+  std::ofstream(corrupt) << "not a png";
+  const CliRun bad = facet("circle --image " + corrupt.string() + " --center 81,69 --radius 40");
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(bad.err.find("corrupt.png"), std::string::npos) << bad.err;
+
   const CliRun zero = facet("circle --image " + image_ + " --center 81,69 --radius 0 --json");
   EXPECT_EQ(zero.exitCode, 1);
   EXPECT_NE(zero.err.find("radius"), std::string::npos) << zero.err;

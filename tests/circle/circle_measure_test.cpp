@@ -240,3 +240,57 @@ TEST(CircleMeasure, ClutterAndOcclusionDoNotPullTheFit) {
 
 }  // namespace
 }  // namespace facet
+
+namespace facet {
+namespace {
+
+TEST(CircleMeasure, GreyValueRefinementReportsTheBlurAndEdgeOnlyFitIsBiasCorrected) {
+  Scene s(spec(120, 60));
+  const cv::Point2d c{60.35, 59.8};
+  s.addDisc(c, 20.4, 160);
+  const cv::Mat image = s.render();
+  auto p = params({61, 59}, 20, CirclePolarity::LightToDark);
+  const auto refined = measureCircle(image, p);
+  ASSERT_TRUE(refined.ok()) << refined.message;
+  EXPECT_TRUE(refined.greyRefined);
+  // PSF sigma 1 combined with the pixel's own width: sqrt(1 + 1/12) = 1.04.
+  EXPECT_NEAR(refined.blur, 1.04, 0.15);
+  expectCircle(refined, c, 20.4, 0.03);
+
+  p.refineWithGreyValues = false;
+  const auto edgeOnly = measureCircle(image, p);
+  ASSERT_TRUE(edgeOnly.ok()) << edgeOnly.message;
+  EXPECT_FALSE(edgeOnly.greyRefined);
+  expectCircle(edgeOnly, c, 20.4, 0.05);
+  // Without the curvature-bias correction the radius comes out about k / r = 0.05 px short.
+  p.correctRadiusBias = false;
+  const auto biased = measureCircle(image, p);
+  ASSERT_TRUE(biased.ok()) << biased.message;
+  EXPECT_LT(biased.radius, edgeOnly.radius - 0.03);
+}
+
+TEST(CircleMeasure, CircleCutByTheImageBorderIsAPartialArc) {
+  Scene s(spec(100, 60));
+  const cv::Point2d c{12.4, 50.3};  // 30 px radius: the left third lies outside the image
+  s.addDisc(c, 30.2, 170);
+  auto p = params({13, 50}, 30, CirclePolarity::LightToDark);
+  const auto m = measureCircle(s.render(), p);
+  ASSERT_TRUE(m.ok()) << m.message;
+  EXPECT_NEAR(m.centre.x, c.x, 0.1);
+  EXPECT_NEAR(m.centre.y, c.y, 0.1);
+  EXPECT_NEAR(m.radius, 30.2, 0.1);
+  EXPECT_LT(m.coverageDeg, 250.0);
+  EXPECT_GT(m.coverageDeg, 150.0);
+}
+
+TEST(CircleMeasure, AbsurdAnnulusIsBadInput) {
+  Scene s(spec(60, 60));
+  auto p = params({30, 30}, 1e9, CirclePolarity::Any);
+  const auto m = measureCircle(s.render(), p);
+  EXPECT_TRUE(m.has(CircleFailure::BadInput)) << m.message;
+  p = params({1e12, 30}, 10, CirclePolarity::Any);
+  EXPECT_TRUE(measureCircle(s.render(), p).has(CircleFailure::BadInput));
+}
+
+}  // namespace
+}  // namespace facet

@@ -17,6 +17,7 @@
 
 #include "plc/plc_link.hpp"
 #include "plc/register_encoding.hpp"
+#include "plc/register_map_yaml.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
 
 namespace facet::plc {
@@ -164,12 +165,12 @@ std::size_t countIn(const std::vector<nlohmann::json>& events, const char* kind)
                                                 [&](const auto& e) { return e["event"] == kind; }));
 }
 
-void triggeredRoundTrip(int base) {
-  const RegisterMap map = fullMap(base);
+void triggeredRoundTrip(const RegisterMap& map) {
   const int port = test::freeTcpPort();
   PymodbusPlc plc(test::writePeerConfig(map, false), port);
   plc.start();
-  plc.command("set_register 5 7");  // recipe select (wire address 5)
+  plc.command("set_register " +  // recipe select
+              std::to_string(map.wireAddress(map.control.recipeSelect->address)) + " 7");
   PlcLink link(map, fastSettings(port));
   link.setActiveRecipe(7);
   link.start();
@@ -211,11 +212,19 @@ void triggeredRoundTrip(int base) {
 }
 
 TEST(PlcLinkWithPymodbus, TriggeredHandshakeDeliversEveryTypeAndWordOrder) {
-  triggeredRoundTrip(0);
+  triggeredRoundTrip(fullMap(0));
+}
+
+// The example station map keeps its status flags in adjacent coils: they go out in one request.
+TEST(PlcLinkWithPymodbus, ExampleStationMapWithAdjacentStatusCoils) {
+  RegisterMap map =
+      loadRegisterMap(std::string(FACET_SOURCE_DIR) + "/tests/plc/data/station_register_map.yaml");
+  map.control.enable.reset();  // the pymodbus PLC does not enable; tested separately
+  triggeredRoundTrip(map);
 }
 
 TEST(PlcLinkWithPymodbus, OneBasedMapReachesTheSameWireAddresses) {
-  triggeredRoundTrip(1);
+  triggeredRoundTrip(fullMap(1));
 }
 
 TEST(PlcLinkWithPymodbus, TriggerWhileBusyRaisesMissedTrigger) {
@@ -390,6 +399,97 @@ TEST(PlcLinkWithPymodbus, ModbusExceptionIsLoggedWithTheRegister) {
   spdlog::set_default_logger(previous);
   EXPECT_THAT(log.str(), HasSubstr("writing holding register 600 for result.far"));
   EXPECT_THAT(log.str(), HasSubstr("Illegal data address"));
+}
+
+}  // namespace
+}  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// Server role: the daemon serves the registers and a pymodbus client (the PLC) polls them.
+TEST(PlcLinkWithPymodbus, ServerRoleLetsThePlcPollTheDaemon) {
+  const RegisterMap map = fullMap();
+  PlcSettings settings = fastSettings(0);
+  settings.role = LinkRole::Server;
+  PlcLink link(map, settings);
+  link.start();
+  ASSERT_GT(link.serverPort(), 0);
+  PymodbusPlc plc(test::writePeerConfig(map, false), link.serverPort(), /*clientMode=*/true);
+  plc.start();
+  for (int round = 0; round < 2; ++round) {
+    plc.command("trigger");
+    const auto trigger = link.waitTrigger(5s);
+    ASSERT_TRUE(trigger) << "round " << round;
+    const InspectionResult sent = sampleResult(map, round, "served-" + std::to_string(round));
+    ASSERT_TRUE(link.publish(sent));
+    ASSERT_TRUE(plc.waitFor(
+        [&](const auto& all) { return countIn(all, "result") == std::size_t(round + 1); }, 5s));
+    expectDelivered(map, sent, plc.events("result").back(), round + 1);
+    ASSERT_TRUE(
+        waitUntil([&] { return link.stats().acknowledged == std::uint64_t(round + 1); }, 5s));
+  }
+}
+
+}  // namespace
+}  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// control.enable = 0: the line is not running; triggers are ignored (neither accepted nor missed).
+TEST(PlcLinkWithPymodbus, TriggersAreIgnoredWhileNotEnabled) {
+  RegisterMap map = fullMap();
+  map.control.enable = reg(6);
+  const int port = test::freeTcpPort();
+  PymodbusPlc plc(test::writePeerConfig(map, false), port);
+  plc.start();
+  PlcLink link(map, fastSettings(port));
+  link.start();
+  ASSERT_TRUE(waitUntil([&] { return link.stats().connected; }, 5s));
+  plc.command("trigger");
+  EXPECT_FALSE(link.waitTrigger(300ms));
+  EXPECT_EQ(link.stats().triggers, 0u);
+  EXPECT_EQ(link.stats().missedTriggers, 0u);
+  std::this_thread::sleep_for(300ms);  // the peer drops the unanswered pulse after 0.5 s
+  plc.command("set_register 6 1");
+  plc.command("trigger");
+  EXPECT_TRUE(link.waitTrigger(5s));
+}
+
+}  // namespace
+}  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// What the daemon owns besides results: ready, active recipe, a heartbeat that keeps counting.
+TEST(PlcLinkWithPymodbus, ReadyActiveRecipeAndHeartbeatReachThePlc) {
+  const RegisterMap map = fullMap();
+  const int port = test::freeTcpPort();
+  PymodbusPlc plc(test::writePeerConfig(map, false), port);
+  plc.start();
+  PlcLink link(map, fastSettings(port));  // heartbeat every 20 ms
+  link.setActiveRecipe(12);
+  link.start();
+  ASSERT_TRUE(waitUntil([&] { return link.stats().connected; }, 5s));
+  auto report = [&](const std::string& signal) {
+    const std::size_t before = plc.events("report").size();
+    plc.command("report " + signal);
+    EXPECT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "report") > before; }, 5s));
+    return plc.events("report").back()["value"];
+  };
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(report("ready"), true);
+  EXPECT_EQ(report("active_recipe"), 12);
+  const int beat = report("heartbeat");
+  std::this_thread::sleep_for(200ms);
+  EXPECT_GE(static_cast<int>(report("heartbeat")), beat + 3);
+  link.setReady(false);
+  link.setActiveRecipe(4);
+  std::this_thread::sleep_for(50ms);
+  EXPECT_EQ(report("ready"), false);
+  EXPECT_EQ(report("active_recipe"), 4);
 }
 
 }  // namespace

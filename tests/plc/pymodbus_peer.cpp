@@ -82,7 +82,8 @@ void PymodbusPlc::start() {
     ::close(toChild[1]);
     ::close(fromChild[0]);
     ::execl("/usr/bin/python3", "python3", script.c_str(), "--config", configPath_.c_str(),
-            "--port", port.c_str(), static_cast<char*>(nullptr));
+            "--port", port.c_str(), clientMode_ ? "--client" : static_cast<char*>(nullptr),
+            static_cast<char*>(nullptr));
     std::fprintf(stderr, "cannot run /usr/bin/python3\n");
     std::_Exit(127);
   }
@@ -100,7 +101,8 @@ void PymodbusPlc::start() {
       [&](const std::vector<nlohmann::json>& all) {
         for (const auto& e : all) {
           if (e["event"] == "error") failure = e["message"];
-          if (e["event"] == "listening" && e["port"] == port_) return true;
+          if ((e["event"] == "listening" || e["event"] == "connected") && e["port"] == port_)
+            return true;
         }
         return !failure.empty();
       },

@@ -27,10 +27,12 @@ std::string writePeerConfig(const RegisterMap& map, bool freeRun, int registers 
 
 class PymodbusPlc {
  public:
-  PymodbusPlc(std::string configPath, int port) : configPath_(std::move(configPath)), port_(port) {}
+  // clientMode: the PLC is a Modbus client polling the daemon's server on `port`.
+  PymodbusPlc(std::string configPath, int port, bool clientMode = false)
+      : configPath_(std::move(configPath)), port_(port), clientMode_(clientMode) {}
   ~PymodbusPlc();
 
-  // Starts the script and waits until it listens. Throws std::runtime_error (with the script's
+  // Starts the script and waits until it listens (or, in client mode, is connected). Throws std::runtime_error (with the script's
   // message, e.g. "pymodbus is not installed") when it does not.
   void start();
   // SIGKILL, as a PLC losing power: no goodbye on the connection.
@@ -48,6 +50,7 @@ class PymodbusPlc {
 
   std::string configPath_;
   int port_;
+  bool clientMode_;
   pid_t pid_ = -1;
   int stdinFd_ = -1;
   std::thread reader_;

@@ -2,7 +2,8 @@
 """An independent PLC for facet's PLC tests: a pymodbus TCP server plus a scan loop that acts
 like a PLC program on the same registers.
 
-    pymodbus_plc.py --config plc.json --port 5020
+    pymodbus_plc.py --config plc.json --port 5020            # the PLC serves the registers
+    pymodbus_plc.py --config plc.json --port 5020 --client   # the daemon serves, the PLC polls
 
 plc.json (wire addresses, i.e. zero-based as sent on the wire):
     {"coils": 64, "registers": 256,
@@ -15,7 +16,9 @@ plc.json (wire addresses, i.e. zero-based as sent on the wire):
      "auto_ack": true, "mode": "triggered"}   (mode "free_run": report each new counter)
 
 stdin commands, one per line: "trigger" (raise the trigger; cleared when busy or result valid
-rises, or after 0.5 s), "quit". stdout: one JSON object per line: {"event": "listening", "port": P}, then
+rises, or after 0.5 s), "report <signal>" (emit {"event": "report", ...} with its value),
+"set_register <address> <value>", "quit".
+stdout: one JSON object per line: {"event": "listening", "port": P}, then
 {"event": "result", ...} per result valid rising edge (decoded here with struct, independently
 of facet's encoder, plus the raw words), {"event": "missed_trigger"} per rising edge.
 """
@@ -32,6 +35,7 @@ try:
     import pymodbus
     from pymodbus.datastore import (ModbusSequentialDataBlock, ModbusServerContext,
                                     ModbusSlaveContext)
+    from pymodbus.client import ModbusTcpClient
     from pymodbus.server import StartAsyncTcpServer
 except ImportError as error:  # the C++ test turns this into a failure with this message
     print(json.dumps({"event": "error",
@@ -145,18 +149,79 @@ class Plc:
         if line == "trigger":
             self.set_flag("trigger", True)
             self.trigger_since = time.monotonic()
+        elif line.startswith("report "):
+            # "report <signal>": the current value of a mapped signal, as the PLC sees it
+            name = line.split()[1]
+            at = self.signals[name]
+            value = (self.flag(name) if at["table"] == "coil" or at.get("bit", -1) >= 0
+                     else self.number(name))
+            emit({"event": "report", "signal": name, "value": value})
         elif line.startswith("set_register "):
             _, address, value = line.split()
             self.slave.setValues(HOLDING, int(address), [int(value)])
+
+
+class ClientTables:
+    """The daemon's registers seen through a pymodbus client: the PLC program polls them."""
+
+    def __init__(self, client):
+        self.client = client
+
+    def getValues(self, fc, address, count=1):  # pylint: disable=invalid-name
+        reply = (self.client.read_coils(address, count) if fc == COILS
+                 else self.client.read_holding_registers(address, count))
+        if reply.isError():
+            raise RuntimeError(f"read {fc} {address}: {reply}")
+        return reply.bits[:count] if fc == COILS else reply.registers
+
+    def setValues(self, fc, address, values):  # pylint: disable=invalid-name
+        reply = (self.client.write_coil(address, values[0]) if fc == COILS
+                 else self.client.write_registers(address, values))
+        if reply.isError():
+            raise RuntimeError(f"write {fc} {address}: {reply}")
+
+
+def run_client(config, port):
+    client = ModbusTcpClient("127.0.0.1", port=port)
+    if not client.connect():
+        emit({"event": "error", "message": f"cannot connect to 127.0.0.1:{port}"})
+        sys.exit(4)
+    emit({"event": "connected", "port": port, "pymodbus": pymodbus.__version__})
+    plc = Plc(config, ClientTables(client))
+    commands = []
+    lock = threading.Lock()
+
+    def read_stdin():
+        for line in sys.stdin:
+            with lock:
+                commands.append(line.strip())
+        with lock:
+            commands.append("quit")
+
+    threading.Thread(target=read_stdin, daemon=True).start()
+    while True:
+        with lock:
+            pending, commands[:] = list(commands), []
+        for line in pending:
+            if line == "quit":
+                client.close()
+                return
+            plc.command(line)
+        plc.scan()
+        time.sleep(0.001)
 
 
 async def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--config", required=True)
     parser.add_argument("--port", type=int, required=True)
+    parser.add_argument("--client", action="store_true")
     args = parser.parse_args()
     with open(args.config, encoding="utf-8") as f:
         config = json.load(f)
+    if args.client:
+        run_client(config, args.port)
+        return
 
     slave = ModbusSlaveContext(
         co=ModbusSequentialDataBlock(0, [False] * config.get("coils", 64)),

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <typeinfo>
 
 #include <modbus.h>
 
@@ -248,6 +249,50 @@ TEST(RegisterMapYaml, UnreadableFileIsNamed) {
   } catch (const RegisterMapError& e) {
     EXPECT_THAT(e.what(), HasSubstr("/nonexistent/plc.yaml: cannot read"));
   }
+}
+
+}  // namespace
+}  // namespace facet::plc
+
+namespace facet::plc {
+namespace {
+
+// Byte-level mutations of a good map: every outcome is a map or a RegisterMapError, never another
+// exception or a crash (the hardening fuzzer goes further; this keeps the contract in CI).
+TEST(RegisterMapYaml, MutatedInputGivesAMapOrAClearError) {
+  const std::string good = kYaml;
+  std::mt19937 rng(1234);
+  const std::string alphabet = "{}[]:,-#&*!|>'\"%@` \n\t0123456789abcxyz.";
+  int errors = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    std::string text = good;
+    const int edits = 1 + static_cast<int>(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      const std::size_t at = rng() % text.size();
+      switch (rng() % 3) {
+        case 0:
+          text[at] = alphabet[rng() % alphabet.size()];
+          break;
+        case 1:
+          text.erase(at, 1 + rng() % 8);
+          break;
+        default:
+          text.insert(text.begin() + static_cast<std::ptrdiff_t>(at),
+                      alphabet[rng() % alphabet.size()]);
+          break;
+      }
+      if (text.empty()) text.push_back('x');
+    }
+    try {
+      parseRegisterMapText(text, "fuzz.yaml");
+    } catch (const RegisterMapError& e) {
+      ++errors;
+      EXPECT_THAT(e.what(), HasSubstr("fuzz.yaml")) << "the error does not name the file";
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << "unexpected " << typeid(e).name() << ": " << e.what() << "\n" << text;
+    }
+  }
+  EXPECT_GT(errors, 100);  // the mutations do break the map
 }
 
 }  // namespace

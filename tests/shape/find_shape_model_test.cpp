@@ -231,6 +231,24 @@ TEST(FindShapeModel, GreedinessAndLevelsKeepTheResult) {
   EXPECT_LT(positionError(m[0], truth), 0.05);
 }
 
+TEST(FindShapeModel, MinContrastIgnoresWeakGradients) {
+  // A faint part: contrast 30 grey levels, edge gradients of about 12 grey levels per pixel.
+  const Pose2D truth{200.4, 150.3, radians(70.0), 1.0};
+  const cv::Mat faint = bracketScene({400, 300}, {truth}, 97, testing::kBackground + 30.0);
+  auto m = findShapeModel(faint, bracketModel());  // model minContrast 5
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.1);
+  ShapeModelParams strict;
+  strict.minContrast = 20.0;
+  const ShapeModel model = createShapeModel(bracketTemplate(), strict);
+  EXPECT_DOUBLE_EQ(model.minContrast, 20.0);
+  EXPECT_TRUE(findShapeModel(faint, model).empty());
+  // The strong part is still found with the strict model.
+  m = findShapeModel(bracketScene({400, 300}, {truth}, 98), model);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(positionError(m[0], truth), 0.05);
+}
+
 TEST(FindShapeModel, SixteenBitImage) {
   const Pose2D truth{200.6, 150.2, radians(-10.0), 1.0};
   const auto m = findShapeModel(

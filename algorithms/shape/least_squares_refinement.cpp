@@ -1,0 +1,127 @@
+#include "algorithms/shape/least_squares_refinement.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "algorithms/edges/subpixel_edges.hpp"
+
+namespace facet::shape_detail {
+
+Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Rect roi, Pose2D pose,
+                           Polarity polarity, bool withScale) {
+  Refined result{pose, 0.0, false};
+  roi &= cv::Rect(0, 0, image.cols, image.rows);
+  if (roi.width < 3 || roi.height < 3) return result;
+  EdgeParams edgeParams;
+  edgeParams.roi = roi;
+  edgeParams.low = model.minContrast;
+  edgeParams.high = std::max(2.0 * model.minContrast, 0.5 * model.contrastHigh);
+  const EdgeContours edges = detectSubpixelEdges(image, edgeParams);
+  if (edges.points.size() < 6) return result;
+
+  // Edge points indexed by the pixel that holds them.
+  cv::Mat cell(roi.size(), CV_32S, cv::Scalar(-1));
+  for (int i = 0; i < static_cast<int>(edges.points.size()); ++i) {
+    const cv::Point p(cvRound(edges.points[i].position.x) - roi.x,
+                      cvRound(edges.points[i].position.y) - roi.y);
+    if (!cv::Rect(0, 0, roi.width, roi.height).contains(p)) continue;
+    int& slot = cell.at<int>(p);
+    if (slot < 0 || edges.points[slot].magnitude < edges.points[i].magnitude) slot = i;
+  }
+
+  constexpr double kMinCos = 0.8;  // direction agreement of a correspondence (about 37 degrees)
+  double sign = 1.0;               // global polarity, decided on the first pass
+  const int unknowns = withScale ? 4 : 3;
+  struct Pair {
+    Eigen::Vector4d J;
+    double r;
+  };
+  std::vector<Pair> pairs;
+  std::vector<double> absResiduals;
+  for (int iteration = 0; iteration < 15; ++iteration) {
+    const int radius = iteration < 2 ? 3 - iteration : 1;
+    const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+    double polaritySum = 0.0;
+    pairs.clear();
+    for (const auto& mp : model.finePoints) {
+      const double px = mp.position.x, py = mp.position.y;
+      const cv::Point2d q = pose.apply({px, py});
+      const double dx = c * mp.direction.x + s * mp.direction.y;
+      const double dy = -s * mp.direction.x + c * mp.direction.y;
+      const int cx = cvRound(q.x) - roi.x, cy = cvRound(q.y) - roi.y;
+      int bestIdx = -1;
+      double bestD2 = 1e30, bestDot = 0.0;
+      for (int v = cy - radius; v <= cy + radius; ++v) {
+        if (v < 0 || v >= roi.height) continue;
+        const int* row = cell.ptr<int>(v);
+        for (int u = cx - radius; u <= cx + radius; ++u) {
+          if (u < 0 || u >= roi.width || row[u] < 0) continue;
+          const EdgePoint& e = edges.points[row[u]];
+          const double dot = e.normal.x * dx + e.normal.y * dy;
+          const double agree = polarity == Polarity::IgnoreLocal    ? std::abs(dot)
+                               : polarity == Polarity::IgnoreGlobal ? sign * dot
+                                                                    : dot;
+          if (agree < kMinCos &&
+              !(iteration == 0 && polarity == Polarity::IgnoreGlobal && std::abs(dot) >= kMinCos))
+            continue;
+          const double d2 = (e.position.x - q.x) * (e.position.x - q.x) +
+                            (e.position.y - q.y) * (e.position.y - q.y);
+          if (d2 < bestD2) bestD2 = d2, bestIdx = row[u], bestDot = dot;
+        }
+      }
+      if (bestIdx < 0) continue;
+      polaritySum += bestDot;
+      const EdgePoint& e = edges.points[bestIdx];
+      const double r = e.normal.x * (q.x - e.position.x) + e.normal.y * (q.y - e.position.y);
+      // q = t + s R(a) p: dq/da = s R'(a) p, dq/ds = R(a) p.
+      const double rpx = c * px + s * py, rpy = -s * px + c * py;
+      pairs.push_back({Eigen::Vector4d(e.normal.x, e.normal.y,
+                                       pose.scale * (e.normal.x * rpy - e.normal.y * rpx),
+                                       e.normal.x * rpx + e.normal.y * rpy),
+                       r});
+    }
+    if (iteration == 0 && polarity == Polarity::IgnoreGlobal) sign = polaritySum < 0 ? -1.0 : 1.0;
+    if (pairs.size() < 6) return result;
+
+    // Robust weights: Huber while the pose is coarse, then Tukey's biweight with a cut-off from
+    // the median residual, so that edges of occluders and clutter drop out entirely.
+    absResiduals.clear();
+    for (const auto& pr : pairs) absResiduals.push_back(std::abs(pr.r));
+    auto mid = absResiduals.begin() + static_cast<std::ptrdiff_t>(absResiduals.size() / 2);
+    std::nth_element(absResiduals.begin(), mid, absResiduals.end());
+    const double cutoff = std::clamp(4.685 * 1.4826 * *mid, 0.15, 1.5);
+    Eigen::Matrix4d H = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d g = Eigen::Vector4d::Zero();
+    double sumSq = 0.0, weightSum = 0.0;
+    for (const auto& pr : pairs) {
+      const double a = std::abs(pr.r);
+      double w = 0.0;
+      if (iteration < 2) {
+        w = a <= 0.5 ? 1.0 : 0.5 / a;
+      } else if (a < cutoff) {
+        const double t = 1.0 - (a / cutoff) * (a / cutoff);
+        w = t * t;
+      }
+      H += w * pr.J * pr.J.transpose();
+      g += w * pr.r * pr.J;
+      sumSq += w * pr.r * pr.r;
+      weightSum += w;
+    }
+    if (weightSum < 6.0) return result;
+    Eigen::VectorXd delta = H.topLeftCorner(unknowns, unknowns).ldlt().solve(-g.head(unknowns));
+    if (!delta.allFinite()) return result;
+    pose.x += delta[0];
+    pose.y += delta[1];
+    pose.angle += delta[2];
+    if (withScale) pose.scale += delta[3];
+    result = {pose, std::sqrt(sumSq / weightSum), true};
+    if (iteration >= 3 && std::hypot(delta[0], delta[1]) < 1e-4 && std::abs(delta[2]) < 1e-6) break;
+  }
+  result.pose.angle = wrapAngle(result.pose.angle);
+  return result;
+}
+
+}  // namespace facet::shape_detail

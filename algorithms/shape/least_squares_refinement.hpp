@@ -1,0 +1,24 @@
+#pragma once
+// Least-squares refinement of a match (internal to facet_shape): ICP of the model's subpixel
+// points against the image's Facet-model subpixel edges, minimising point-to-line distances
+// along the image edge normals in position, angle and optionally scale.
+
+#include <opencv2/core.hpp>
+
+#include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/shape_model.hpp"
+
+namespace facet::shape_detail {
+
+struct Refined {
+  Pose2D pose;
+  double residual = 0.0;  // weighted RMS point-to-line distance, pixels
+  bool ok = false;        // false: too few correspondences, the pose is the start pose
+};
+
+// Refines `pose` using the image's edges inside `roi` (image pixels, clipped to the image).
+Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Rect roi, Pose2D pose,
+                           Polarity polarity, bool withScale);
+
+}  // namespace facet::shape_detail

@@ -1,0 +1,31 @@
+#pragma once
+// Exhaustive search of the top pyramid level with quantised-orientation response maps (internal
+// to facet_shape). Map b holds 127 cos(theta - theta_b) for every pixel, so the score of a
+// template (one angle and scale) at every position is a sum of shifted map rows: one
+// vectorisable 8-bit add per model point and image row, as in LINE-MOD.
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/shape_model.hpp"
+
+namespace facet::shape_detail {
+
+struct Candidate {
+  double x = 0.0, y = 0.0;  // position on the current level, pixels
+  double angle = 0.0;       // radians
+  double scale = 1.0;
+  double score = 0.0;
+};
+
+// Local maxima (over position, best template per pixel) scoring at least `threshold`, best first,
+// at most `maxCandidates`. `field` is the top level's DirectionField; the search splits its rows
+// over `threads` threads.
+std::vector<Candidate> searchTopLevel(const cv::Mat& field, const std::vector<ShapePoint>& points,
+                                      const std::vector<double>& angles,
+                                      const std::vector<double>& scales, Polarity polarity,
+                                      double threshold, int threads, int maxCandidates);
+
+}  // namespace facet::shape_detail

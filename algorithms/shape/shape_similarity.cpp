@@ -1,0 +1,75 @@
+#include "algorithms/shape/shape_similarity.hpp"
+
+#include <cmath>
+
+#include "algorithms/shape/image_gradients.hpp"
+
+namespace facet::shape_detail {
+
+PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, double scale) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  PosedPoints out;
+  out.offsets.reserve(points.size());
+  out.directions.reserve(points.size());
+  for (const auto& p : points) {
+    const double x = p.position.x, y = p.position.y;
+    out.offsets.emplace_back(cvRound(scale * (c * x + s * y)), cvRound(scale * (-s * x + c * y)));
+    const double dx = p.direction.x, dy = p.direction.y;
+    out.directions.emplace_back(static_cast<float>(c * dx + s * dy),
+                                static_cast<float>(-s * dx + c * dy));
+  }
+  return out;
+}
+
+double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, Polarity polarity,
+                 double minScore, double greediness) {
+  const int n = static_cast<int>(posed.offsets.size());
+  const double invN = 1.0 / n;
+  const double safe = minScore - 1.0, greedy = minScore;
+  double sum = 0.0;
+  const int w = field.cols, h = field.rows;
+  for (int j = 0; j < n; ++j) {
+    const int x = at.x + posed.offsets[j].x, y = at.y + posed.offsets[j].y;
+    if (x >= 0 && y >= 0 && x < w && y < h) {
+      const Direction g = field.ptr<Direction>(y)[x];
+      const double dot =
+          (g[0] * posed.directions[j].x + g[1] * posed.directions[j].y) * (1.0 / 127);
+      sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
+    }
+    if ((j & 7) == 7 && minScore > 0.0) {
+      const double f = (j + 1) * invN;
+      const double bound = (1.0 - greediness) * (safe + f) + greediness * greedy * f;
+      const double partial = (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
+      if (partial < bound) return -1.0;
+    }
+  }
+  return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
+}
+
+double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
+                    Polarity polarity) {
+  const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+  double sum = 0.0;
+  for (const auto& mp : model.finePoints) {
+    const cv::Point2d q = pose.apply(mp.position);
+    const int x0 = static_cast<int>(std::floor(q.x)), y0 = static_cast<int>(std::floor(q.y));
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= field.cols || y0 + 1 >= field.rows) continue;
+    const double fx = q.x - x0, fy = q.y - y0;
+    const Direction* r0 = field.ptr<Direction>(y0) + x0;
+    const Direction* r1 = field.ptr<Direction>(y0 + 1) + x0;
+    double gx = 0.0, gy = 0.0;
+    const double w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+    const Direction* d[4] = {r0, r0 + 1, r1, r1 + 1};
+    for (int k = 0; k < 4; ++k) gx += w[k] * (*d[k])[0], gy += w[k] * (*d[k])[1];
+    const double norm = std::hypot(gx, gy);
+    if (norm < 1e-6) continue;
+    const double dot = ((c * mp.direction.x + s * mp.direction.y) * gx +
+                        (-s * mp.direction.x + c * mp.direction.y) * gy) /
+                       norm;
+    sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
+  }
+  const double n = static_cast<double>(model.finePoints.size());
+  return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) / n;
+}
+
+}  // namespace facet::shape_detail

@@ -1,0 +1,37 @@
+#pragma once
+// Steger's similarity measure (internal to facet_shape): the mean normalised dot product of the
+// model's gradient directions, turned into the image, and the image's gradient directions.
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/shape_model.hpp"
+
+namespace facet::shape_detail {
+
+// Model points turned and scaled into the image: integer offsets from the reference point and
+// turned directions.
+struct PosedPoints {
+  std::vector<cv::Point> offsets;       // rounded s R(a) p, pixels of the level
+  std::vector<cv::Point2f> directions;  // R(a) d
+};
+
+PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, double scale);
+
+// The similarity at an integer position of a direction field (CV_8SC2, DirectionField), with
+// early termination: after j of n points the pose is abandoned when the partial mean falls below a
+// bound between the safe one (every remaining point matches perfectly, greediness 0) and the
+// greedy one (the remaining points match at exactly minScore, greediness 1). Returns the score,
+// or -1 if abandoned.
+double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, Polarity polarity,
+                 double minScore, double greediness);
+
+// The similarity of the model's subpixel points at a subpixel pose, with the image's directions
+// interpolated bilinearly: the score of a refined match.
+double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
+                    Polarity polarity);
+
+}  // namespace facet::shape_detail

@@ -1,0 +1,34 @@
+#pragma once
+// `facet recipe train`: creates the shape models a recipe needs (its `align` steps with method
+// shape and its `shape` steps) from their template images, writes them where the recipe says,
+// and records beside each model what it was trained from (training_record.hpp), so that a
+// model gone stale is noticed when the recipe is loaded.
+//
+// Registration references and reference scans are used as they are and need no training.
+
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "config/recipe.hpp"
+
+namespace facet::config {
+
+struct TrainedModel {
+  std::string stepId;
+  std::filesystem::path model;  // absolute
+  int numLevels = 0;            // pyramid levels of the model
+  std::size_t points = 0;       // model points on level 0
+};
+
+// Bad template (no edges, unreadable) or unwritable model file; what() names the step and file.
+struct TrainingError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// Trains every model of `recipe` (load it with requireTrainedModels = false). Throws
+// TrainingError on the first model that cannot be trained; models trained before stay written.
+std::vector<TrainedModel> trainRecipe(const Recipe& recipe);
+
+}  // namespace facet::config

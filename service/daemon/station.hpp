@@ -1,0 +1,138 @@
+#pragma once
+// Station: one running facetd. Three stages run concurrently, joined by bounded queues:
+//
+//   acquisition  waits for a trigger (PLC) or free-runs, grabs a frame, picks the recipe for the
+//                part (only here, so a switch happens between two parts, never during one)
+//   inspection   runs the recipe on the frame (RecipeInspection)
+//   publishing   PLC registers, results store, image archive, metrics, last result for HTTP
+//
+// Every part that was triggered or grabbed gets a result: a frame that could not be grabbed,
+// was incomplete, or was dropped because inspection fell behind is published as Verdict::Error
+// ("not inspected"), never as good. Results are never dropped between inspection and
+// publishing (that queue blocks); the PLC link keeps its own bounded, counted queue.
+
+#include <atomic>
+#include <chrono>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+
+#include <opencv2/core.hpp>
+
+#include "camera/camera.hpp"
+#include "camera/scan_source.hpp"
+#include "config/recipe_library.hpp"
+#include "config/station_config.hpp"
+#include "plc/plc_link.hpp"
+#include "service/daemon/bounded_queue.hpp"
+#include "service/daemon/image_archive.hpp"
+#include "service/daemon/inspection.hpp"
+#include "service/daemon/metrics.hpp"
+#include "service/daemon/results_store.hpp"
+#include "service/daemon/station_view.hpp"
+
+namespace facet::service {
+
+struct StationOptions {
+  OverflowPolicy overflow = OverflowPolicy::DropOldest;  // when inspection falls behind
+  std::size_t inspectQueue = 4;                          // frames waiting for inspection
+  std::size_t publishQueue = 64;                         // results waiting for publishing
+  std::optional<int> recipe;       // recipe to start with (default: the lowest id)
+  std::uint64_t maxParts = 0;      // stop after this many parts (0 = run until stopped)
+  bool stopAtEndOfStream = false;  // replay without loop: stop once every file was inspected
+  bool usePlc = true;              // false: no PLC link even if configured
+  std::function<void(const PartResult&)> onPart;  // called by the publishing stage, per part
+};
+
+class Station : public StationView {
+ public:
+  // Opens the results store, loads the recipes and prepares camera, PLC and archive. Throws
+  // std::runtime_error with a clear message when the station cannot run at all (no usable
+  // recipe, store not writable, camera backend unknown).
+  Station(config::StationConfig config, StationOptions options);
+  ~Station() override;
+  Station(const Station&) = delete;
+  Station& operator=(const Station&) = delete;
+
+  // Starts the stages; returns once the camera is open (the PLC may still be connecting).
+  void start();
+  // Asks the stages to finish: no new parts are taken, queued parts are inspected and published.
+  void requestStop();
+  // Waits until the stages have finished (after requestStop(), maxParts or end of stream).
+  void join();
+  [[nodiscard]] bool finished() const { return finished_.load(); }
+  // True once every stage has run out of work (maxParts reached, end of stream, or stop).
+  [[nodiscard]] bool drained() const { return drained_.load(); }
+  // Re-reads the recipes folder; a broken recipe is rejected and the one in use stays.
+  config::ReloadReport reloadRecipes();
+  [[nodiscard]] bool recipesChangedOnDisk() const { return library_.changedOnDisk(); }
+  // Liveness of the acquisition and inspection loops (for the systemd watchdog).
+  [[nodiscard]] bool loopsAlive(std::chrono::milliseconds within) const;
+
+  // StationView
+  [[nodiscard]] nlohmann::json health() const override;
+  [[nodiscard]] std::string metricsText() const override;
+  [[nodiscard]] std::vector<PartResult> recentParts(std::size_t count) const override;
+  [[nodiscard]] std::vector<PartResult> storedParts(std::uint64_t afterPartId,
+                                                    std::size_t limit) const override;
+  [[nodiscard]] std::vector<unsigned char> lastOverlayPng() const override;
+  [[nodiscard]] nlohmann::json summary() const override;
+  ActionOutcome selectRecipe(int recipeId) override;
+  ActionOutcome resetCounters() override;
+
+  [[nodiscard]] const config::StationConfig& config() const { return config_; }
+  [[nodiscard]] MetricsRegistry& metrics() { return metrics_; }
+
+ private:
+  struct Job;
+  void acquisitionLoop();
+  void inspectionLoop();
+  void publishingLoop();
+  std::shared_ptr<const RecipeInspection> inspectionFor(int recipeId, std::string* error);
+  std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
+                                                        const plc::TriggerEvent* trigger);
+  void publishNotInspected(Job job, const std::string& cause);
+  // A scan recipe's part: the next recorded scan instead of a camera frame. False at the end.
+  bool acquireScan(Job& job);
+  void publish(PartResult part, const cv::Mat& image, const Overlay& overlay);
+
+  config::StationConfig config_;
+  StationOptions options_;
+  MetricsRegistry metrics_;
+  std::unique_ptr<ResultsStore> store_;
+  mutable std::mutex storeMutex_;  // SQLite connection shared by publishing and HTTP readers
+  std::unique_ptr<ImageArchive> archive_;
+  config::RecipeLibrary library_;
+  std::unique_ptr<Camera> camera_;
+  std::unique_ptr<ScanSource> scans_;  // recorded range scans for scan recipes (may be null)
+  std::unique_ptr<plc::PlcLink> plc_;
+
+  mutable std::mutex recipeMutex_;
+  std::map<int, std::shared_ptr<const RecipeInspection>> inspections_;  // prepared recipes by id
+  std::map<int, std::string> recipeErrors_;                             // setup errors by id
+  std::shared_ptr<const RecipeInspection> active_;
+  std::optional<int> requestedRecipe_;  // from HTTP, applied before the next part
+
+  BoundedQueue<std::unique_ptr<Job>> inspectQueue_;
+  BoundedQueue<std::unique_ptr<Job>> publishQueue_;
+  std::atomic<bool> stopRequested_{false};
+  std::atomic<bool> finished_{false};
+  std::atomic<bool> drained_{false};
+  bool scansEnded_ = false;  // the scan replay has delivered every file (acquisition thread)
+  std::atomic<std::uint64_t> nextPartId_{1};
+  std::atomic<std::uint64_t> partsTaken_{0};
+  std::atomic<std::int64_t> acquisitionBeat_{0}, inspectionBeat_{0};
+  std::thread acquisition_, inspection_, publishing_;
+
+  mutable std::mutex recentMutex_;
+  std::deque<PartResult> recent_;
+  cv::Mat lastOverlay_;
+  std::map<std::string, std::uint64_t> shiftCounts_;
+  std::string lastStoreError_;
+};
+
+}  // namespace facet::service

@@ -1,0 +1,138 @@
+// Log-polar windows and their NCC: shifts mean rotation/scale, accelerations change nothing.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "algorithms/registration/harris_corners.hpp"
+#include "algorithms/registration/log_polar_window.hpp"
+#include "algorithms/registration/ncc_matcher.hpp"
+#include "tests/registration/textured_scene.hpp"
+
+namespace facet {
+namespace {
+
+cv::Mat toFloat(const cv::Mat& img) {
+  cv::Mat f;
+  img.convertTo(f, CV_32F, 1 / 255.0);
+  return f;
+}
+
+TEST(LogPolarWindow, ShiftCorrespondsToRotationAndScale) {
+  const cv::Mat ref = testing::texturedScene({300, 300}, 17);
+  const cv::Point2d c(150, 150);
+  LogPolarParams lp;  // 32 angles (11.25 deg), ring ratio 1.19
+  const auto refPyramid = buildSamplingPyramid(toFloat(ref));
+  const LogPolarWindow a = sampleLogPolar(refPyramid, c, cv::Matx22d(6, 0, 0, 6), lp);
+  ASSERT_TRUE(a.valid);
+  for (const auto& [angleSteps, ringSteps] :
+       {std::pair{4, 1}, std::pair{-7, 0}, std::pair{12, -1}}) {
+    // Image = reference turned by angleSteps * 11.25 deg about c (in the window's angle sense,
+    // x towards y) and scaled by 1.19^ringSteps.
+    const double phi = angleSteps * 2 * CV_PI / lp.angles, s = std::pow(lp.ringRatio, ringSteps);
+    const cv::Matx22d L(s * std::cos(phi), -s * std::sin(phi), s * std::sin(phi),
+                        s * std::cos(phi));
+    const cv::Matx33d H(L(0, 0), L(0, 1), c.x - L(0, 0) * c.x - L(0, 1) * c.y, L(1, 0), L(1, 1),
+                        c.y - L(1, 0) * c.x - L(1, 1) * c.y, 0, 0, 1);
+    const cv::Mat image = testing::warp(ref, H, ref.size());
+    const LogPolarWindow b =
+        sampleLogPolar(buildSamplingPyramid(toFloat(image)), c, cv::Matx22d(6, 0, 0, 6), lp);
+    ASSERT_TRUE(b.valid);
+    const WindowScore w = compareWindows(a, b, lp.ringShifts, 0.0, {});
+    EXPECT_EQ(w.angleShift, (angleSteps + lp.angles) % lp.angles) << angleSteps;
+    EXPECT_EQ(w.ringShift, ringSteps);
+    EXPECT_GT(w.score, 0.9);
+  }
+}
+
+// Windows from a textured scene and from a rotated, scaled, noisy copy: some pairs match well,
+// most do not, which exercises every pruning path.
+std::pair<std::vector<LogPolarWindow>, std::vector<LogPolarWindow>> windowSets(int count) {
+  const cv::Mat ref = testing::texturedScene({320, 320}, 29);
+  const cv::Matx33d H = testing::similarity(70.0, 1.15, {159.5, 159.5}, {159.5, 159.5});
+  cv::Mat image = testing::warp(ref, H, ref.size());
+  cv::Mat noise(image.size(), CV_8U);
+  cv::randn(noise, 0, 4);
+  image += noise;
+  LogPolarParams lp;
+  HarrisParams hp;
+  hp.maxCorners = count;
+  auto windows = [&](const cv::Mat& img) {
+    const cv::Mat f = toFloat(img);
+    const auto pyramid = buildSamplingPyramid(f);
+    std::vector<LogPolarWindow> out;
+    for (const auto& c : detectHarrisCorners(f, hp)) {
+      LogPolarWindow w = sampleLogPolar(pyramid, c.pt, cv::Matx22d(c.scale, 0, 0, c.scale), lp);
+      if (w.valid) out.push_back(std::move(w));
+    }
+    // Random windows at random points too (not corners).
+    cv::RNG rng(3);
+    for (int i = 0; i < count / 4; ++i) {
+      const cv::Point2d p(rng.uniform(60.0, 260.0), rng.uniform(60.0, 260.0));
+      const double s = rng.uniform(1.5, 4.0);
+      LogPolarWindow w = sampleLogPolar(pyramid, p, cv::Matx22d(s, 0, 0, s), lp);
+      if (w.valid) out.push_back(std::move(w));
+    }
+    return out;
+  };
+  return {windows(ref), windows(image)};
+}
+
+TEST(NccMatcher, AccelerationsGiveIdenticalScoresToPlainNcc) {
+  const auto [a, b] = windowSets(40);
+  ASSERT_GT(a.size(), 30u);
+  ASSERT_GT(b.size(), 30u);
+  int compared = 0, aboveThreshold = 0;
+  for (std::size_t i = 0; i < a.size(); i += 3)
+    for (std::size_t j = 0; j < b.size(); j += 2) {
+      for (double threshold : {-1.0, 0.5, 0.8}) {
+        const WindowScore plain = compareWindows(a[i], b[j], 2, threshold, {false, false, false});
+        aboveThreshold += plain.score >= threshold;
+        for (int flags = 1; flags < 8; ++flags) {
+          const NccAccelerations acc{(flags & 1) != 0, (flags & 2) != 0, (flags & 4) != 0};
+          const WindowScore fast = compareWindows(a[i], b[j], 2, threshold, acc);
+          ASSERT_EQ(fast.score, plain.score) << i << " " << j << " flags " << flags;
+          ASSERT_EQ(fast.ringShift, plain.ringShift);
+          ASSERT_EQ(fast.angleShift, plain.angleShift);
+        }
+        ++compared;
+      }
+    }
+  EXPECT_GT(compared, 500);
+  EXPECT_GT(aboveThreshold, 50);  // the comparison covered accepted pairs, not just rejections
+}
+
+TEST(NccMatcher, AcceleratedMatchingGivesTheSameMatches) {
+  const auto [a, b] = windowSets(80);
+  NccMatchParams plainParams;
+  plainParams.accelerations = {false, false, false};
+  const auto plain = matchWindows(a, b, 2, plainParams);
+  EXPECT_GT(plain.size(), 20u);
+  for (int flags = 1; flags < 8; ++flags) {
+    NccMatchParams p;
+    p.accelerations = {(flags & 1) != 0, (flags & 2) != 0, (flags & 4) != 0};
+    const auto fast = matchWindows(a, b, 2, p);
+    ASSERT_EQ(fast.size(), plain.size()) << flags;
+    for (std::size_t k = 0; k < plain.size(); ++k) {
+      EXPECT_EQ(fast[k].ref, plain[k].ref);
+      EXPECT_EQ(fast[k].image, plain[k].image);
+      EXPECT_EQ(fast[k].best.score, plain[k].best.score);
+    }
+  }
+}
+
+TEST(HarrisCorners, BudgetAndSpreading) {
+  const cv::Mat f = toFloat(testing::texturedScene({400, 300}, 2));
+  HarrisParams hp;
+  hp.maxCorners = 100;
+  const auto corners = detectHarrisCorners(f, hp);
+  EXPECT_EQ(corners.size(), 100u);
+  // Spread: every quadrant of the image holds some corners.
+  int quadrant[4] = {0, 0, 0, 0};
+  for (const auto& c : corners) ++quadrant[(c.pt.x > 200) + 2 * (c.pt.y > 150)];
+  for (int q : quadrant) EXPECT_GE(q, 10);
+  // A flat image has none.
+  EXPECT_TRUE(detectHarrisCorners(cv::Mat(100, 100, CV_32F, cv::Scalar(0.5)), hp).empty());
+}
+
+}  // namespace
+}  // namespace facet

@@ -1,0 +1,105 @@
+// `facet register` end to end: generated images written to disk, the real binary, its JSON.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include "tests/registration/textured_scene.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exitCode = -1;
+  std::string out, err;
+};
+
+CliRun facet(const std::string& args) {
+  const fs::path errFile =
+      fs::temp_directory_path() / ("facet_register_cli_err_" + std::to_string(::getpid()) + ".txt");
+  const std::string cmd = std::string(FACET_CLI) + " " + args + " 2>" + errFile.string();
+  CliRun r;
+  FILE* pipe = ::popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  char buf[4096];
+  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.out.append(buf, n);
+  const int status = ::pclose(pipe);
+  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(errFile);
+  r.err.assign(std::istreambuf_iterator<char>(in), {});
+  fs::remove(errFile);
+  return r;
+}
+
+class RegisterCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("facet_register_cli_" + std::to_string(::getpid()));
+    fs::create_directories(dir_);
+    const cv::Mat ref = facet::testing::texturedScene({280, 260}, 41);
+    truth_ = facet::testing::similarity(-50.0, 0.8, {139.5, 129.5}, {150, 140});
+    ref_ = (dir_ / "ref.png").string();
+    image_ = (dir_ / "image.png").string();
+    blank_ = (dir_ / "blank.png").string();
+    cv::imwrite(ref_, ref);
+    cv::imwrite(image_, facet::testing::warp(ref, truth_, {300, 280}));
+    cv::imwrite(blank_, cv::Mat(100, 100, CV_8U, cv::Scalar(90)));
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  fs::path dir_;
+  std::string ref_, image_, blank_;
+  cv::Matx33d truth_;
+};
+
+TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairs) {
+  const CliRun r =
+      facet("register --ref " + ref_ + " --image " + image_ + " --model similarity --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  ASSERT_EQ(j.at("H").size(), 9u);
+  cv::Matx33d H;
+  for (int k = 0; k < 9; ++k) H(k / 3, k % 3) = j.at("H")[k].get<double>();
+  for (const cv::Point2d p : {cv::Point2d(0, 0), cv::Point2d(279, 259)}) {
+    const cv::Vec3d a = H * cv::Vec3d(p.x, p.y, 1), b = truth_ * cv::Vec3d(p.x, p.y, 1);
+    EXPECT_LT(std::hypot(a[0] / a[2] - b[0] / b[2], a[1] / a[2] - b[1] / b[2]), 1.0);
+  }
+  EXPECT_GE(j.at("matches").get<int>(), j.at("inliers").get<int>());
+  EXPECT_EQ(j.at("pairs").size(), j.at("inliers").get<std::size_t>());
+  ASSERT_GT(j.at("pairs").size(), 10u);
+  for (const auto& pair : j.at("pairs")) {
+    ASSERT_EQ(pair.size(), 4u);
+    const cv::Vec3d t = truth_ * cv::Vec3d(pair[0].get<double>(), pair[1].get<double>(), 1);
+    EXPECT_LT(std::hypot(t[0] - pair[2].get<double>(), t[1] - pair[3].get<double>()), 3.0);
+  }
+  EXPECT_GT(j.at("time_ms").get<double>(), 0.0);
+}
+
+TEST_F(RegisterCli, BlankImageIsAMeasurementFailureWithItsCause) {
+  const CliRun r = facet("register --ref " + ref_ + " --image " + blank_ + " --json");
+  EXPECT_EQ(r.exitCode, 2);
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("error").at("cause"), "blank_image");
+  EXPECT_NE(j.at("error").at("message").get<std::string>().find("blank.png"), std::string::npos);
+}
+
+TEST_F(RegisterCli, BadInputNamesTheFileOrTheOption) {
+  const CliRun missing =
+      facet("register --ref " + (dir_ / "nope.png").string() + " --image " + image_ + " --json");
+  EXPECT_EQ(missing.exitCode, 1);
+  EXPECT_NE(missing.err.find("nope.png"), std::string::npos) << missing.err;
+  const CliRun model = facet("register --ref " + ref_ + " --image " + image_ + " --model rigid");
+  EXPECT_EQ(model.exitCode, 1);
+  EXPECT_NE(model.err.find("--model"), std::string::npos) << model.err;
+}
+
+}  // namespace

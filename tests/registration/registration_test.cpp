@@ -1,0 +1,172 @@
+// registerImages and its parts on synthetic scenes with exact ground truth.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "algorithms/registration/fiducials.hpp"
+#include "algorithms/registration/register_images.hpp"
+#include "algorithms/registration/transform_fit.hpp"
+#include "tests/registration/textured_scene.hpp"
+
+namespace facet {
+namespace {
+
+using testing::similarity;
+using testing::texturedScene;
+using testing::warp;
+
+double cornerError(const cv::Matx33d& est, const cv::Matx33d& truth, cv::Size size) {
+  const cv::Point2d corners[4] = {
+      {0, 0}, {size.width - 1.0, 0}, {size.width - 1.0, size.height - 1.0}, {0, size.height - 1.0}};
+  double sum = 0;
+  for (const auto& c : corners) {
+    const cv::Point2d a = mapPoint(est, c), b = mapPoint(truth, c);
+    sum += std::hypot(a.x - b.x, a.y - b.y);
+  }
+  return sum / 4;
+}
+
+TEST(RegisterImages, RecoversAKnownSimilarity) {
+  const cv::Mat ref = texturedScene({300, 300}, 11);
+  const cv::Matx33d truth = similarity(37.0, 1.3, {149.5, 149.5}, {170, 160});
+  const cv::Mat image = warp(ref, truth, {340, 320});
+  RegistrationParams p;
+  p.model = TransformModel::Similarity;
+  const RegistrationResult r = registerImages(ref, image, p);
+  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  EXPECT_LT(cornerError(r.H, truth, ref.size()), 0.5);
+  EXPECT_GE(r.inliers.size(), 30u);
+  // The similarity's angle and scale, read back from H in the Pose2D convention.
+  EXPECT_NEAR(std::atan2(r.H(0, 1), r.H(0, 0)) * 180 / CV_PI, 37.0, 0.1);
+  EXPECT_NEAR(std::hypot(r.H(0, 0), r.H(0, 1)), 1.3, 0.003);
+  // Every reported pair agrees with the truth.
+  for (const cv::Vec4d& q : r.pairs()) {
+    const cv::Point2d t = mapPoint(truth, {q[0], q[1]});
+    EXPECT_LT(std::hypot(t.x - q[2], t.y - q[3]), 3.0);
+  }
+}
+
+TEST(RegisterImages, RecoversAHomographyUnderStrongRotationAndScale) {
+  const cv::Mat ref = texturedScene({320, 320}, 5);
+  const cv::Matx33d truth = cv::Matx33d(1, 0.05, 0, -0.03, 1, 0, 2e-4, 1e-4, 1) *
+                            similarity(-120.0, 0.7, {159.5, 159.5}, {150, 150});
+  const cv::Mat image = warp(ref, truth, {300, 300});
+  const RegistrationResult r = registerImages(ref, image, {});
+  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  EXPECT_LT(cornerError(r.H, truth, ref.size()), 1.5);
+}
+
+TEST(RegisterImages, IdenticalImagesGiveTheIdentity) {
+  const cv::Mat ref = texturedScene({256, 240}, 3);
+  const RegistrationResult r = registerImages(ref, ref, {});
+  ASSERT_TRUE(r.ok) << r.message;
+  EXPECT_LT(cornerError(r.H, cv::Matx33d::eye(), ref.size()), 0.05);
+  for (const FeatureMatch& m : r.matches) {
+    EXPECT_NEAR(m.rotationDeg, 0.0, 12.0);
+    EXPECT_NEAR(m.scale, 1.0, 0.25);
+  }
+}
+
+TEST(RegisterImages, BlankImageIsAClearFailure) {
+  const cv::Mat ref = texturedScene({200, 200}, 4);
+  const cv::Mat blank(200, 200, CV_8U, cv::Scalar(128));
+  const RegistrationResult r = registerImages(ref, blank, {});
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.failureCause, "blank_image");
+  EXPECT_NE(r.message.find("image"), std::string::npos);
+  const RegistrationResult r2 = registerImages(blank, ref, {});
+  EXPECT_EQ(r2.failureCause, "blank_image");
+  EXPECT_NE(r2.message.find("reference"), std::string::npos);
+  EXPECT_EQ(registerImages(cv::Mat(), ref, {}).failureCause, "empty_image");
+}
+
+TEST(RegisterImages, FewerThanFourCornersIsAClearFailure) {
+  // A ramp crossed by one straight edge: gradients everywhere, corners nowhere.
+  cv::Mat ramp(200, 200, CV_8U);
+  for (int y = 0; y < ramp.rows; ++y)
+    for (int x = 0; x < ramp.cols; ++x)
+      ramp.at<uchar>(y, x) = static_cast<uchar>(40 + x / 2 + (y > 100 ? 60 : 0));
+  const cv::Mat ref = texturedScene({200, 200}, 8);
+  const RegistrationResult r = registerImages(ref, ramp, {});
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.failureCause, "too_few_corners") << r.message;
+  EXPECT_LT(r.imageCorners, 4);
+}
+
+TEST(RegisterImages, UnrelatedImagesFailInsteadOfInventingATransform) {
+  // Default parameters: a weak global fit must be confirmed by the re-matching, which finds
+  // nothing between two different scenes.
+  for (std::uint64_t seed : {21, 23, 25}) {
+    const cv::Mat a = texturedScene({240, 240}, seed), b = texturedScene({240, 240}, seed + 1);
+    const RegistrationResult r = registerImages(a, b, {});
+    EXPECT_FALSE(r.ok) << seed;
+    EXPECT_TRUE(r.failureCause == "too_few_matches" || r.failureCause == "too_few_inliers")
+        << r.failureCause;
+  }
+}
+
+TEST(RegisterImages, HarrisAffineRegionsHandleAStrongTilt) {
+  const cv::Mat ref = texturedScene({320, 320}, 9);
+  // Foreshortening by 2 along a 30 degree axis plus a perspective term.
+  const double c = std::cos(CV_PI / 6), s = std::sin(CV_PI / 6);
+  const cv::Matx22d R(c, -s, s, c), D(1.0, 0, 0, 0.5);
+  const cv::Matx22d A = R * D * R.t();
+  const cv::Matx33d truth(A(0, 0), A(0, 1), 60, A(1, 0), A(1, 1), 80, 1e-4, 0, 1);
+  const cv::Mat image = warp(ref, truth, {360, 340});
+  RegistrationParams p;
+  p.affineRegions = true;
+  const RegistrationResult r = registerImages(ref, image, p);
+  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  EXPECT_LT(cornerError(r.H, truth, ref.size()), 2.0);
+}
+
+TEST(TransformFit, RobustHomographyIgnoresOutliers) {
+  const cv::Matx33d truth(0.9, 0.2, 30, -0.1, 1.1, -20, 1e-4, -2e-4, 1);
+  cv::RNG rng(1);
+  std::vector<cv::Point2d> src, dst;
+  for (int i = 0; i < 200; ++i) {
+    const cv::Point2d p(rng.uniform(0.0, 500.0), rng.uniform(0.0, 400.0));
+    src.push_back(p);
+    cv::Point2d q = mapPoint(truth, p);
+    if (i % 3 == 0)
+      q += cv::Point2d(rng.uniform(-80.0, 80.0), rng.uniform(-80.0, 80.0));
+    else
+      q += cv::Point2d(rng.gaussian(0.3), rng.gaussian(0.3));
+    dst.push_back(q);
+  }
+  TransformFitParams fp;
+  const auto fit = fitTransformRobust(src, dst, fp);
+  ASSERT_TRUE(fit.has_value());
+  EXPECT_GE(fit->inliers.size(), 130u);
+  EXPECT_LE(fit->inliers.size(), 140u);
+  for (const cv::Point2d p : {cv::Point2d(0, 0), cv::Point2d(500, 400), cv::Point2d(250, 100)}) {
+    const cv::Point2d a = mapPoint(fit->H, p), b = mapPoint(truth, p);
+    EXPECT_LT(std::hypot(a.x - b.x, a.y - b.y), 0.3);
+  }
+  TransformModel m;
+  EXPECT_TRUE(parseTransformModel("affine", m));
+  EXPECT_EQ(m, TransformModel::Affine);
+  EXPECT_FALSE(parseTransformModel("projective", m));
+}
+
+TEST(Fiducials, TwoMarksGivePositionsAndRotation) {
+  const cv::Mat ref = texturedScene({300, 300}, 13);
+  const std::vector<cv::Point2d> marks = {{60, 70}, {240, 220}};
+  const cv::Matx33d truth = similarity(25.0, 1.0, {149.5, 149.5}, {160, 150});
+  const cv::Mat image = warp(ref, truth, {320, 300});
+  RegistrationParams p;
+  p.model = TransformModel::Similarity;
+  const FiducialResult f = locateFiducials(ref, marks, image, p);
+  ASSERT_TRUE(f.ok) << f.failureCause << ": " << f.message;
+  ASSERT_EQ(f.marks.size(), 2u);
+  for (std::size_t i = 0; i < marks.size(); ++i) {
+    const cv::Point2d t = mapPoint(truth, marks[i]);
+    EXPECT_LT(std::hypot(t.x - f.marks[i].x, t.y - f.marks[i].y), 0.5);
+  }
+  EXPECT_NEAR(f.rotationDeg, 25.0, 0.2);
+  EXPECT_NEAR(f.scale, 1.0, 0.005);
+  EXPECT_EQ(locateFiducials(ref, {{10, 10}}, image, p).failureCause, "too_few_fiducials");
+}
+
+}  // namespace
+}  // namespace facet
