@@ -46,8 +46,11 @@ if [ "$run_asan" = 1 ]; then
   cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Asan -DFACET_WERROR=ON \
     -DFACET_BUILD_BENCH=OFF >/dev/null
   cmake --build "$build" -j2
-  # Leak checks stay on; halt on the first report so that CTest sees a failure.
-  ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:strict_string_checks=1} \
+  # Leak checks stay on (third-party leaks suppressed, see the file); halt on the first report
+  # so that CTest sees a failure.
+  # Full allocation stacks (slower) so that the suppressions match through libstdc++ frames.
+  ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:fast_unwind_on_malloc=0} \
+  LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$PWD/tests/sanitizers/lsan.supp} \
   UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1} \
     ctest --test-dir "$build" --output-on-failure -j2 --timeout 900 -L "$asan_labels"
   phase_done asan "$start"
