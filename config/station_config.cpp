@@ -1,6 +1,7 @@
 #include "config/station_config.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <sstream>
 
 #include "config/station_format.hpp"
@@ -93,6 +94,14 @@ class StationReader {
   static double number(const YAML::Node& n, double fallback) {
     return n ? readNumber(n).value_or(fallback) : fallback;
   }
+  // A sensor region's x, y, width or height: whole pixels, 0..2^20 (found by the station fuzz
+  // target: a huge number was converted to int, which is undefined behaviour).
+  int regionValue(const YAML::Node& n) {
+    const double v = number(n, 0.0);
+    if (v >= 0.0 && v <= double(1 << 20) && v == std::floor(v)) return static_cast<int>(v);
+    error(n, "region values must be whole pixels from 0 to 1048576, not " + describe(n));
+    return 0;
+  }
   static bool boolean(const YAML::Node& n, bool fallback) {
     return n ? readBoolean(n).value_or(fallback) : fallback;
   }
@@ -142,8 +151,7 @@ class StationReader {
       if (a["exposure_us"]) v.exposure_us = number(a["exposure_us"], 0);
       if (a["gain_db"]) v.gain_db = number(a["gain_db"], 0);
       if (const YAML::Node r = a["region"]; r && r.IsSequence() && r.size() == 4) {
-        v.region = {static_cast<int>(number(r[0], 0)), static_cast<int>(number(r[1], 0)),
-                    static_cast<int>(number(r[2], 0)), static_cast<int>(number(r[3], 0))};
+        v.region = {regionValue(r[0]), regionValue(r[1]), regionValue(r[2]), regionValue(r[3])};
       }
       v.packet_size = static_cast<int>(integer(a["packet_size"], v.packet_size));
       if (a["frame_rate_hz"]) v.frame_rate_hz = number(a["frame_rate_hz"], 0);

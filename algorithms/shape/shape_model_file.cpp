@@ -112,6 +112,9 @@ std::string implausibility(const ShapeModel& m) {
   if (!(m.angleExtent >= 0.0 && m.angleExtent <= kTwoPi + 1e-6)) return "angle extent";
   if (!(m.scaleMin > 0.0) || !(m.scaleMax >= m.scaleMin) || m.scaleMax > kMaxScale)
     return "scale range";
+  if (std::abs(m.referencePoint.x) > 2.0 * kMaxTemplateSide ||
+      std::abs(m.referencePoint.y) > 2.0 * kMaxTemplateSide)
+    return "reference point";
   const double extent = m.templateSize.width + m.templateSize.height +
                         std::abs(m.referencePoint.x) + std::abs(m.referencePoint.y);
   for (const auto& level : m.levels) {
