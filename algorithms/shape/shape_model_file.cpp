@@ -110,6 +110,7 @@ std::string implausibility(const ShapeModel& m) {
                    m.scaleMax, m.minContrast, m.contrastLow, m.contrastHigh})
     if (!std::isfinite(v)) return "a value is not a finite number";
   if (!(m.angleExtent >= 0.0 && m.angleExtent <= kTwoPi + 1e-6)) return "angle extent";
+  if (std::abs(m.angleStart) > 2.0 * kTwoPi) return "angle start";
   if (!(m.scaleMin > 0.0) || !(m.scaleMax >= m.scaleMin) || m.scaleMax > kMaxScale)
     return "scale range";
   if (std::abs(m.referencePoint.x) > 2.0 * kMaxTemplateSide ||

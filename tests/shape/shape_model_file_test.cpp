@@ -182,6 +182,7 @@ TEST_F(ShapeModelFile, UnusableValuesBehindAValidChecksumAreRefused) {
   refusal("point_off_template", [](ShapeModel& m) { m.levels.back().points[0].position.x = 9e4f; });
   refusal("huge_scale", [](ShapeModel& m) { m.scaleMax = 1e6; });
   refusal("far_reference", [](ShapeModel& m) { m.referencePoint.x = 1e9; });
+  refusal("angle_start", [](ShapeModel& m) { m.angleStart = 1e43; });
   // The trained model itself is fine.
   saveShapeModel(trained, dir_ / "trained.model");
   EXPECT_NO_THROW(loadShapeModel(dir_ / "trained.model"));
