@@ -119,9 +119,10 @@ std::string implausibility(const ShapeModel& m) {
   const double extent = m.templateSize.width + m.templateSize.height +
                         std::abs(m.referencePoint.x) + std::abs(m.referencePoint.y);
   for (const auto& level : m.levels) {
-    if (!(level.angleStep > 0.0) || !(kTwoPi / level.angleStep <= kMaxSearchSamples))
+    if (!(level.angleStep > 0.0) || !(kTwoPi / level.angleStep <= kMaxSearchSamples) ||
+        level.angleStep > kTwoPi)
       return "angle step";
-    if (!(level.scaleStep >= 0.0) || !std::isfinite(level.scaleStep) ||
+    if (!(level.scaleStep >= 0.0) || !(level.scaleStep <= kMaxScale) ||
         (level.scaleStep > 0.0 && (m.scaleMax - m.scaleMin) / level.scaleStep > kMaxSearchSamples))
       return "scale step";
     if (!finitePoints(level.points, extent)) return "point coordinates";

@@ -183,6 +183,7 @@ TEST_F(ShapeModelFile, UnusableValuesBehindAValidChecksumAreRefused) {
   refusal("huge_scale", [](ShapeModel& m) { m.scaleMax = 1e6; });
   refusal("far_reference", [](ShapeModel& m) { m.referencePoint.x = 1e9; });
   refusal("angle_start", [](ShapeModel& m) { m.angleStart = 1e43; });
+  refusal("huge_angle_step", [](ShapeModel& m) { m.levels.front().angleStep = 2.7e154; });
   // The trained model itself is fine.
   saveShapeModel(trained, dir_ / "trained.model");
   EXPECT_NO_THROW(loadShapeModel(dir_ / "trained.model"));
