@@ -1,5 +1,7 @@
 #include "config/confined_path.hpp"
 
+#include <iterator>
+#include <optional>
 #include <system_error>
 
 namespace facet::config {
@@ -23,6 +25,35 @@ std::filesystem::path normalisedRoot(const std::filesystem::path& root) {
   return r.has_filename() ? r : r.parent_path();
 }
 
+// The first place `path` reaches outside `root` through a symbolic link below `root`, whether or
+// not the link's target exists: weakly_canonical() stops at a dangling link, yet writing a model
+// file through one would create the file wherever it points. Links are followed by hand, the
+// target taking the link's place in the path, at most kMaxLinks times (a loop counts as outside).
+std::optional<std::filesystem::path> linkEscape(const std::filesystem::path& path,
+                                                const std::filesystem::path& root) {
+  constexpr int kMaxLinks = 40;
+  std::filesystem::path current = path;
+  for (int followed = 0; followed <= kMaxLinks; ++followed) {
+    std::filesystem::path prefix;
+    bool relinked = false;
+    for (auto part = current.begin(); part != current.end() && !relinked; ++part) {
+      prefix /= *part;
+      std::error_code ec;
+      if (!isInside(prefix, root) || !std::filesystem::is_symlink(prefix, ec)) continue;
+      const std::filesystem::path target = std::filesystem::read_symlink(prefix, ec);
+      if (ec) return prefix;
+      std::filesystem::path next = prefix.parent_path() / target;  // absolute targets replace
+      for (auto rest = std::next(part); rest != current.end(); ++rest) next /= *rest;
+      next = next.lexically_normal();
+      if (!isInside(next, root)) return next;
+      current = next;
+      relinked = true;
+    }
+    if (!relinked) return std::nullopt;
+  }
+  return current;
+}
+
 }  // namespace
 
 std::variant<std::filesystem::path, std::string> confinedPath(const std::string& written,
@@ -41,6 +72,9 @@ std::variant<std::filesystem::path, std::string> confinedPath(const std::string&
   if (!ec && !isInside(real, rootPath))
     return "leaves the recipes folder " + rootPath.string() + " through a symbolic link (to " +
            real.string() + ")";
+  if (const auto escape = linkEscape(lexical, rootPath))
+    return "leaves the recipes folder " + rootPath.string() + " through a symbolic link (to " +
+           escape->string() + ")";
   return lexical;
 }
 

@@ -19,6 +19,13 @@
 namespace facet::config {
 namespace {
 
+// Non-throwing file checks: a name too long for the file system, a loop of links or a folder
+// we may not read mean "not there", reported as such, never an exception out of the loader.
+bool isFile(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(p, ec);
+}
+
 std::string inQuotes(const std::string& s) {
   return "'" + s + "'";
 }
@@ -226,7 +233,7 @@ class RecipeReader {
       recipe_.dependencies.push_back(trainingRecordPath(path));
       return path;  // checked against its training record by checkModel
     }
-    if (!std::filesystem::is_regular_file(path)) {
+    if (!isFile(path)) {
       error(n, inQuotes(key) + " file " + inQuotes(n.Scalar()) + " does not exist (looked for " +
                    path.string() + ")");
       return std::nullopt;

@@ -1,6 +1,7 @@
 #include "config/station_config.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <sstream>
 
 #include "config/station_format.hpp"
@@ -10,6 +11,18 @@
 
 namespace facet::config {
 namespace {
+
+// Non-throwing file checks: a name too long for the file system, a loop of links or a folder
+// we may not read mean "not there", reported as such, never an exception out of the loader.
+bool isFile(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(p, ec);
+}
+
+bool isFolder(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_directory(p, ec);
+}
 
 // Reads "<digits>" at `text[pos]`, moving `pos` past it.
 std::optional<int> digitsAt(const std::string& text, std::size_t& pos) {
@@ -81,6 +94,14 @@ class StationReader {
   static double number(const YAML::Node& n, double fallback) {
     return n ? readNumber(n).value_or(fallback) : fallback;
   }
+  // A sensor region's x, y, width or height: whole pixels, 0..2^20 (found by the station fuzz
+  // target: a huge number was converted to int, which is undefined behaviour).
+  int regionValue(const YAML::Node& n) {
+    const double v = number(n, 0.0);
+    if (v >= 0.0 && v <= double(1 << 20) && v == std::floor(v)) return static_cast<int>(v);
+    error(n, "region values must be whole pixels from 0 to 1048576, not " + describe(n));
+    return 0;
+  }
   static bool boolean(const YAML::Node& n, bool fallback) {
     return n ? readBoolean(n).value_or(fallback) : fallback;
   }
@@ -97,7 +118,7 @@ class StationReader {
   }
   std::optional<std::filesystem::path> folderPath(const YAML::Node& n, const std::string& key) {
     const auto p = pathOf(n);
-    if (p && !std::filesystem::is_directory(*p)) {
+    if (p && !isFolder(*p)) {
       error(n, "'" + key + "' folder '" + n.Scalar() + "' does not exist (looked for " +
                    p->string() + ")");
       return std::nullopt;
@@ -130,8 +151,7 @@ class StationReader {
       if (a["exposure_us"]) v.exposure_us = number(a["exposure_us"], 0);
       if (a["gain_db"]) v.gain_db = number(a["gain_db"], 0);
       if (const YAML::Node r = a["region"]; r && r.IsSequence() && r.size() == 4) {
-        v.region = {static_cast<int>(number(r[0], 0)), static_cast<int>(number(r[1], 0)),
-                    static_cast<int>(number(r[2], 0)), static_cast<int>(number(r[3], 0))};
+        v.region = {regionValue(r[0]), regionValue(r[1]), regionValue(r[2]), regionValue(r[3])};
       }
       v.packet_size = static_cast<int>(integer(a["packet_size"], v.packet_size));
       if (a["frame_rate_hz"]) v.frame_rate_hz = number(a["frame_rate_hz"], 0);
@@ -220,7 +240,7 @@ class StationReader {
     const auto db = pathOf(r["database"]);
     if (!db) return;
     station_.results.database = *db;
-    if (!std::filesystem::is_directory(db->parent_path()))
+    if (!isFolder(db->parent_path()))
       error(r["database"],
             "the folder of 'database' (" + db->parent_path().string() + ") does not exist");
   }
@@ -233,7 +253,7 @@ class StationReader {
     s.keep = keep == "all"    ? ArchiveSettings::Keep::All
              : keep == "none" ? ArchiveSettings::Keep::None
                               : ArchiveSettings::Keep::Failed;
-    if (!s.folder.empty() && !std::filesystem::is_directory(s.folder.parent_path()))
+    if (!s.folder.empty() && !isFolder(s.folder.parent_path()))
       error(a["folder"], "the folder containing 'folder' (" + s.folder.parent_path().string() +
                              ") does not exist");
   }
@@ -244,7 +264,7 @@ class StationReader {
     if (c["file"]) {
       const auto p = pathOf(c["file"]);
       if (!p) return;
-      if (!std::filesystem::is_regular_file(*p)) {
+      if (!isFile(*p)) {
         error(c["file"], "calibration file '" + c["file"].Scalar() + "' does not exist");
         return;
       }

@@ -13,6 +13,13 @@
 namespace facet::config {
 namespace {
 
+// Non-throwing file checks: a name too long for the file system, a loop of links or a folder
+// we may not read mean "not there", reported as such, never an exception out of the loader.
+bool isFile(const std::filesystem::path& p) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(p, ec);
+}
+
 std::string rectText(const std::optional<cv::Rect2d>& r) {
   if (!r) return "all";
   return formatNumber(r->x) + "," + formatNumber(r->y) + "," + formatNumber(r->width) + "," +
@@ -39,7 +46,7 @@ std::string trainingParameters(const Step& step) {
 
 ModelStatus modelStatus(const std::filesystem::path& model, const std::filesystem::path& source,
                         const std::string& parameters) {
-  if (!std::filesystem::is_regular_file(model)) return {ModelState::Missing, "does not exist"};
+  if (!isFile(model)) return {ModelState::Missing, "does not exist"};
   std::ifstream in(trainingRecordPath(model));
   nlohmann::json record;
   try {

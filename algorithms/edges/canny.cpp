@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <stdexcept>
 #include <vector>
 
@@ -41,7 +42,9 @@ void magnitudeOf(const cv::Mat& gx, const cv::Mat& gy, float scale, cv::Mat& mag
 template <typename T>
 void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask, cv::Rect area,
               int gradientRow0, cv::Mat& state, std::vector<cv::Point>& strong) {
-  const size_t step = g.magnitude.step1();
+  // Signed: m[x - step] with an unsigned step wraps around before the pointer addition, which is
+  // undefined behaviour (UBSan's pointer-overflow check) even though it lands on the row above.
+  const auto step = static_cast<std::ptrdiff_t>(g.magnitude.step1());
   for (int y = area.y; y < area.y + area.height; ++y) {
     const int gy0 = y - gradientRow0;  // the gradient maps may cover a strip only
     const float* m = g.magnitude.ptr<float>(gy0);

@@ -1,9 +1,12 @@
 #include "algorithms/shape/shape_model_file.hpp"
 
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -14,6 +17,9 @@ constexpr std::array<char, 8> kMagic = {'F', 'A', 'C', 'E', 'T', 'S', 'H', 'M'};
 constexpr std::size_t kHeaderSize = kMagic.size() + sizeof(std::uint32_t) + sizeof(std::uint64_t);
 constexpr std::uint32_t kMaxPoints = 10'000'000;  // far above any real model: guards bad counts
 constexpr std::uint32_t kMaxLevels = 16;
+constexpr int kMaxTemplateSide = 1 << 14;  // pixels
+constexpr double kMaxScale = 10.0;         // the search's border grows with radius * scale
+constexpr double kMaxSearchSamples = 1e6;  // angle or scale steps per search range
 
 std::uint64_t fnv1a(const char* data, std::size_t size) {
   std::uint64_t h = 14695981039346656037ull;
@@ -77,6 +83,53 @@ class Reader {
   std::size_t offset_ = 0;
   std::string file_;
 };
+
+bool finitePoint(const cv::Point2f& p, double limit) {
+  return std::isfinite(p.x) && std::isfinite(p.y) && std::abs(p.x) <= limit &&
+         std::abs(p.y) <= limit;
+}
+
+// Model points lie on the template, relative to the reference point: farther out than the
+// template's size from it is not a trained model.
+bool finitePoints(const std::vector<ShapePoint>& points, double extent) {
+  return std::all_of(points.begin(), points.end(), [extent](const ShapePoint& p) {
+    return finitePoint(p.position, extent) && finitePoint(p.direction, 2.0);
+  });
+}
+
+// A file can pass its checksum and still hold values no search can use (crafted by hand, or
+// damaged before the checksum was written): NaN poses, zero or tiny search steps that make
+// findShapeModel loop (nearly) for ever or allocate without bound, points that overflow pixel
+// indices. Why a model is refused, or "" when it is usable.
+std::string implausibility(const ShapeModel& m) {
+  constexpr double kTwoPi = 2.0 * std::numbers::pi;
+  if (m.templateSize.width <= 0 || m.templateSize.height <= 0 ||
+      m.templateSize.width > kMaxTemplateSide || m.templateSize.height > kMaxTemplateSide)
+    return "template size";
+  for (double v : {m.referencePoint.x, m.referencePoint.y, m.angleStart, m.angleExtent, m.scaleMin,
+                   m.scaleMax, m.minContrast, m.contrastLow, m.contrastHigh})
+    if (!std::isfinite(v)) return "a value is not a finite number";
+  if (!(m.angleExtent >= 0.0 && m.angleExtent <= kTwoPi + 1e-6)) return "angle extent";
+  if (std::abs(m.angleStart) > 2.0 * kTwoPi) return "angle start";
+  if (!(m.scaleMin > 0.0) || !(m.scaleMax >= m.scaleMin) || m.scaleMax > kMaxScale)
+    return "scale range";
+  if (std::abs(m.referencePoint.x) > 2.0 * kMaxTemplateSide ||
+      std::abs(m.referencePoint.y) > 2.0 * kMaxTemplateSide)
+    return "reference point";
+  const double extent = m.templateSize.width + m.templateSize.height +
+                        std::abs(m.referencePoint.x) + std::abs(m.referencePoint.y);
+  for (const auto& level : m.levels) {
+    if (!(level.angleStep > 0.0) || !(kTwoPi / level.angleStep <= kMaxSearchSamples) ||
+        level.angleStep > kTwoPi)
+      return "angle step";
+    if (!(level.scaleStep >= 0.0) || !(level.scaleStep <= kMaxScale) ||
+        (level.scaleStep > 0.0 && (m.scaleMax - m.scaleMin) / level.scaleStep > kMaxSearchSamples))
+      return "scale step";
+    if (!finitePoints(level.points, extent)) return "point coordinates";
+  }
+  if (!finitePoints(m.finePoints, extent)) return "point coordinates";
+  return "";
+}
 
 }  // namespace
 
@@ -160,9 +213,10 @@ ShapeModel loadShapeModel(const std::filesystem::path& path) {
   }
   model.finePoints = r.getPoints();
   if (!r.atEnd()) r.fail("corrupt shape model file (unexpected data after the model)");
-  if (!(model.scaleMin > 0.0) || !(model.scaleMax >= model.scaleMin) ||
-      model.levels.front().points.empty() || model.finePoints.empty())
+  if (model.levels.front().points.empty() || model.finePoints.empty())
     r.fail("corrupt shape model file (invalid values)");
+  if (const std::string why = implausibility(model); !why.empty())
+    r.fail("corrupt shape model file (invalid values: " + why + ")");
   return model;
 }
 

@@ -2,6 +2,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -145,6 +146,47 @@ TEST_F(ShapeModelFile, BadFilesAreRefusedNamingTheFile) {
   EXPECT_THROW(saveShapeModel(ShapeModel{}, dir_ / "empty_model.model"), ShapeModelFileError);
   EXPECT_THROW(saveShapeModel(loadShapeModel(good), dir_ / "no_such_dir" / "x.model"),
                ShapeModelFileError);
+}
+
+// A file with a valid checksum can still hold values the search cannot use (hand-made, or
+// damaged before it was written). Found while writing the loader's fuzz target: a zero or tiny
+// angle step makes findShapeModel convert an infinite sample count to int (or allocate without
+// bound), NaN points reach pixel indices.
+TEST_F(ShapeModelFile, UnusableValuesBehindAValidChecksumAreRefused) {
+  const ShapeModel trained = createShapeModel(testing::bracketTemplate());
+  const auto refusal = [&](const char* name, auto&& spoil) {
+    ShapeModel m = trained;
+    spoil(m);
+    const fs::path file = dir_ / (std::string(name) + ".model");
+    saveShapeModel(m, file);
+    const std::string e = loadError(file);
+    EXPECT_NE(e.find(file.string()), std::string::npos) << e;
+    EXPECT_NE(e.find("invalid values"), std::string::npos) << name << ": " << e;
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  refusal("zero_angle_step", [](ShapeModel& m) { m.levels.back().angleStep = 0.0; });
+  refusal("tiny_angle_step", [](ShapeModel& m) { m.levels.front().angleStep = 1e-300; });
+  refusal("nan_angle_step", [&](ShapeModel& m) { m.levels.front().angleStep = nan; });
+  refusal("negative_scale_step", [](ShapeModel& m) { m.levels.front().scaleStep = -1.0; });
+  refusal("nan_reference", [&](ShapeModel& m) { m.referencePoint.x = nan; });
+  refusal("infinite_contrast",
+          [](ShapeModel& m) { m.minContrast = std::numeric_limits<double>::infinity(); });
+  refusal("angle_extent", [](ShapeModel& m) { m.angleExtent = 100.0; });
+  refusal("template_size", [](ShapeModel& m) { m.templateSize = {0, 10}; });
+  refusal("nan_point", [](ShapeModel& m) {
+    m.levels.front().points.front().position.x = std::numeric_limits<float>::quiet_NaN();
+  });
+  refusal("far_point", [](ShapeModel& m) { m.finePoints.back().position.y = 1e30f; });
+  // A point far off the template with a large scale made the search allocate 284 GB for its
+  // border (found by the fuzz target).
+  refusal("point_off_template", [](ShapeModel& m) { m.levels.back().points[0].position.x = 9e4f; });
+  refusal("huge_scale", [](ShapeModel& m) { m.scaleMax = 1e6; });
+  refusal("far_reference", [](ShapeModel& m) { m.referencePoint.x = 1e9; });
+  refusal("angle_start", [](ShapeModel& m) { m.angleStart = 1e43; });
+  refusal("huge_angle_step", [](ShapeModel& m) { m.levels.front().angleStep = 2.7e154; });
+  // The trained model itself is fine.
+  saveShapeModel(trained, dir_ / "trained.model");
+  EXPECT_NO_THROW(loadShapeModel(dir_ / "trained.model"));
 }
 
 }  // namespace
