@@ -43,7 +43,9 @@ if [ "$run_asan" = 1 ]; then
   start=$(date +%s)
   build=${FACET_ASAN_BUILD_DIR:-build/asan}
   # No benchmarks: they are not run under ASan, and building them would double the build time.
-  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Asan -DFACET_WERROR=ON \
+  # Warnings are enforced by the release phase; at -O1 with sanitizer instrumentation GCC 12
+  # reports false maybe-uninitialized warnings inside <regex> and <functional>, so no -Werror here.
+  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Asan -DFACET_WERROR=OFF \
     -DFACET_BUILD_BENCH=OFF >/dev/null
   cmake --build "$build" -j2
   # Leak checks stay on (third-party leaks suppressed, see the file); halt on the first report
