@@ -10,32 +10,16 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/support/cli/facet_cli.hpp"
 #include "tests/support/scene/scene.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct CliRun {
-  int exitCode = -1;
-  std::string out, err;
-};
-
+using facet::test::CliRun;
 CliRun facet(const std::string& args) {
-  const fs::path errFile =
-      fs::temp_directory_path() / ("facet_circle_cli_err_" + std::to_string(::getpid()) + ".txt");
-  const std::string cmd = std::string(FACET_CLI) + " " + args + " 2>" + errFile.string();
-  CliRun r;
-  FILE* pipe = ::popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  char buf[4096];
-  while (std::size_t n = std::fread(buf, 1, sizeof buf, pipe)) r.out.append(buf, n);
-  const int status = ::pclose(pipe);
-  r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream in(errFile);
-  r.err.assign(std::istreambuf_iterator<char>(in), {});
-  fs::remove(errFile);
-  return r;
+  return facet::test::runFacet(args);
 }
 
 class CircleCli : public ::testing::Test {

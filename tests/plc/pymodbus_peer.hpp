@@ -32,8 +32,9 @@ class PymodbusPlc {
       : configPath_(std::move(configPath)), port_(port), clientMode_(clientMode) {}
   ~PymodbusPlc();
 
-  // Starts the script and waits until it listens (or, in client mode, is connected). Throws std::runtime_error (with the script's
-  // message, e.g. "pymodbus is not installed") when it does not.
+  // Starts the script and waits until it listens (or, in client mode, is connected). Throws
+  // std::runtime_error (with the script's message, e.g. "pymodbus is not installed") when it does
+  // not.
   void start();
   // SIGKILL, as a PLC losing power: no goodbye on the connection.
   void kill();

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "tests/support/cli/facet_cli.hpp"
 #include "tests/support/scan_room/scan_room.hpp"
 
 namespace {
@@ -17,22 +18,9 @@ namespace fs = std::filesystem;
 using facet::scan::Scan;
 using facet::scan::ScanPose;
 
-struct CliRun {
-  int exitCode = -1;
-  std::string out;
-};
-
+using facet::test::CliRun;
 CliRun runCli(const std::string& args) {
-  const std::string command = std::string(FACET_CLI) + " " + args + " 2>/dev/null";
-  CliRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  char buffer[4096];
-  while (const std::size_t n = std::fread(buffer, 1, sizeof(buffer), pipe))
-    run.out.append(buffer, n);
-  const int status = pclose(pipe);
-  run.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return run;
+  return facet::test::runFacet(args);
 }
 
 class ScanMatchCli : public ::testing::Test {
