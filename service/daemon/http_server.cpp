@@ -26,6 +26,16 @@ std::size_t parseCount(const httplib::Request& req, const char* key, std::size_t
   }
 }
 
+// Compares in time that depends only on the lengths, so that response times do not reveal how
+// much of a guessed token was right.
+bool sameSecret(const std::string& given, const std::string& expected) {
+  unsigned char diff = given.size() == expected.size() ? 0 : 1;
+  for (std::size_t i = 0; i < given.size(); ++i)
+    diff |= static_cast<unsigned char>(given[i] ^
+                                       expected[i % std::max<std::size_t>(1, expected.size())]);
+  return diff == 0;
+}
+
 }  // namespace
 
 HttpServer::HttpServer(StationView& station, HttpSettings settings)
@@ -81,7 +91,7 @@ void HttpServer::routes() {
       sendJson(res, {{"error", "read-only station: no token configured"}}, 403);
       return false;
     }
-    if (req.get_header_value("Authorization") != "Bearer " + settings_.token) {
+    if (!sameSecret(req.get_header_value("Authorization"), "Bearer " + settings_.token)) {
       sendJson(res, {{"error", "missing or wrong token"}}, 401);
       return false;
     }
