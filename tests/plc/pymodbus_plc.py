@@ -16,7 +16,7 @@ plc.json (wire addresses, i.e. zero-based as sent on the wire):
      "auto_ack": true, "mode": "triggered"}   (mode "free_run": report each new counter)
 
 stdin commands, one per line: "trigger" (raise the trigger; cleared when busy or result valid
-rises, or after 0.5 s), "report <signal>" (emit {"event": "report", ...} with its value),
+rises, or after 5 s; 0.5 s when raised while busy), "untrigger" (clear it now), "report <signal>" (emit {"event": "report", ...} with its value),
 "set_register <address> <value>", "quit".
 stdout: one JSON object per line: {"event": "listening", "port": P}, then
 {"event": "result", ...} per result valid rising edge (decoded here with struct, independently
@@ -57,6 +57,7 @@ class Plc:
         self.slave = slave
         self.signals = config.get("signals", {})
         self.trigger_since = None
+        self.trigger_while_busy = False
         self.last = {}
 
     def flag(self, name):
@@ -127,12 +128,15 @@ class Plc:
                 self.last["counter"] = counter
                 emit(self.read_result())
             return
-        # The trigger is held until the daemon answers: busy rises, or (when the inspection was
-        # quicker than this scan) a result arrives; or 0.5 s pass.
+        # The trigger is held until the daemon answers, as a PLC program does: busy rises, or
+        # (when the inspection was quicker than this scan) a result arrives. A trigger raised
+        # while busy (a deliberate missed trigger) is a 0.5 s pulse; any other gives up after 5 s,
+        # long enough for a link starved of CPU on a loaded machine.
         busy_rising, _ = self.edge("busy")
         valid_rising, valid_falling = self.edge("result_valid")
+        hold = 0.5 if self.trigger_while_busy else 5.0
         if self.trigger_since is not None and (busy_rising or valid_rising or
-                                               time.monotonic() - self.trigger_since > 0.5):
+                                               time.monotonic() - self.trigger_since > hold):
             self.set_flag("trigger", False)
             self.trigger_since = None
         if valid_rising:
@@ -147,8 +151,12 @@ class Plc:
 
     def command(self, line):
         if line == "trigger":
+            self.trigger_while_busy = "busy" in self.signals and self.flag("busy")
             self.set_flag("trigger", True)
             self.trigger_since = time.monotonic()
+        elif line == "untrigger":
+            self.set_flag("trigger", False)
+            self.trigger_since = None
         elif line.startswith("report "):
             # "report <signal>": the current value of a mapped signal, as the PLC sees it
             name = line.split()[1]
