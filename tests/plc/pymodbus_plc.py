@@ -189,6 +189,28 @@ class ClientTables:
             raise RuntimeError(f"write {fc} {address}: {reply}")
 
 
+class StdinCommands:
+    """The test's commands, one per line on stdin, read on a thread of their own so that the scan
+    loop never blocks; end of input becomes "quit"."""
+
+    def __init__(self):
+        self.lines = []
+        self.lock = threading.Lock()
+        threading.Thread(target=self.read, daemon=True).start()
+
+    def read(self):
+        for line in sys.stdin:
+            with self.lock:
+                self.lines.append(line.strip())
+        with self.lock:
+            self.lines.append("quit")
+
+    def take(self):
+        with self.lock:
+            pending, self.lines = self.lines, []
+        return pending
+
+
 def run_client(config, port):
     client = ModbusTcpClient("127.0.0.1", port=port)
     if not client.connect():
@@ -196,21 +218,9 @@ def run_client(config, port):
         sys.exit(4)
     emit({"event": "connected", "port": port, "pymodbus": pymodbus.__version__})
     plc = Plc(config, ClientTables(client))
-    commands = []
-    lock = threading.Lock()
-
-    def read_stdin():
-        for line in sys.stdin:
-            with lock:
-                commands.append(line.strip())
-        with lock:
-            commands.append("quit")
-
-    threading.Thread(target=read_stdin, daemon=True).start()
+    commands = StdinCommands()
     while True:
-        with lock:
-            pending, commands[:] = list(commands), []
-        for line in pending:
+        for line in commands.take():
             if line == "quit":
                 client.close()
                 return
@@ -243,21 +253,9 @@ async def main():
     emit({"event": "listening", "port": args.port, "pymodbus": pymodbus.__version__})
 
     plc = Plc(config, slave)
-    commands = []
-    lock = threading.Lock()
-
-    def read_stdin():
-        for line in sys.stdin:
-            with lock:
-                commands.append(line.strip())
-        with lock:
-            commands.append("quit")
-
-    threading.Thread(target=read_stdin, daemon=True).start()
+    commands = StdinCommands()
     while True:
-        with lock:
-            pending, commands[:] = list(commands), []
-        for line in pending:
+        for line in commands.take():
             if line == "quit":
                 serving.cancel()
                 return
