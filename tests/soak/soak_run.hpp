@@ -1,0 +1,81 @@
+#pragma once
+// SoakRun: the real facetd replaying a recorded folder in a loop for many parts (free run, no
+// PLC, nothing dropped), sampled every period from the outside: resident memory, open file
+// descriptors and threads from /proc, parts done and the publish-stage histogram from /metrics.
+// After facetd exits, the results database gives every part's inspection time and verdict.
+//
+// The parts are split into equal windows (the table's rows). The first `warmupWindows` are the
+// warm-up (models loaded, archive and SQLite caches filling, allocator arenas growing); the
+// judgement compares the last window with the first one after the warm-up.
+
+#include <chrono>
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+namespace facet::soak {
+
+struct SoakOptions {
+  std::string facetd;  // path of the facetd binary
+  std::uint64_t parts = 2000;
+  int windows = 10;
+  int warmupWindows = 1;
+  std::chrono::milliseconds samplePeriod{500};
+  // The lightest demo recipe (fiducial board, id 3) and its recorded images.
+  int recipe = 3;
+  std::string replayFolder;  // looped; its sidecars give each part's expected verdict
+  std::string recipesFolder;
+  std::string calibrationFile;
+  // Where the station file, results database, archive and facetd's log go; empty: a temporary
+  // folder removed at the end.
+  std::string workDir;
+  double archiveQuotaMb = 50;  // failed parts' images are archived, the quota makes it evict
+  // Judgement bounds.
+  double maxRssGrowth = 0.05;  // last window's peak RSS vs the first after warm-up
+  int maxFdGrowth = 0;         // last window's fewest fds vs the first after warm-up
+  int maxThreadGrowth = 0;
+  double maxP99Ratio = 1.5;  // inspection p99, last window vs the first after warm-up; 0 = off
+  std::chrono::seconds timeout{3600};
+  bool progress = false;  // one line on stderr per window while running
+};
+
+struct SoakWindow {
+  std::uint64_t firstPart = 0, lastPart = 0;  // part ids, inclusive
+  double seconds = 0;                         // wall time the window took
+  int samples = 0;                            // /proc samples taken during the window
+  double rssMiB = 0;                          // the highest RSS sampled
+  int fds = 0;                                // the fewest open fds sampled
+  int maxFds = 0;                             // the most open fds sampled
+  int threads = 0;                            // the fewest threads sampled
+  double p50Ms = 0, p99Ms = 0;                // inspection time, exact (results database)
+  double publishP99Ms = 0;  // publish stage (PLC, store, archive): histogram bucket bound
+};
+
+struct SoakReport {
+  std::vector<SoakWindow> windows;
+  int exitCode = -1;  // facetd's
+  double seconds = 0;
+  std::uint64_t partsStored = 0;
+  std::uint64_t partsMissing = 0;  // ids 1..parts absent from the database
+  std::uint64_t errorParts = 0;    // stored with verdict "error"
+  std::uint64_t unexpected = 0;    // verdict differs from the sidecar's expected verdict
+  std::string integrity;           // PRAGMA integrity_check
+  double databaseMiB = 0;          // results database and its WAL on disk at the end
+  // Judgement (last window vs the first after warm-up).
+  double rssGrowth = 0;
+  int fdGrowth = 0;
+  int threadGrowth = 0;
+  double p99Ratio = 0;
+  std::vector<std::string> failures;  // one sentence per bound not met; empty = pass
+  [[nodiscard]] bool ok() const { return failures.empty(); }
+};
+
+// Runs the soak; throws std::runtime_error when facetd cannot be started or sampled at all.
+SoakReport runSoak(const SoakOptions& options);
+
+// The table (window, parts, seconds, RSS MiB, fds, threads, p50, p99, publish p99) and the
+// verdict, as the closing note quotes them.
+void printSoakReport(std::ostream& out, const SoakOptions& options, const SoakReport& report);
+
+}  // namespace facet::soak

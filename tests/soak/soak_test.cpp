@@ -1,0 +1,46 @@
+// The CI soak: 2,000 parts through the real facetd (looped replay of the fiducial-board demo,
+// free run, no PLC). Asserts that resident memory, open fds and threads do not grow after the
+// warm-up and that every part is stored with its recorded verdict. Latency is printed, not
+// asserted (timing is for benchmarks, and CI machines are shared); tests/soak/run-soak.sh runs
+// the 100,000-part soak, which judges the p99 too.
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+#include "tests/soak/soak_run.hpp"
+
+namespace facet::soak {
+namespace {
+
+TEST(Soak, TwoThousandPartsKeepMemoryFdsAndThreadsFlat) {
+  SoakOptions o;
+  o.facetd = FACETD_PATH;
+  o.replayFolder = FACET_SOURCE_DIR "/recipes/demo/fiducial_board";
+  o.recipesFolder = FACET_SOURCE_DIR "/recipes";
+  o.calibrationFile = FACET_SOURCE_DIR "/recipes/calibration.yaml";
+  o.parts = 2000;
+  o.windows = 8;
+  o.warmupWindows = 2;
+  o.samplePeriod = std::chrono::milliseconds(250);
+  o.maxP99Ratio = 0;  // printed, not judged here
+  o.timeout = std::chrono::seconds(150);
+  const SoakReport r = runSoak(o);
+  printSoakReport(std::cout, o, r);
+
+  EXPECT_EQ(r.exitCode, 0);
+  EXPECT_EQ(r.partsStored, o.parts);
+  EXPECT_EQ(r.partsMissing, 0u);
+  EXPECT_EQ(r.errorParts, 0u);
+  EXPECT_EQ(r.unexpected, 0u);
+  EXPECT_EQ(r.integrity, "ok");
+  ASSERT_EQ(r.windows.size(), static_cast<std::size_t>(o.windows));
+  for (std::size_t k = static_cast<std::size_t>(o.warmupWindows); k < r.windows.size(); ++k)
+    ASSERT_GT(r.windows[k].samples, 0) << "window " << k + 1 << " was not sampled";
+  EXPECT_LE(r.rssGrowth, 0.05);
+  EXPECT_LE(r.fdGrowth, 0);
+  EXPECT_LE(r.threadGrowth, 0);
+  EXPECT_TRUE(r.ok()) << r.failures.front();
+}
+
+}  // namespace
+}  // namespace facet::soak
