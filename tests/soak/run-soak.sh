@@ -13,9 +13,10 @@
 # thread growth, inspection p99 within 1.5x (the machine is shared: timings are noisy), every
 # part id stored with its recorded verdict, PRAGMA integrity_check ok. Exit 0 = all bounds hold.
 #
-# The results database is not trimmed (facetd has no retention setting yet): it grows by one
-# row per part (about 1 MiB per 1,000 parts) on disk, but SQLite's page cache is bounded
-# (cache_size default, 2 MiB per connection; no mmap), so it does not grow facetd's RSS.
+# The results database is not trimmed (ResultsStore has a RetentionPolicy, but the station file
+# has no setting for it and facetd never applies it): it grows by one row per part (about
+# 0.8 MiB per 1,000 parts of this recipe) on disk, but SQLite's page cache is bounded (default
+# cache_size, 2 MiB per connection; no mmap_size), so a growing file does not grow facetd's RSS.
 # Failed parts' images are archived with a 50 MB quota, so archive eviction runs all along.
 #
 # Usage: tests/soak/run-soak.sh [--build DIR] [facet_soak options; later ones win]
