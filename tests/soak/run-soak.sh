@@ -9,7 +9,8 @@
 # one row per window (N / --windows parts each):
 #   window, parts, seconds, peak RSS MiB, fewest fds (most), fewest threads, inspection p50/p99
 #   (exact, from the database), publish p99 (bucket bound of facet_stage_ms{stage="publish"})
-# and the verdict: last window vs the first after the warm-up, RSS growth <= 5 %, no fd or
+# and the verdict: last window vs the baseline (the --baseline-windows windows after the
+# warm-up: their highest RSS, fds and threads, the p99 over their parts), RSS growth <= 5 %, no fd or
 # thread growth, inspection p99 within 1.5x (the machine is shared: timings are noisy), every
 # part id stored with its recorded verdict, PRAGMA integrity_check ok. Exit 0 = all bounds hold.
 #
@@ -20,7 +21,8 @@
 # Failed parts' images are archived with a 50 MB quota, so archive eviction runs all along.
 #
 # Usage: tests/soak/run-soak.sh [--build DIR] [facet_soak options; later ones win]
-#   Defaults: --parts 100000 --windows 20 --warmup-windows 2 --sample-ms 2000 --timeout-s 7200
+#   Defaults: --parts 100000 --windows 20 --warmup-windows 2 --baseline-windows 2
+#   --sample-ms 2000 --timeout-s 7200
 #   --work-dir /tmp/facet-soak (station file, results.db, archive, facetd.log, soak.log).
 # The 2,000-part version is the CTest test soak_test (label integration).
 set -euo pipefail
@@ -40,7 +42,7 @@ mkdir -p "$work"
 
 cmake --build "$build" -j2 --target facetd facet_soak >/dev/null
 cmd=(nice -n 5 "$build/tests/soak/facet_soak" --parts 100000 --windows 20 --warmup-windows 2
-  --sample-ms 2000 --timeout-s 7200 --work-dir "$work" "$@")
+  --baseline-windows 2 --sample-ms 2000 --timeout-s 7200 --work-dir "$work" "$@")
 # HTTP is on 127.0.0.1 with an ephemeral port; a private network namespace keeps it to itself
 # when one can be made.
 if unshare -n true 2>/dev/null; then

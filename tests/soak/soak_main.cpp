@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
   app.add_option("--windows", o.windows, "Table rows (equal part counts)")->capture_default_str();
   app.add_option("--warmup-windows", o.warmupWindows, "Windows left out of the judgement")
       ->capture_default_str();
+  app.add_option("--baseline-windows", o.baselineWindows,
+                 "Windows after the warm-up the last one is compared with")
+      ->capture_default_str();
   app.add_option("--sample-ms", sampleMs, "Sampling period (ms)")->capture_default_str();
   app.add_option("--recipe", o.recipe, "Recipe id")->capture_default_str();
   app.add_option("--replay", o.replayFolder, "Recorded folder to loop")

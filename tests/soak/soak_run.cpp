@@ -202,8 +202,9 @@ void judge(const SoakOptions& o, SoakReport& r) {
          static_cast<unsigned long long>(r.unexpected));
   if (r.integrity != "ok") fail("integrity_check: %s", r.integrity.c_str());
   const auto base = static_cast<std::size_t>(o.warmupWindows);
-  if (r.windows.size() < base + 2) {
-    fail("only %zu windows reached: nothing to compare after the warm-up", r.windows.size());
+  const auto baseEnd = base + static_cast<std::size_t>(o.baselineWindows);
+  if (r.windows.size() < baseEnd + 1) {
+    fail("only %zu windows reached: nothing to compare with the baseline", r.windows.size());
     return;
   }
   for (std::size_t k = base; k < r.windows.size(); ++k)
@@ -211,29 +212,35 @@ void judge(const SoakOptions& o, SoakReport& r) {
       fail("window %zu has no /proc sample (sample more often)", k + 1);
       return;
     }
-  const SoakWindow& first = r.windows[base];
+  for (std::size_t k = base; k < baseEnd; ++k) {
+    r.baselineRssMiB = std::max(r.baselineRssMiB, r.windows[k].rssMiB);
+    r.baselineFds = std::max(r.baselineFds, r.windows[k].fds);
+    r.baselineThreads = std::max(r.baselineThreads, r.windows[k].threads);
+  }
   const SoakWindow& last = r.windows.back();
-  r.rssGrowth = last.rssMiB / first.rssMiB - 1.0;
-  r.fdGrowth = last.fds - first.fds;
-  r.threadGrowth = last.threads - first.threads;
-  r.p99Ratio = first.p99Ms > 0 ? last.p99Ms / first.p99Ms : 0;
+  r.rssGrowth = last.rssMiB / r.baselineRssMiB - 1.0;
+  r.fdGrowth = last.fds - r.baselineFds;
+  r.threadGrowth = last.threads - r.baselineThreads;
+  r.p99Ratio = r.baselineP99Ms > 0 ? last.p99Ms / r.baselineP99Ms : 0;
   if (r.rssGrowth > o.maxRssGrowth)
-    fail("RSS grew %.1f %% (%.1f -> %.1f MiB), bound %.1f %%", 100 * r.rssGrowth, first.rssMiB,
+    fail("RSS grew %.1f %% (%.1f -> %.1f MiB), bound %.1f %%", 100 * r.rssGrowth, r.baselineRssMiB,
          last.rssMiB, 100 * o.maxRssGrowth);
   if (r.fdGrowth > o.maxFdGrowth)
-    fail("open fds grew by %d (%d -> %d)", r.fdGrowth, first.fds, last.fds);
+    fail("open fds grew by %d (%d -> %d)", r.fdGrowth, r.baselineFds, last.fds);
   if (r.threadGrowth > o.maxThreadGrowth)
-    fail("threads grew by %d (%d -> %d)", r.threadGrowth, first.threads, last.threads);
+    fail("threads grew by %d (%d -> %d)", r.threadGrowth, r.baselineThreads, last.threads);
   if (o.maxP99Ratio > 0 && r.p99Ratio > o.maxP99Ratio)
-    fail("inspection p99 %.2fx the first window's (%.2f -> %.2f ms), bound %.2fx", r.p99Ratio,
-         first.p99Ms, last.p99Ms, o.maxP99Ratio);
+    fail("inspection p99 %.2fx the baseline's (%.2f -> %.2f ms), bound %.2fx", r.p99Ratio,
+         r.baselineP99Ms, last.p99Ms, o.maxP99Ratio);
 }
 
 }  // namespace
 
 SoakReport runSoak(const SoakOptions& o) {
-  if (o.parts == 0 || o.windows < 2 || o.warmupWindows < 0 || o.warmupWindows >= o.windows - 1)
-    throw std::runtime_error("soak: need parts > 0 and at least two windows after the warm-up");
+  if (o.parts == 0 || o.warmupWindows < 0 || o.baselineWindows < 1 ||
+      o.warmupWindows + o.baselineWindows >= o.windows)
+    throw std::runtime_error(
+        "soak: need parts > 0 and a window after the warm-up and baseline windows");
   std::optional<daemon_test::TempDir> temp;
   std::string dir = o.workDir;
   if (dir.empty()) {
@@ -351,6 +358,18 @@ SoakReport runSoak(const SoakOptions& o) {
     }
     r.windows.push_back(w);
   }
+  {
+    std::vector<double> ms;
+    const auto from = o.parts * static_cast<std::uint64_t>(o.warmupWindows) /
+                          static_cast<std::uint64_t>(o.windows) +
+                      1;
+    const auto to = o.parts * static_cast<std::uint64_t>(o.warmupWindows + o.baselineWindows) /
+                    static_cast<std::uint64_t>(o.windows);
+    for (auto id = from; id <= std::min(to, reached); ++id)
+      if (auto it = byId.find(static_cast<std::int64_t>(id)); it != byId.end())
+        ms.push_back(it->second->inspectionMs);
+    r.baselineP99Ms = quantile(ms, 0.99);
+  }
   judge(o, r);
   if (timedOut)
     r.failures.insert(r.failures.begin(), "timed out after " + std::to_string(o.timeout.count()) +
@@ -389,11 +408,20 @@ void printSoakReport(std::ostream& out, const SoakOptions& o, const SoakReport& 
                 static_cast<unsigned long long>(r.unexpected), r.integrity.c_str(), r.databaseMiB);
   out << line;
   std::snprintf(line, sizeof line,
-                "last window vs window %d: RSS %+.2f %% (bound %.1f %%), fds %+d (bound %d), "
-                "threads %+d (bound %d), inspection p99 x%.2f (bound x%.2f%s)\n",
-                o.warmupWindows + 1, 100 * r.rssGrowth, 100 * o.maxRssGrowth, r.fdGrowth,
-                o.maxFdGrowth, r.threadGrowth, o.maxThreadGrowth, r.p99Ratio, o.maxP99Ratio,
-                o.maxP99Ratio > 0 ? "; timing on a shared machine is noisy" : ", not judged");
+                "baseline: windows %d-%d (highest RSS %.1f MiB, fds %d, threads %d; inspection "
+                "p99 over their parts %.2f ms)\n",
+                o.warmupWindows + 1, o.warmupWindows + o.baselineWindows, r.baselineRssMiB,
+                r.baselineFds, r.baselineThreads, r.baselineP99Ms);
+  out << line;
+  std::snprintf(line, sizeof line,
+                "last window vs baseline: RSS %+.2f %% (bound %.1f %%), fds %+d (bound %d), "
+                "threads %+d (bound %d), inspection p99 x%.2f (%s)\n",
+                100 * r.rssGrowth, 100 * o.maxRssGrowth, r.fdGrowth, o.maxFdGrowth, r.threadGrowth,
+                o.maxThreadGrowth, r.p99Ratio,
+                o.maxP99Ratio > 0 ? ("bound x" + std::to_string(o.maxP99Ratio).substr(0, 4) +
+                                     "; timing on a shared machine is noisy")
+                                        .c_str()
+                                  : "not judged");
   out << line;
   if (r.ok()) {
     out << "verdict: PASS\n";

@@ -6,7 +6,11 @@
 //
 // The parts are split into equal windows (the table's rows). The first `warmupWindows` are the
 // warm-up (models loaded, archive and SQLite caches filling, allocator arenas growing); the
-// judgement compares the last window with the first one after the warm-up.
+// judgement compares the last window with the baseline: the `baselineWindows` windows after the
+// warm-up, taking their highest RSS, fd and thread figures and the p99 over all their parts.
+// Why more than one: glibc sometimes gives ~10 MiB back to the system for a whole window; a
+// baseline taken from such a dip alone would report growth that is not there. A dip in the
+// last window can only hide growth of that size, never invent it.
 
 #include <chrono>
 #include <cstdint>
@@ -21,6 +25,7 @@ struct SoakOptions {
   std::uint64_t parts = 2000;
   int windows = 10;
   int warmupWindows = 1;
+  int baselineWindows = 2;
   std::chrono::milliseconds samplePeriod{500};
   // The lightest demo recipe (fiducial board, id 3) and its recorded images.
   int recipe = 3;
@@ -32,10 +37,10 @@ struct SoakOptions {
   std::string workDir;
   double archiveQuotaMb = 50;  // failed parts' images are archived, the quota makes it evict
   // Judgement bounds.
-  double maxRssGrowth = 0.05;  // last window's peak RSS vs the first after warm-up
-  int maxFdGrowth = 0;         // last window's fewest fds vs the first after warm-up
+  double maxRssGrowth = 0.05;  // last window's peak RSS vs the baseline's
+  int maxFdGrowth = 0;         // last window's fewest fds vs the baseline's
   int maxThreadGrowth = 0;
-  double maxP99Ratio = 1.5;  // inspection p99, last window vs the first after warm-up; 0 = off
+  double maxP99Ratio = 1.5;  // inspection p99, last window vs the baseline; 0 = not judged
   std::chrono::seconds timeout{3600};
   bool progress = false;  // one line on stderr per window while running
 };
@@ -62,7 +67,11 @@ struct SoakReport {
   std::uint64_t unexpected = 0;    // verdict differs from the sidecar's expected verdict
   std::string integrity;           // PRAGMA integrity_check
   double databaseMiB = 0;          // results database and its WAL on disk at the end
-  // Judgement (last window vs the first after warm-up).
+  // The baseline (see above) and the judgement, last window vs baseline.
+  double baselineRssMiB = 0;
+  int baselineFds = 0;
+  int baselineThreads = 0;
+  double baselineP99Ms = 0;
   double rssGrowth = 0;
   int fdGrowth = 0;
   int threadGrowth = 0;

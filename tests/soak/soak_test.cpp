@@ -21,6 +21,7 @@ TEST(Soak, TwoThousandPartsKeepMemoryFdsAndThreadsFlat) {
   o.parts = 2000;
   o.windows = 8;
   o.warmupWindows = 3;  // allocator arenas grow over the first ~500 parts
+  o.baselineWindows = 2;
   o.samplePeriod = std::chrono::milliseconds(250);
   o.maxP99Ratio = 0;  // printed, not judged here
   o.timeout = std::chrono::seconds(150);
