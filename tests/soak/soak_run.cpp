@@ -201,6 +201,8 @@ void judge(const SoakOptions& o, SoakReport& r) {
     fail("%llu parts with a verdict other than their recorded one",
          static_cast<unsigned long long>(r.unexpected));
   if (r.integrity != "ok") fail("integrity_check: %s", r.integrity.c_str());
+  if (r.archiveMiB > o.archiveQuotaMb)
+    fail("archive holds %.1f MiB, quota %.1f MiB", r.archiveMiB, o.archiveQuotaMb);
   const auto base = static_cast<std::size_t>(o.warmupWindows);
   const auto baseEnd = base + static_cast<std::size_t>(o.baselineWindows);
   if (r.windows.size() < baseEnd + 1) {
@@ -319,9 +321,19 @@ SoakReport runSoak(const SoakOptions& o) {
   for (std::uint64_t id = 1; id <= std::min(reached, o.parts); ++id)
     if (!byId.contains(static_cast<std::int64_t>(id))) ++r.partsMissing;
   r.integrity = fs::exists(database) ? integrityCheck(database) : "no database";
+  auto mib = [](const fs::path& file) {
+    std::error_code ec;
+    const auto bytes = fs::file_size(file, ec);  // a WAL is gone after a clean close
+    return ec ? 0.0 : static_cast<double>(bytes) / (1 << 20);
+  };
+  r.databaseMiB = mib(database) + mib(database + "-wal");
   std::error_code ec;
-  for (const auto* file : {"results.db", "results.db-wal"})
-    r.databaseMiB += static_cast<double>(fs::file_size(dir + "/" + file, ec)) / (1 << 20);
+  for (fs::recursive_directory_iterator it(dir + "/archive", ec), end; !ec && it != end;
+       it.increment(ec))
+    if (it->is_regular_file(ec)) {
+      r.archiveMiB += mib(it->path());
+      ++r.archiveFiles;
+    }
 
   std::vector<std::pair<double, std::uint64_t>> previousBuckets;
   for (int k = 0; k < o.windows; ++k) {
@@ -378,7 +390,7 @@ SoakReport runSoak(const SoakOptions& o) {
 }
 
 void printSoakReport(std::ostream& out, const SoakOptions& o, const SoakReport& r) {
-  char line[256];
+  char line[512];
   out << "facetd soak: " << o.parts << " parts, recipe " << o.recipe << ", replay of "
       << o.replayFolder << " (looped), free run, no PLC, archive keep=fail quota "
       << o.archiveQuotaMb << " MB\n";
@@ -401,11 +413,13 @@ void printSoakReport(std::ostream& out, const SoakOptions& o, const SoakReport& 
   }
   std::snprintf(line, sizeof line,
                 "stored %llu parts in %.0f s (facetd exit %d); missing ids %llu, not inspected "
-                "%llu, unexpected verdicts %llu; integrity_check %s; database %.1f MiB\n",
+                "%llu, unexpected verdicts %llu; integrity_check %s; database %.1f MiB; archive "
+                "%llu files, %.1f MiB (quota %.0f)\n",
                 static_cast<unsigned long long>(r.partsStored), r.seconds, r.exitCode,
                 static_cast<unsigned long long>(r.partsMissing),
                 static_cast<unsigned long long>(r.errorParts),
-                static_cast<unsigned long long>(r.unexpected), r.integrity.c_str(), r.databaseMiB);
+                static_cast<unsigned long long>(r.unexpected), r.integrity.c_str(), r.databaseMiB,
+                static_cast<unsigned long long>(r.archiveFiles), r.archiveMiB, o.archiveQuotaMb);
   out << line;
   std::snprintf(line, sizeof line,
                 "baseline: windows %d-%d (highest RSS %.1f MiB, fds %d, threads %d; inspection "

@@ -67,6 +67,8 @@ struct SoakReport {
   std::uint64_t unexpected = 0;    // verdict differs from the sidecar's expected verdict
   std::string integrity;           // PRAGMA integrity_check
   double databaseMiB = 0;          // results database and its WAL on disk at the end
+  double archiveMiB = 0;           // archived images on disk at the end (quota: archiveQuotaMb)
+  std::uint64_t archiveFiles = 0;
   // The baseline (see above) and the judgement, last window vs baseline.
   double baselineRssMiB = 0;
   int baselineFds = 0;

@@ -23,7 +23,8 @@ TEST(Soak, TwoThousandPartsKeepMemoryFdsAndThreadsFlat) {
   o.warmupWindows = 3;  // allocator arenas grow over the first ~500 parts
   o.baselineWindows = 2;
   o.samplePeriod = std::chrono::milliseconds(250);
-  o.maxP99Ratio = 0;  // printed, not judged here
+  o.maxP99Ratio = 0;      // printed, not judged here
+  o.archiveQuotaMb = 20;  // about 130 images: eviction runs for most of the test
   o.timeout = std::chrono::seconds(150);
   const SoakReport r = runSoak(o);
   printSoakReport(std::cout, o, r);
@@ -34,6 +35,8 @@ TEST(Soak, TwoThousandPartsKeepMemoryFdsAndThreadsFlat) {
   EXPECT_EQ(r.errorParts, 0u);
   EXPECT_EQ(r.unexpected, 0u);
   EXPECT_EQ(r.integrity, "ok");
+  EXPECT_GT(r.archiveFiles, 0u);              // 500 failed parts were archived...
+  EXPECT_LE(r.archiveMiB, o.archiveQuotaMb);  // ...and the oldest evicted to stay in the quota
   ASSERT_EQ(r.windows.size(), static_cast<std::size_t>(o.windows));
   for (std::size_t k = static_cast<std::size_t>(o.warmupWindows); k < r.windows.size(); ++k)
     ASSERT_GT(r.windows[k].samples, 0) << "window " << k + 1 << " was not sampled";
