@@ -20,6 +20,11 @@
 # cache_size, 2 MiB per connection; no mmap_size), so a growing file does not grow facetd's RSS.
 # Failed parts' images are archived with a 50 MB quota, so archive eviction runs all along.
 #
+# To see the judgement fail, preload the leak shim into facetd (facet_soak passes its environment
+# on): FACET_LEAK_KB=8 LD_PRELOAD=build/release/tests/soak/libsoak_leak_shim.so
+# tests/soak/run-soak.sh --parts 2000 --windows 8 --warmup-windows 3 (an 8 KiB per part leak
+# gave +5.8 %, FAIL; FACET_LEAK_FDS=1 leaks one fd per part).
+#
 # Usage: tests/soak/run-soak.sh [--build DIR] [facet_soak options; later ones win]
 #   Defaults: --parts 100000 --windows 20 --warmup-windows 2 --baseline-windows 2
 #   --sample-ms 2000 --timeout-s 7200

@@ -261,7 +261,7 @@ SoakReport runSoak(const SoakOptions& o) {
       {o.facetd, "--config", stationFile(o, dir), "--recipe", std::to_string(o.recipe), "--no-plc",
        "--max-parts", std::to_string(o.parts), "--block-when-behind", "--http-port-file", portFile,
        "--log-level", "warn"},
-      {}, dir + "/facetd.log");
+      o.environment, dir + "/facetd.log");
 
   // Per window: its samples; the last scrape of each window bounds its histogram delta.
   std::vector<std::vector<Sample>> samples(static_cast<std::size_t>(o.windows));

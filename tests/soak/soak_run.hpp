@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cstdint>
 #include <iosfwd>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,7 @@ struct SoakOptions {
   // Where the station file, results database, archive and facetd's log go; empty: a temporary
   // folder removed at the end.
   std::string workDir;
+  std::map<std::string, std::string> environment;  // added to facetd's
   double archiveQuotaMb = 50;  // failed parts' images are archived, the quota makes it evict
   // Judgement bounds.
   double maxRssGrowth = 0.05;  // last window's peak RSS vs the baseline's

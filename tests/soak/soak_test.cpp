@@ -12,12 +12,17 @@
 namespace facet::soak {
 namespace {
 
-TEST(Soak, TwoThousandPartsKeepMemoryFdsAndThreadsFlat) {
+SoakOptions demoSoak() {
   SoakOptions o;
   o.facetd = FACETD_PATH;
   o.replayFolder = FACET_SOURCE_DIR "/recipes/demo/fiducial_board";
   o.recipesFolder = FACET_SOURCE_DIR "/recipes";
   o.calibrationFile = FACET_SOURCE_DIR "/recipes/calibration.yaml";
+  return o;
+}
+
+TEST(Soak, TwoThousandPartsKeepMemoryFdsAndThreadsFlat) {
+  SoakOptions o = demoSoak();
   o.parts = 2000;
   o.windows = 8;
   o.warmupWindows = 3;  // allocator arenas grow over the first ~500 parts
@@ -44,6 +49,25 @@ TEST(Soak, TwoThousandPartsKeepMemoryFdsAndThreadsFlat) {
   EXPECT_LE(r.fdGrowth, 0);
   EXPECT_LE(r.threadGrowth, 0);
   EXPECT_TRUE(r.ok()) << r.failures.front();
+}
+
+// The judgement must be able to fail: facetd with a shim that leaks one fd per opened PNG.
+TEST(Soak, InjectedFdLeakFailsTheJudgement) {
+  SoakOptions o = demoSoak();
+  o.parts = 400;
+  o.windows = 4;
+  o.warmupWindows = 1;
+  o.baselineWindows = 1;
+  o.samplePeriod = std::chrono::milliseconds(200);
+  o.maxP99Ratio = 0;
+  o.timeout = std::chrono::seconds(100);
+  o.environment = {{"LD_PRELOAD", LEAK_SHIM_PATH}, {"FACET_LEAK_FDS", "1"}};
+  const SoakReport r = runSoak(o);
+  printSoakReport(std::cout, o, r);
+
+  EXPECT_EQ(r.partsStored, o.parts);  // facetd itself still works...
+  EXPECT_GE(r.fdGrowth, 100);         // ...but 200 parts later it holds about 200 more fds
+  EXPECT_FALSE(r.ok());
 }
 
 }  // namespace
