@@ -10,7 +10,9 @@
 // contrast (inside minus outside) and a(x, y) = a0 + g . (p - c0) the outside grey with an
 // illumination ramp g. In a thin band a ramp looks much like a shifted rim (it would cost half
 // the precision of a small circle), so g is kept only when it is significant (chi-square, 99.9%).
-// Levenberg-Marquardt; Tukey weights on the grey residuals reject clutter.
+// Levenberg-Marquardt; Tukey weights on the grey residuals reject clutter, and angular sectors
+// whose residuals stay too large for the noise (a faint blob next to the rim, each pixel within
+// the Tukey weight's reach) are dropped before a final solve.
 //
 // The 50% level of a blurred disc lies s^2 / (2 R) inside its true rim (the disc is convex, so
 // it covers less than half of the PSF centred on its rim); the fitted s corrects that bias

@@ -8,7 +8,8 @@
 // and radius RMS <= 0.01 px, hard <= 0.02 px without failure, low contrast <= 0.03 px, <= 1 ms at r
 // = 100.
 //
-// Usage: bench_circle [--smoke] [--scenes N]
+// Usage: bench_circle [--smoke] [--scenes N] [--case clean|hard|low-contrast] [--radius R]
+//                     [--verbose] [--no-grey-refinement] [--no-bias-correction]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -175,6 +176,8 @@ double medianMs(std::vector<double> v) {
 int main(int argc, char** argv) {
   bool smoke = false;
   int scenes = 30;
+  std::string onlyCase;   // --case clean|hard|low-contrast: that case alone
+  double onlyRadius = 0;  // --radius R: that radius alone
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke"))
       smoke = true;
@@ -186,6 +189,10 @@ int main(int argc, char** argv) {
       gGreyRefinement = false;
     else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc)
       scenes = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--case") && i + 1 < argc)
+      onlyCase = argv[++i];
+    else if (!std::strcmp(argv[i], "--radius") && i + 1 < argc)
+      onlyRadius = std::atof(argv[++i]);
   }
   if (smoke) scenes = 2;
   const int subrows = smoke ? 32 : 256;
@@ -205,7 +212,9 @@ int main(int argc, char** argv) {
       "miss", "HG/c", "HG/r", "ALT/c", "ALT/r", "target", "k");
   bool allMet = true;
   for (Case kind : {Case::Clean, Case::Hard, Case::LowContrast}) {
+    if (!onlyCase.empty() && onlyCase != caseName(kind)) continue;
     for (double radius : radii) {
+      if (onlyRadius > 0 && radius != onlyRadius) continue;
       std::mt19937_64 rng(static_cast<std::uint64_t>(radius * 1000) + static_cast<int>(kind));
       Errors ours, hg, alt;
       for (int s = 0; s < scenes; ++s) {
