@@ -254,8 +254,10 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     double current = cost(r);
     double lambda = 1e-4;
     for (int it = 0; it < maxIterations; ++it) {
-      // Robust weights once the grey levels have settled (after the first, nearly linear step).
-      if (reweight && it == 1) {
+      // Robust weights from the start (the starting levels are medians, so clutter already stands
+      // out; an unweighted first step lets large dark blobs drag the contrast down), and again
+      // once the grey levels have settled after the first, nearly linear step.
+      if (reweight && it <= 1) {
         sigma = tukeyWeights();
         current = cost(r);
       }
