@@ -118,7 +118,11 @@ GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
     if (!content.ok()) {
       ++health_.skipped_files;
       health_.last_error = content.error;
-      continue;
+      if (!settings_.report_unreadable) continue;
+      Frame refused;  // no image and no frame number: only where it came from
+      refused.source = file.string();
+      refused.metadata = sidecar_.forImage(file, &sidecar_error);
+      return {GrabStatus::Error, std::move(refused), content.error};
     }
     if (!sidecar_error.empty()) health_.last_error = sidecar_error;
     frame.id = next_id_++;

@@ -126,6 +126,7 @@ class Station : public StationView {
   std::atomic<bool> finished_{false};
   std::atomic<bool> drained_{false};
   bool scansEnded_ = false;  // the scan replay has delivered every file (acquisition thread)
+  bool archiveDegradedLogged_ = false;  // the archive state last logged (publishing thread)
   std::atomic<std::uint64_t> nextPartId_{1};
   std::uint64_t firstPartId_ = 1;  // the first id of this run (the store may hold older ones)
   std::atomic<std::uint64_t> partsTaken_{0};
