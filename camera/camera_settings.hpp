@@ -50,7 +50,8 @@ struct ReplaySettings {
   // false: an unreadable file is skipped, and grab() goes on to the next one (counted in
   // CameraHealth::skipped_files). true: grab() returns GrabStatus::Error for it, with
   // frame.source naming the file and frame.metadata its sidecar, so that a caller that treats
-  // every recorded file as a part (facetd) can answer it as "not inspected".
+  // every recorded file as a part (facetd) can answer it as "not inspected". Once per file: a
+  // looping replay skips it on later passes.
   bool report_unreadable = false;
 };
 
