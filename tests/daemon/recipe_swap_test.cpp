@@ -1,6 +1,7 @@
 // A recipe replaced by a broken one while facetd inspects parts, through both ways facetd
-// reloads: SIGHUP, and its poll of the recipe files (once a second). The broken version must be
-// rejected with its file and line in the log and in /healthz, the old version must keep
+// reloads: SIGHUP, and its poll of the recipe files (once a second); broken in its YAML, or in
+// the shape model file it names. The broken version must be rejected with the recipe file and
+// line in the log and in /healthz, the old version must keep
 // inspecting (same verdicts, same recipe hash in the store), and once the file is repaired the
 // new version must be used from one part on, never mixed back with the old one.
 #include <gtest/gtest.h>
@@ -24,10 +25,16 @@ const std::string kDemo = std::string(FACET_SOURCE_DIR) + "/recipes/demo/bracket
 const std::string kRecipeFile = "bracket_shape.recipe.yaml";  // recipe id 2
 
 enum class ReloadBy { Sighup, FileChange };
+enum class Breakage {
+  WrongValueType,   // min_score: high
+  UnknownStepKind,  // kind: circel
+  CorruptModel,     // models/bracket.shape overwritten (the recipe file itself unchanged)
+};
+const std::string kModelFile = "models/bracket.shape";  // bracket_shape's "part" step
 
 std::string readFile(const std::string& file) {
   std::ostringstream s;
-  s << std::ifstream(file).rdbuf();
+  s << std::ifstream(file, std::ios::binary).rdbuf();
   return s.str();
 }
 
@@ -35,17 +42,22 @@ std::string readFile(const std::string& file) {
 // daemon never reads a half-written file.
 void replaceFile(const std::string& file, const std::string& text) {
   const std::string aside = file + ".new";
-  std::ofstream(aside) << text;
+  std::ofstream(aside, std::ios::binary) << text;
   fs::rename(aside, file);
 }
 
-// `text` with the first `from` replaced by `to`; and the 1-based line where that happened.
-std::pair<std::string, int> edit(std::string text, const std::string& from, const std::string& to) {
+// The 1-based line of the first `what` in `text`.
+int lineOf(const std::string& text, const std::string& what) {
+  const auto at = text.find(what);
+  if (at == std::string::npos) throw std::runtime_error("recipe lacks '" + what + "'");
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
+}
+
+// `text` with the first `from` replaced by `to`.
+std::string edit(std::string text, const std::string& from, const std::string& to) {
   const auto at = text.find(from);
   if (at == std::string::npos) throw std::runtime_error("recipe lacks '" + from + "'");
-  const int line = 1 + static_cast<int>(std::count(text.begin(), text.begin() + at, '\n'));
-  text.replace(at, from.size(), to);
-  return {text, line};
+  return text.replace(at, from.size(), to);
 }
 
 bool contains(const std::string& line, const std::string& part) {
@@ -54,11 +66,13 @@ bool contains(const std::string& line, const std::string& part) {
 
 class RecipeSwap {
  public:
-  explicit RecipeSwap(ReloadBy how) : how_(how) {
+  RecipeSwap(ReloadBy how, Breakage breakage) : how_(how), breakage_(breakage) {
     fs::copy(std::string(FACET_SOURCE_DIR) + "/recipes", dir_ / "recipes",
              fs::copy_options::recursive);
     recipeFile_ = dir_ / ("recipes/" + kRecipeFile);
     original_ = readFile(recipeFile_);
+    modelFile_ = dir_ / ("recipes/" + kModelFile);
+    originalModel_ = readFile(modelFile_);
   }
 
   void run() {
@@ -92,12 +106,23 @@ class RecipeSwap {
     EXPECT_TRUE(health["recipe"]["problems"].empty()) << health.dump();
     EXPECT_EQ(health["status"], "ok") << health.dump();
 
-    // 2. Broken: a value of the wrong type (SIGHUP) or an unknown step kind (file change).
-    const auto [broken, brokenLine] = how_ == ReloadBy::Sighup
-                                          ? edit(original_, "min_score: 0.7", "min_score: high")
-                                          : edit(original_, "kind: circle", "kind: circel");
-    const std::string where = recipeFile_ + ":" + std::to_string(brokenLine) + ":";
-    replaceFile(recipeFile_, broken);
+    // 2. Broken. The error is located on the recipe file's line that was edited, or that names
+    // the broken model.
+    std::string where = recipeFile_ + ":";
+    switch (breakage_) {
+      case Breakage::WrongValueType:
+        where += std::to_string(lineOf(original_, "min_score: 0.7")) + ":";
+        replaceFile(recipeFile_, edit(original_, "min_score: 0.7", "min_score: high"));
+        break;
+      case Breakage::UnknownStepKind:
+        where += std::to_string(lineOf(original_, "kind: circle")) + ":";
+        replaceFile(recipeFile_, edit(original_, "kind: circle", "kind: circel"));
+        break;
+      case Breakage::CorruptModel:
+        where += std::to_string(lineOf(original_, "model: " + kModelFile)) + ":";
+        replaceFile(modelFile_, "not a shape model\n");
+        break;
+    }
     if (how_ == ReloadBy::Sighup) facetd_->signal(SIGHUP);
     ASSERT_TRUE(facetd_->waitForLine(
         [&](const std::string& l) {
@@ -127,10 +152,10 @@ class RecipeSwap {
     EXPECT_EQ(healthz(port_)["recipe"]["version"], v1);
 
     // 4. Repaired, as a new version (another name): picked up by the same way of reloading.
-    const std::string fixed =
-        edit(original_, "name: Bracket B-100, label", "name: Bracket B-100, label rev B").first;
     const std::int64_t beforeFix = lastPartId(db);
-    replaceFile(recipeFile_, fixed);
+    if (breakage_ == Breakage::CorruptModel) replaceFile(modelFile_, originalModel_);
+    replaceFile(recipeFile_,
+                edit(original_, "name: Bracket B-100, label", "name: Bracket B-100, label rev B"));
     if (how_ == ReloadBy::Sighup) facetd_->signal(SIGHUP);
     ASSERT_TRUE(facetd_->waitForLine(
         [&](const std::string& l) {
@@ -200,18 +225,23 @@ class RecipeSwap {
   }
 
   ReloadBy how_;
+  Breakage breakage_;
   TempDir dir_;
-  std::string recipeFile_, original_;
+  std::string recipeFile_, original_, modelFile_, originalModel_;
   std::unique_ptr<ChildProcess> facetd_;
   int port_ = 0;
 };
 
 TEST(RecipeSwap, BrokenRecipeRejectedOnSighupThenRepairedVersionUsed) {
-  RecipeSwap(ReloadBy::Sighup).run();
+  RecipeSwap(ReloadBy::Sighup, Breakage::WrongValueType).run();
 }
 
 TEST(RecipeSwap, BrokenRecipeRejectedOnFileChangeThenRepairedVersionUsed) {
-  RecipeSwap(ReloadBy::FileChange).run();
+  RecipeSwap(ReloadBy::FileChange, Breakage::UnknownStepKind).run();
+}
+
+TEST(RecipeSwap, CorruptModelRejectedOnFileChangeThenRepairedVersionUsed) {
+  RecipeSwap(ReloadBy::FileChange, Breakage::CorruptModel).run();
 }
 
 }  // namespace
