@@ -7,9 +7,10 @@
 //   publishing   PLC registers, results store, image archive, metrics, last result for HTTP
 //
 // Every part that was triggered or grabbed gets a result: a frame that could not be grabbed,
-// was incomplete, or was dropped because inspection fell behind is published as Verdict::Error
-// ("not inspected"), never as good. Results are never dropped between inspection and
-// publishing (that queue blocks); the PLC link keeps its own bounded, counted queue.
+// was incomplete, was a replay file that could not be read, or was dropped because inspection
+// fell behind is published as Verdict::Error ("not inspected"), never as good. Results are
+// never dropped between inspection and publishing (that queue blocks); the PLC link keeps its
+// own bounded, counted queue.
 
 #include <atomic>
 #include <chrono>
