@@ -52,6 +52,15 @@ std::uint64_t childrenPeakResidentBytes() {
   return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;
 }
 
+// How much the bad files may add to facetd's peak RSS. The 16000 x 16000 x RGB16 header passes
+// the pixel limit, so its decoder reserves 1.5 GB that it never fills; AddressSanitizer writes
+// the shadow of that reservation (1/8 of it), which a release build never touches.
+#ifdef __SANITIZE_ADDRESS__
+constexpr std::uint64_t kAllowedGrowth = std::uint64_t{256} << 20;
+#else
+constexpr std::uint64_t kAllowedGrowth = std::uint64_t{128} << 20;
+#endif
+
 struct ReplayRun {
   int exitCode = -1;
   std::uint64_t sampledPeak = 0;  // the largest VmHWM read while facetd ran
@@ -177,7 +186,7 @@ TEST(ReplayBadImages, EachBadFileIsAnErrorPartNamedByItsFileAndGoodOnesAreInspec
   EXPECT_GT(run.sampledPeak, 0u);
   EXPECT_LE(run.sampledPeak, peakBoth) << "VmHWM read while running exceeds the final peak";
   EXPECT_LT(peakBoth, std::uint64_t{1} << 30) << "peak RSS " << (peakBoth >> 20) << " MiB";
-  EXPECT_LT(peakBoth - peakGood, std::uint64_t{128} << 20)
+  EXPECT_LT(peakBoth - peakGood, kAllowedGrowth)
       << "the bad files raised facetd's peak RSS from " << (peakGood >> 20) << " to "
       << (peakBoth >> 20) << " MiB";
   std::cout << "[ figures  ] facetd peak RSS: good files only " << (peakGood >> 20)
