@@ -6,6 +6,7 @@
 #include <fstream>
 #include <memory>
 #include <stdexcept>
+#include <thread>
 
 #include "config/station_config.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
@@ -56,7 +57,7 @@ std::vector<StoredPart> storedParts(const std::string& database) {
   std::map<std::int64_t, std::size_t> index;
   query(database,
         "SELECT part_id, recipe_id, frame_id, source, serial, expected, verdict, failed_checks, "
-        "error "
+        "error, recipe_name, recipe_version "
         "FROM parts ORDER BY part_id",
         [&](sqlite3_stmt* s) {
           StoredPart p;
@@ -69,6 +70,8 @@ std::vector<StoredPart> storedParts(const std::string& database) {
           p.verdict = text(s, 6);
           p.failedChecks = text(s, 7);
           p.error = text(s, 8);
+          p.recipeName = text(s, 9);
+          p.recipeVersion = text(s, 10);
           index[p.partId] = parts.size();
           parts.push_back(p);
         });
@@ -83,13 +86,31 @@ std::vector<StoredPart> storedParts(const std::string& database) {
   return parts;
 }
 
+std::optional<std::vector<StoredPart>> waitForStored(
+    const std::string& database, const std::function<bool(const std::vector<StoredPart>&)>& done,
+    std::chrono::milliseconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    std::vector<StoredPart> parts;
+    try {
+      if (std::filesystem::exists(database)) parts = storedParts(database);
+    } catch (const std::exception&) {
+      // facetd has created the file but not yet its tables
+    }
+    if (done(parts)) return parts;
+    if (std::chrono::steady_clock::now() > until) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+}
+
 std::string integrityCheck(const std::string& database) {
   std::string answer;
   query(database, "PRAGMA integrity_check", [&](sqlite3_stmt* s) { answer += text(s, 0); });
   return answer;
 }
 
-std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort) {
+std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort,
+                             const StationFileOptions& options) {
   const std::string recipes = std::string(FACET_SOURCE_DIR) + "/recipes";
   std::ofstream f(dir + "/station.yaml");
   f << "schema_version: 1\nname: integration-station\ncamera:\n" << camera;
@@ -107,9 +128,10 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
       << "      error_code: {register: 10}\n      heartbeat: {register: 11}\n"
       << "      inspection_counter: {register: 12}\n      active_recipe: {register: 13}\n";
   }
-  f << "recipes: " << recipes << "\n";
+  f << "recipes: " << (options.recipes.empty() ? recipes : options.recipes) << "\n";
   f << "results:\n  database: " << dir << "/results.db\n";
-  f << "archive:\n  folder: " << dir << "/archive\n  quota_mb: 50\n  keep: fail\n";
+  f << "archive:\n  folder: " << dir << "/archive\n  quota_mb: " << options.archiveQuotaMb
+    << "\n  keep: " << options.archiveKeep << "\n";
   f << "http:\n  bind: 127.0.0.1\n  port: 0\n";
   f << "calibration:\n  file: " << recipes << "/calibration.yaml\n";
   return dir + "/station.yaml";
