@@ -334,6 +334,7 @@ TEST(CameraFaults, CameraThatDisappearsIsReportedDownAndInspectsAgainWhenBack) {
       ASSERT_TRUE(frames[i]) << where << ": frame id " << p.frameId << " was never served";
       if (p.verdict == "error") {  // loopback dropped a packet (a loaded machine)
         ++incomplete;
+        std::printf("part %lld: %s\n", static_cast<long long>(p.partId), p.error.c_str());
         EXPECT_NE(p.error.find("incomplete frame"), std::string::npos) << where << ": " << p.error;
         continue;
       }
