@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <stdexcept>
 
 #include "config/station_config.hpp"
@@ -18,24 +19,21 @@ std::string text(sqlite3_stmt* s, int column) {
   return p ? reinterpret_cast<const char*>(p) : "";
 }
 
-// Runs `sql` on a read-only connection and calls `row` per result row.
+// Runs `sql` on a read-only connection and calls `row` per result row. The connection and the
+// statement are released even when `row` throws (callers poll while facetd is still writing).
 template <typename Row>
 void query(const std::string& database, const std::string& sql, Row row) {
-  sqlite3* db = nullptr;
-  if (sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-    sqlite3_close(db);
-    throw std::runtime_error(database + ": cannot open");
-  }
-  sqlite3_busy_timeout(db, 5000);  // facetd may be writing (WAL) or creating the schema
-  sqlite3_stmt* s = nullptr;
-  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) != SQLITE_OK) {
-    const std::string message = sqlite3_errmsg(db);
-    sqlite3_close(db);
-    throw std::runtime_error(database + ": " + message);
-  }
-  while (sqlite3_step(s) == SQLITE_ROW) row(s);
-  sqlite3_finalize(s);
-  sqlite3_close(db);
+  sqlite3* raw = nullptr;
+  const int opened = sqlite3_open_v2(database.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
+  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> db(raw, sqlite3_close);
+  if (opened != SQLITE_OK) throw std::runtime_error(database + ": cannot open");
+  sqlite3_busy_timeout(db.get(), 5000);  // facetd may be writing (WAL) or creating the schema
+  sqlite3_stmt* rawStatement = nullptr;
+  if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &rawStatement, nullptr) != SQLITE_OK)
+    throw std::runtime_error(database + ": " + sqlite3_errmsg(db.get()));
+  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> statement(rawStatement,
+                                                                        sqlite3_finalize);
+  while (sqlite3_step(statement.get()) == SQLITE_ROW) row(statement.get());
 }
 
 }  // namespace
