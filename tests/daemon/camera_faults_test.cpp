@@ -359,8 +359,11 @@ TEST(CameraFaults, CameraThatDisappearsIsReportedDownAndInspectsAgainWhenBack) {
     EXPECT_TRUE(p.measurements.empty());
     std::printf("part %lld: %s\n", static_cast<long long>(p.partId), p.error.c_str());
   }
-  // The first one is told apart by the trigger's timeout, the others by the known loss.
-  EXPECT_NE(during.front().error.find("no frame"), std::string::npos) << during.front().error;
+  // The first one is told apart by the trigger's timeout (or by the loss, when the probe beats
+  // the 2 s grab on a loaded machine), the others by the known loss.
+  EXPECT_TRUE(during.front().error.find("no frame") != std::string::npos ||
+              during.front().error.find("camera disconnected") != std::string::npos)
+      << during.front().error;
   for (std::size_t i = 1; i < during.size(); ++i)
     EXPECT_NE(during[i].error.find("camera disconnected"), std::string::npos) << during[i].error;
   EXPECT_LE(incomplete, 2) << "loopback should rarely lose packets by itself";
