@@ -365,11 +365,16 @@ void AravisCamera::softwareTrigger() {
   if (!camera_ || lost_) return;
   ErrorSlot error;
   arv_camera_software_trigger(camera_, &error);
-  if (error) {
-    spdlog::warn("aravis camera {}: software trigger failed: {}", label_, error.message());
-    std::lock_guard health_lock(health_mutex_);
-    health_.last_error = "software trigger failed: " + error.message();
+  if (!error) return;
+  spdlog::warn("aravis camera {}: software trigger failed: {}", label_, error.message());
+  if (g_error_matches(error.error, ARV_DEVICE_ERROR, ARV_DEVICE_ERROR_TIMEOUT)) {
+    // Unanswered after Aravis' retries: the same evidence the watch thread's probe looks for,
+    // and a part is waiting on it.
+    flagLost("software trigger not answered");
+    return;
   }
+  std::lock_guard health_lock(health_mutex_);
+  health_.last_error = "software trigger failed: " + error.message();
 }
 
 std::string AravisCamera::controlChannelProblem() {
@@ -378,6 +383,7 @@ std::string AravisCamera::controlChannelProblem() {
   // restarted (or taken over): our stream settings are gone with it.
   std::lock_guard lock(device_mutex_);
   if (!camera_) return "no device";
+  if (control_lost_) return {};  // found out (e.g. by a trigger) while we waited for the lock
   ErrorSlot error;
   guint32 value = 0;
   arv_device_read_register(arv_camera_get_device(camera_), kControlChannelPrivilege, &value,

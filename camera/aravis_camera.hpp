@@ -3,14 +3,16 @@
 //
 // - Opened by address (GigE, no discovery needed), serial number, Aravis device id, or the
 //   first camera found, in that order of preference.
-// - The stream uses Aravis' automatic socket buffer. The packet-socket fast path is turned off
+// - The stream uses Aravis' automatic socket buffer, sized to a frame before acquisition starts
+//   (Aravis waits for the first packet). The packet-socket fast path is turned off
 //   for cameras on a loopback address (it cannot capture there, e.g. the fake camera as root).
 // - A frame with missing packets is returned as GrabStatus::Incomplete without pixels and is
 //   counted; it is never handed out as a good frame.
 // - While streaming, a watch thread asks the control channel whether the camera is still there
 //   (and still ours) once no frame has come for a second, whatever the trigger mode: a triggered
 //   camera waiting for its next part is silent too, and Aravis' own heartbeat never reports a
-//   camera that stopped answering. A lost camera shows in health() at once (connected = false);
+//   camera that stopped answering. A software trigger left unanswered counts as the same
+//   evidence. A lost camera shows in health() at once (connected = false);
 //   grab() reports Disconnected while a background thread releases the dead device (Aravis
 //   blocks for seconds on it) and reconnects with exponential backoff. When no grab() runs
 //   (e.g. waiting for a PLC trigger), the watch thread does the same, so health() also shows the
