@@ -11,7 +11,10 @@
 // --drop-every K withholds one GVSP data packet (the second) of frames K-1, 2K-1, ...: a
 // deterministic packet loss that a test can account for frame by frame (no tc/netem needed).
 // The packet is lost for good: Aravis' fake camera does not answer packet resend requests
-// (GVCP PACKETRESEND is not among the commands it handles), so the receiver must give up on it.
+// (GVCP PACKETRESEND is not among the commands it handles). Aravis 0.8.26's receiver does not
+// even ask here (its resend check runs when a later packet of the frame arrives, and the whole
+// burst beats the first packet timeout): it closes the frame after its frame retention time
+// (100 ms) with status ARV_BUFFER_STATUS_TIMEOUT.
 #include <arv.h>
 #include <dlfcn.h>
 
