@@ -3,6 +3,8 @@
 // the station file the test generated, the pymodbus PLC (tests/plc/pymodbus_plc.py) raising
 // triggers, and, afterwards, what facetd left in its SQLite results store.
 
+#include <chrono>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -31,18 +33,33 @@ struct StoredPart {
   int recipeId = 0;
   std::int64_t frameId = 0;
   std::string source, serial, expected, verdict, failedChecks, error;
+  std::string recipeName, recipeVersion;  // recipe_version: the recipe file's content hash
   std::map<std::string, StoredMeasurement> measurements;
 };
 
 // Every row of the results store, in part order.
 std::vector<StoredPart> storedParts(const std::string& database);
+// Polls the store (every 100 ms) until `done` holds for its rows; returns them then, or nullopt
+// when `timeout` passes first. A store facetd has not created yet counts as no rows.
+std::optional<std::vector<StoredPart>> waitForStored(
+    const std::string& database, const std::function<bool(const std::vector<StoredPart>&)>& done,
+    std::chrono::milliseconds timeout);
 // PRAGMA integrity_check's answer ("ok" when the file is sound).
 std::string integrityCheck(const std::string& database);
+
+// What a test may change in the station file; the defaults are the repository's recipes folder
+// and an archive of failed parts.
+struct StationFileOptions {
+  std::string recipes;               // recipes folder; empty: FACET_SOURCE_DIR/recipes
+  std::string archiveKeep = "fail";  // archive.keep: none, fail or all
+  double archiveQuotaMb = 50;        // archive.quota_mb
+};
 
 // The station file for a test: results, archive and HTTP in `dir`; `camera` is the YAML of the
 // camera section (indented by two spaces); plcPort 0: a placeholder PLC section for facetd
 // --no-plc.
-std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort);
+std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort,
+                             const StationFileOptions& options = {});
 
 // The pymodbus peer's config for that station and the bracket_shape recipe's PLC outputs.
 std::string writePeerConfig(const std::string& stationFile);
