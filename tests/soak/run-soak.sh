@@ -22,7 +22,8 @@
 #
 # To see the judgement fail, preload the leak shim into facetd (facet_soak passes its environment
 # on): FACET_LEAK_KB=8 LD_PRELOAD=build/release/tests/soak/libsoak_leak_shim.so
-# tests/soak/run-soak.sh --parts 2000 --windows 8 --warmup-windows 3 (an 8 KiB per part leak
+# tests/soak/run-soak.sh --parts 2000 --windows 8 --warmup-windows 3 --sample-ms 250
+# --archive-quota-mb 20 --work-dir /tmp/facet-soak-leak (an 8 KiB per part leak
 # gave +5.8 %, FAIL; FACET_LEAK_FDS=1 leaks one fd per part).
 #
 # Usage: tests/soak/run-soak.sh [--build DIR] [facet_soak options; later ones win]
