@@ -240,6 +240,8 @@ class StationReader {
     const auto db = pathOf(r["database"]);
     if (!db) return;
     station_.results.database = *db;
+    station_.results.keepDays = number(r["keep_days"], 0.0);
+    station_.results.keepParts = integer(r["keep_parts"], 0);
     if (!isFolder(db->parent_path()))
       error(r["database"],
             "the folder of 'database' (" + db->parent_path().string() + ") does not exist");

@@ -4,6 +4,7 @@
 // millimetres. loadStationConfig() validates it completely and reports every problem with its
 // file, line and column; the camera and PLC parts are the camera and PLC modules' own structs.
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -21,6 +22,8 @@ namespace facet::config {
 
 struct ResultsStoreSettings {
   std::filesystem::path database;  // SQLite file, absolute
+  double keepDays = 0.0;           // parts older than this many days are deleted; 0 = keep all
+  std::int64_t keepParts = 0;      // at most this many newest parts are kept; 0 = all
 };
 
 struct ArchiveSettings {

@@ -204,10 +204,12 @@ StationFormat::StationFormat() {
        section("register_map", "Register map (checked by the PLC module).", &registerMap, true)}};
   plc.fields.back().validatedByOwner = true;
 
-  results = {"results store",
-             "SQLite file the results are stored in.",
-             {path("database", "SQLite file, relative to the station file; its folder must exist.",
-                   true)}};
+  results = {
+      "results store",
+      "SQLite file the results are stored in.",
+      {path("database", "SQLite file, relative to the station file; its folder must exist.", true),
+       positive("keep_days", "Parts older than this many days are deleted; unset = keep."),
+       integer("keep_parts", "At most this many newest parts are kept; unset = all.", 1, 9.0e15)}};
   archive = {"image archive",
              "Where inspected images are kept.",
              {path("folder", "Archive folder, relative to the station file.", true),

@@ -229,18 +229,23 @@ void ResultsStore::store(const PartResult& part) {
 
 std::int64_t ResultsStore::applyRetention(std::chrono::system_clock::time_point now) {
   std::int64_t deleted = 0;
+  // The newest part always stays: the next part id after a restart continues from it.
   if (retention_.maxAge) {
-    Statement del(db_, "DELETE FROM parts WHERE time_us < ?1", file_);
+    Statement del(db_,
+                  "DELETE FROM parts WHERE time_us < ?1 "
+                  "AND part_id < (SELECT MAX(part_id) FROM parts)",
+                  file_);
     del.bind(1, toMicros(now - *retention_.maxAge));
     del.step();
     deleted += sqlite3_changes64(db_);
   }
   if (retention_.maxParts) {
+    // Walks the primary key from the newest part: no scan of the whole table.
     Statement del(db_,
-                  "DELETE FROM parts WHERE part_id NOT IN "
-                  "(SELECT part_id FROM parts ORDER BY part_id DESC LIMIT ?1)",
+                  "DELETE FROM parts WHERE part_id <= "
+                  "(SELECT part_id FROM parts ORDER BY part_id DESC LIMIT 1 OFFSET ?1)",
                   file_);
-    del.bind(1, *retention_.maxParts);
+    del.bind(1, std::max<std::int64_t>(*retention_.maxParts, 1));
     del.step();
     deleted += sqlite3_changes64(db_);
   }

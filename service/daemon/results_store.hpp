@@ -18,8 +18,8 @@ struct sqlite3_stmt;
 namespace facet::service {
 
 struct RetentionPolicy {
-  std::optional<std::chrono::hours> maxAge;  // parts older than this are deleted (none = keep)
-  std::optional<std::int64_t> maxParts;      // keep at most this many newest parts (none = all)
+  std::optional<std::chrono::seconds> maxAge;  // parts older than this are deleted (none = keep)
+  std::optional<std::int64_t> maxParts;        // keep at most this many newest parts (none = all)
 };
 
 class ResultsStore {

@@ -1,5 +1,7 @@
 #include "service/daemon/station.hpp"
 
+#include <cmath>
+
 #include <spdlog/spdlog.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -62,6 +64,14 @@ bool scanOnly(const config::Recipe& recipe) {
                      [](const auto& s) { return s.kind == config::StepKind::ScanAlign; });
 }
 
+RetentionPolicy retentionPolicy(const config::ResultsStoreSettings& s) {
+  RetentionPolicy r;
+  if (s.keepDays > 0)
+    r.maxAge = std::chrono::seconds(static_cast<std::int64_t>(std::llround(s.keepDays * 86400)));
+  if (s.keepParts > 0) r.maxParts = s.keepParts;
+  return r;
+}
+
 }  // namespace
 
 Station::Station(config::StationConfig config, StationOptions options)
@@ -70,7 +80,9 @@ Station::Station(config::StationConfig config, StationOptions options)
       library_(config_.recipeLoadOptions()),
       inspectQueue_(options_.inspectQueue, options_.overflow),
       publishQueue_(options_.publishQueue, OverflowPolicy::Block) {
-  store_ = std::make_unique<ResultsStore>(config_.results.database);
+  store_ =
+      std::make_unique<ResultsStore>(config_.results.database, retentionPolicy(config_.results));
+  applyRetention();  // a large first clean-up happens here, before READY, not between parts
   nextPartId_ = store_->lastPartId() + 1;
   firstPartId_ = nextPartId_;
   if (!config_.archive.folder.empty())
@@ -441,7 +453,12 @@ void Station::publishingLoop() {
       publishPart(*job);
     }
   };
+  auto nextRetention = Clock::now() + kRetentionPeriod;
   while (true) {
+    if (Clock::now() >= nextRetention) {
+      applyRetention();
+      nextRetention = Clock::now() + kRetentionPeriod;
+    }
     auto job = publishQueue_.pop(100ms);
     if (!job) {
       if (publishQueue_.closed() && publishQueue_.size() == 0) break;
@@ -453,6 +470,24 @@ void Station::publishingLoop() {
   }
   publishReady(true);
   drained_ = true;
+}
+
+void Station::applyRetention() {
+  try {
+    std::int64_t deleted = 0;
+    {
+      std::lock_guard lock(storeMutex_);
+      deleted = store_->applyRetention(std::chrono::system_clock::now());
+    }
+    if (deleted > 0) {
+      metrics_.counter("facet_results_retention_deleted_total", "Parts deleted by retention")
+          .increment(static_cast<double>(deleted));
+      spdlog::info("results store: retention deleted {} parts", deleted);
+    }
+  } catch (const std::exception& e) {
+    // Retention failing must not stop inspection; the database only keeps growing.
+    spdlog::error("results store: retention failed: {}", e.what());
+  }
 }
 
 void Station::publishPart(Job& j) {

@@ -96,6 +96,9 @@ class Station : public StationView {
   void inspectionLoop();
   void publishingLoop();
   void publishPart(Job& job);
+  // Deletes parts the station file's retention no longer keeps (at start, then periodically).
+  void applyRetention();
+  static constexpr std::chrono::seconds kRetentionPeriod{60};
   std::shared_ptr<const RecipeInspection> inspectionFor(int recipeId, std::string* error);
   std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
                                                         const plc::TriggerEvent* trigger);

@@ -77,6 +77,26 @@ TEST_F(StationProblems, MinimalStationLoads) {
   EXPECT_EQ(r.station->results.database, scratch.path() / "results.db");
 }
 
+TEST_F(StationProblems, ResultsRetentionIsReadAndCheckedWithItsLine) {
+  std::string text = kMinimal;
+  text.replace(text.find("  database: results.db"), 22,
+               "  database: results.db\n  keep_days: 1.5\n  keep_parts: 200000");
+  auto r = load(text);
+  ASSERT_TRUE(r.station.has_value()) << r.diagnostics.text();
+  EXPECT_DOUBLE_EQ(r.station->results.keepDays, 1.5);
+  EXPECT_EQ(r.station->results.keepParts, 200000);
+
+  const auto unset = load(kMinimal);
+  ASSERT_TRUE(unset.station.has_value());
+  EXPECT_EQ(unset.station->results.keepDays, 0.0);  // keep everything
+  EXPECT_EQ(unset.station->results.keepParts, 0);
+
+  text.replace(text.find("keep_parts: 200000"), 18, "keep_parts: 0");
+  r = load(text);
+  EXPECT_FALSE(r.station.has_value());
+  EXPECT_TRUE(hasDiagnostic(r.diagnostics, 14, 15, "'keep_parts' must be")) << r.diagnostics.text();
+}
+
 TEST_F(StationProblems, UnknownKeysAndBadValuesAreReportedTogether) {
   std::string text = kMinimal;
   text.replace(text.find("  backend: replay"), 17, "  backend: replay\n  exposure: 100");

@@ -1,6 +1,7 @@
 #include <filesystem>
 
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include "service/daemon/results_store.hpp"
 
@@ -17,6 +18,20 @@ fs::path freshFile(const std::string& name) {
   fs::remove(f.string() + "-wal");
   fs::remove(f.string() + "-shm");
   return f;
+}
+
+// Rows in the measurements table, counted through a connection of the test's own.
+std::int64_t measurementRows(const fs::path& file) {
+  sqlite3* db = nullptr;
+  sqlite3_open_v2(file.c_str(), &db, SQLITE_OPEN_READONLY, nullptr);
+  sqlite3_stmt* s = nullptr;
+  std::int64_t rows = -1;
+  if (sqlite3_prepare_v2(db, "SELECT COUNT(*) FROM measurements", -1, &s, nullptr) == SQLITE_OK &&
+      sqlite3_step(s) == SQLITE_ROW)
+    rows = sqlite3_column_int64(s, 0);
+  sqlite3_finalize(s);
+  sqlite3_close(db);
+  return rows;
 }
 
 PartResult part(std::uint64_t id, Verdict v, double diameter) {
@@ -73,6 +88,26 @@ TEST(ResultsStore, RetentionKeepsNewestParts) {
   EXPECT_EQ(store.applyRetention(std::chrono::system_clock::now()), 2);
   EXPECT_EQ(store.partCount(), 3);
   EXPECT_EQ(store.latest(10).front().partId, 3u);
+}
+
+TEST(ResultsStore, RetentionByAgeDeletesOldPartsAndTheirMeasurementsButKeepsTheNewest) {
+  const fs::path file = freshFile("age.sqlite");
+  ResultsStore store(file, {.maxAge = std::chrono::hours(24), .maxParts = std::nullopt});
+  const auto now = std::chrono::system_clock::now();
+  for (std::uint64_t i = 1; i <= 4; ++i) {
+    PartResult p = part(i, Verdict::Pass, 10.0);
+    p.time = now - std::chrono::hours(i <= 2 ? 48 : 1);  // parts 1 and 2 are two days old
+    store.store(p);
+  }
+  EXPECT_EQ(store.applyRetention(now), 2);
+  EXPECT_EQ(store.partCount(), 2);
+  EXPECT_EQ(store.latest(10).front().partId, 3u);  // oldest first
+  EXPECT_EQ(measurementRows(file), 4);  // two parts' measurements went with them (foreign key)
+
+  // A week later every part is old, but the newest stays so that part ids continue after it.
+  EXPECT_EQ(store.applyRetention(now + std::chrono::hours(24 * 7)), 1);
+  EXPECT_EQ(store.partCount(), 1);
+  EXPECT_EQ(store.lastPartId(), 4u);
 }
 
 TEST(ResultsStore, ReopenContinuesAfterLastPart) {
