@@ -1,10 +1,16 @@
 #include "tests/daemon/line_run.hpp"
 
+#include <arpa/inet.h>
+#include <netinet/in.h>
 #include <sqlite3.h>
+#include <sys/socket.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
+#include <thread>
 
 #include "config/station_config.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
@@ -91,16 +97,70 @@ std::string integrityCheck(const std::string& database) {
   return answer;
 }
 
-std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort) {
+std::string journalMode(const std::string& database) {
+  std::string answer;
+  query(database, "PRAGMA journal_mode", [&](sqlite3_stmt* s) { answer += text(s, 0); });
+  return answer;
+}
+
+std::string httpGet(int port, const std::string& path) {
+  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  sockaddr_in address{};
+  address.sin_family = AF_INET;
+  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  address.sin_port = htons(static_cast<std::uint16_t>(port));
+  if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
+    if (fd >= 0) ::close(fd);
+    throw std::runtime_error("facetd does not answer on port " + std::to_string(port));
+  }
+  const std::string request =
+      "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
+  std::string reply;
+  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == ssize_t(request.size())) {
+    char chunk[8192];
+    ssize_t n = 0;
+    while ((n = ::recv(fd, chunk, sizeof chunk, 0)) > 0)
+      reply.append(chunk, static_cast<std::size_t>(n));
+  }
+  ::close(fd);
+  const auto body = reply.find("\r\n\r\n");
+  if (reply.rfind("HTTP/1.1 200", 0) != 0 || body == std::string::npos)
+    throw std::runtime_error("GET " + path + ": " + reply.substr(0, reply.find('\r')));
+  return reply.substr(body + 4);
+}
+
+std::optional<double> metricValue(const std::string& exposition, const std::string& series) {
+  std::istringstream lines(exposition);
+  std::string line;
+  while (std::getline(lines, line))
+    if (line.size() > series.size() && line.rfind(series, 0) == 0 && line[series.size()] == ' ')
+      return std::stod(line.substr(series.size() + 1));
+  return std::nullopt;
+}
+
+int readHttpPort(const std::string& portFile, std::chrono::milliseconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  do {
+    std::stringstream content;
+    content << std::ifstream(portFile).rdbuf();
+    const std::string text = content.str();  // complete once the newline is there
+    if (!text.empty() && text.back() == '\n') return std::stoi(text);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  } while (std::chrono::steady_clock::now() < until);
+  return 0;
+}
+
+std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort,
+                             const std::string& plcMode, const std::string& plcOptions) {
   const std::string recipes = std::string(FACET_SOURCE_DIR) + "/recipes";
   std::ofstream f(dir + "/station.yaml");
   f << "schema_version: 1\nname: integration-station\ncamera:\n" << camera;
   f << "  scans:\n    folder: " << recipes << "/demo/scan_offset\n    glob: \"*.csv\"\n";
   {  // facetd --no-plc ignores the section, but the station file needs one
-    f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
+    f << "plc:\n  role: client\n  mode: " << plcMode << "\n  transport: tcp\n  host: 127.0.0.1\n"
       << "  port: " << (plcPort > 0 ? plcPort : 502) << "\n  unit_id: 1\n  word_order: ABCD\n"
       << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
-      << "  register_map:\n    address_base: 0\n    control:\n"
+      << plcOptions << "  register_map:\n    address_base: 0\n    control:\n"
       << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n"
       << "      recipe_select: {register: 0}\n    status:\n"
       << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
@@ -117,7 +177,7 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
   return dir + "/station.yaml";
 }
 
-std::string writePeerConfig(const std::string& stationFile) {
+std::string writePeerConfig(const std::string& stationFile, bool freeRun) {
   const auto loaded = config::loadStationConfig(stationFile);
   if (!loaded.station) throw std::runtime_error(loaded.diagnostics.text());
   plc::RegisterMap map = loaded.station->registerMap;
@@ -134,7 +194,8 @@ std::string writePeerConfig(const std::string& stationFile) {
   map.results = {output("label.count", 110, plc::ValueType::Int16, 1.0),
                  output("bore_to_edge.distance", 111, plc::ValueType::Float32, 1.0),
                  output("label_angle.angle", 113, plc::ValueType::ScaledInt16, 100.0)};
-  return plc::test::writePeerConfig(map, false);
+  return freeRun ? plc::test::writePeerConfig(map, true, 512, 128, {{"report_writes", true}})
+                 : plc::test::writePeerConfig(map, false);
 }
 
 }  // namespace facet::daemon_test
