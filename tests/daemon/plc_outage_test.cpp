@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -155,7 +156,11 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
     ++repeats;
     EXPECT_EQ(it->second.at("pass"), e.at("pass")) << "counter " << counter;
     EXPECT_EQ(it->second.at("error"), e.at("error")) << "counter " << counter;
-    EXPECT_EQ(it->second.at("values"), e.at("values")) << "counter " << counter;
+    // An error result leaves the value registers as they were: only a measured repeat must
+    // carry the same values.
+    if (!e.at("error").get<bool>()) {
+      EXPECT_EQ(it->second.at("values"), e.at("values")) << "counter " << counter;
+    }
   }
 
   // Undelivered: dropped from the full queue (logged by the link and by the station, counted in
@@ -176,8 +181,9 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
   std::set<std::int64_t> undelivered(dropped.begin(), dropped.end());
   undelivered.insert(abandoned.begin(), abandoned.end());
   EXPECT_EQ(undelivered.size(), dropped.size() + abandoned.size()) << "a part logged twice";
-  int passes = 0;
+  int passes = 0, errors = 0;
   for (const auto& part : stored) {
+    errors += part.verdict == "error";
     const auto found = delivered.find(static_cast<int>(part.partId));
     const bool wasDelivered = found != delivered.end();
     const bool wasUndelivered = undelivered.count(part.partId) > 0;
@@ -193,6 +199,16 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
     EXPECT_EQ(r.at("error_code").get<int>() != 0, part.verdict == "error")
         << "part " << part.partId;
     passes += part.verdict == "pass";
+    if (part.verdict == "error") continue;  // nothing measured, the registers keep older values
+    const auto& values = r.at("values");
+    const auto& m = part.measurements;
+    ASSERT_TRUE(m.count("label.count") && m.count("bore_to_edge.distance"))
+        << "part " << part.partId << " lacks a measurement";
+    EXPECT_EQ(values.at("label.count").get<double>(), std::round(m.at("label.count").value))
+        << "part " << part.partId;
+    EXPECT_FLOAT_EQ(values.at("bore_to_edge.distance").get<float>(),
+                    static_cast<float>(m.at("bore_to_edge.distance").value))
+        << "part " << part.partId;
   }
   EXPECT_EQ(delivered.size() + undelivered.size(), static_cast<std::size_t>(kParts));
   // Each outage was longer than the queue: some results were dropped in each, the rest waited.
@@ -209,10 +225,11 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
         << " s, listening at " << listeningAt[k] << " s (CLOCK_MONOTONIC)";
   EXPECT_GE(metricValue(metrics, "facet_plc_reconnects").value_or(0), 4.0);
 
-  std::cout << "[ figures  ] parts " << kParts << ", delivered " << delivered.size() << " (repeats "
-            << repeats << "), undelivered " << undelivered.size() << " (dropped " << dropped.size()
-            << ", abandoned " << abandoned.size() << "), reconnect ms " << reconnectMs[0] << " / "
-            << reconnectMs[1] << " / " << reconnectMs[2] << ", connects "
+  std::cout << "[ figures  ] parts " << kParts << " (" << errors << " not inspected), delivered "
+            << delivered.size() << " (repeats " << repeats << "), undelivered "
+            << undelivered.size() << " (dropped " << dropped.size() << ", abandoned "
+            << abandoned.size() << "), reconnect ms " << reconnectMs[0] << " / " << reconnectMs[1]
+            << " / " << reconnectMs[2] << ", connects "
             << metricValue(metrics, "facet_plc_reconnects").value_or(0) << "\n";
   if (HasFailure()) {  // the link's story (queue overflow lines left out)
     std::cout << "facetd's PLC log:\n";
