@@ -1,5 +1,6 @@
 // facetd stopped by the service manager at a bad moment. SIGTERM while a part is being
-// inspected: that part is finished and stored (not aborted, not dropped), then facetd exits 0.
+// inspected: that part is finished, stored and sent to the PLC (not aborted, not dropped), then
+// facetd exits 0.
 // SIGKILL, several times at arbitrary moments of a fast run: each time the SQLite store is sound
 // (PRAGMA integrity_check), still in WAL mode, keeps every committed row, and the restarted
 // daemon continues the part ids without a gap or a repeat. (daemon_systemd_test's
@@ -9,6 +10,7 @@
 #include <csignal>
 #include <filesystem>
 #include <random>
+#include <set>
 #include <thread>
 
 #include <opencv2/core.hpp>
@@ -16,6 +18,7 @@
 
 #include "tests/daemon/child_process.hpp"
 #include "tests/daemon/line_run.hpp"
+#include "tests/plc/pymodbus_peer.hpp"
 
 namespace facet::daemon_test {
 namespace {
@@ -33,11 +36,12 @@ std::string replayCamera(const std::string& folder, double fps) {
 }
 
 std::unique_ptr<ChildProcess> startFacetd(const TempDir& dir, const std::string& station,
-                                          const std::string& logLevel) {
-  return std::make_unique<ChildProcess>(
-      std::vector<std::string>{FACETD_PATH, "--config", station, "--recipe", "2", "--no-plc",
-                               "--log-level", logLevel},
-      std::map<std::string, std::string>{}, dir / "facetd.log");
+                                          const std::string& logLevel, bool withPlc = false) {
+  std::vector<std::string> argv{FACETD_PATH, "--config",    station, "--recipe",
+                                "2",         "--log-level", logLevel};
+  if (!withPlc) argv.push_back("--no-plc");
+  return std::make_unique<ChildProcess>(std::move(argv), std::map<std::string, std::string>{},
+                                        dir / "facetd.log");
 }
 
 // Index of the first stdout line containing `text`, or -1.
@@ -78,8 +82,13 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
     part.copyTo(big(cv::Rect(3600, 3700, part.cols, part.rows)));
     ASSERT_TRUE(cv::imwrite((images / ("part_00" + std::to_string(i) + ".png")).string(), big));
   }
-  const auto station = writeStationFile(dir.path(), replayCamera(images, 2), 0);
-  auto facetd = startFacetd(dir, station, "debug");
+  // A free-run PLC that reports every result as it lands: the finished part must reach it too.
+  const int plcPort = plc::test::freeTcpPort();
+  const auto station = writeStationFile(dir.path(), replayCamera(images, 2), plcPort, "free_run");
+  const std::string peerConfig = writePeerConfig(station, /*freeRun=*/true);
+  plc::test::PymodbusPlc plc(peerConfig, plcPort);
+  plc.start();
+  auto facetd = startFacetd(dir, station, "debug", /*withPlc=*/true);
 
   // The second part's inspection has begun (the first is stored by then or in the queue).
   const std::string started = "part=2 inspecting";
@@ -113,6 +122,15 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
     EXPECT_LE(id, static_cast<long long>(parts.size())) << "part " << id << " began, not stored";
   }
   EXPECT_EQ(integrityCheck(dir / "results.db"), "ok");
+
+  // ... and every stored part, the one finished after SIGTERM included, reached the PLC before
+  // facetd let go of the link.
+  std::set<int> counters;
+  for (const auto& e : plc.events("result")) counters.insert(e.at("counter").get<int>());
+  for (const auto& p : parts)
+    EXPECT_TRUE(counters.count(static_cast<int>(p.partId))) << "part " << p.partId << " not sent";
+  std::error_code ignored;
+  fs::remove(peerConfig, ignored);
 }
 
 TEST(SignalFaults, RepeatedSigkillKeepsTheStoreSoundInWalAndPartIdsContinue) {
