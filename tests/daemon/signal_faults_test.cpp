@@ -125,6 +125,15 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
 
   // ... and every stored part, the one finished after SIGTERM included, reached the PLC before
   // facetd let go of the link.
+  // (The peer printed each result before answering its write; the pipe may still hold some.)
+  const int lastPart = static_cast<int>(parts.back().partId);
+  plc.waitFor(
+      [&](const std::vector<nlohmann::json>& events) {
+        for (const auto& e : events)
+          if (e.value("event", "") == "result" && e.value("counter", 0) == lastPart) return true;
+        return false;
+      },
+      5s);
   std::set<int> counters;
   for (const auto& e : plc.events("result")) counters.insert(e.at("counter").get<int>());
   for (const auto& p : parts)

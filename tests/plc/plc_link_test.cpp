@@ -401,6 +401,8 @@ TEST(PlcLinkWithPymodbus, FlushDeliversTheQueueAndStopCountsWhatIsLeft) {
     EXPECT_TRUE(link.flush(10s));
     EXPECT_EQ(link.stats().queueDepth, 0u);
     EXPECT_EQ(link.stats().written, std::uint64_t(kBurst));
+    // The peer printed each result before answering its write; the pipe may still hold them.
+    EXPECT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "result") >= kBurst; }, 5s));
     std::vector<int> counters;
     for (const auto& e : plc.events("result")) counters.push_back(e["counter"].get<int>());
     std::vector<int> expected(kBurst);
