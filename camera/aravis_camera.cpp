@@ -1,6 +1,10 @@
 #include "camera/aravis_camera.hpp"
 
+#include <netinet/in.h>
+#include <sys/socket.h>
+
 #include <algorithm>
+#include <filesystem>
 #include <optional>
 #include <thread>
 
@@ -15,9 +19,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// How long a free-running stream may stay silent before we ask the control channel whether
-// the camera is still there.
+// How long a stream may stay silent before we ask the control channel whether the camera is
+// still there, and how often the watch thread looks.
 constexpr auto kSilenceBeforeProbe = std::chrono::milliseconds(1000);
+constexpr auto kWatchPeriod = std::chrono::milliseconds(250);
+
+// GigE Vision bootstrap register: control channel privilege (CCP), and its bits that say an
+// application holds control (exclusive or shared). A camera that restarted reads 0 here.
+constexpr guint32 kControlChannelPrivilege = 0x0A00;
+constexpr guint32 kControlBits = 0x3;
 
 // Owns a GError and turns it into a message.
 struct ErrorSlot {
@@ -81,6 +91,36 @@ std::string deviceIdForSerial(const std::string& serial) {
   return {};
 }
 
+// Aravis sizes its GVSP socket's receive buffer (socket-buffer auto) only when the first
+// packet of the first frame arrives, so that frame's burst meets the system default buffer and,
+// from a fast sender (a camera on loopback, 10 GigE), loses packets: the first part after every
+// (re)connection would be an incomplete frame. Aravis 0.8 does not expose the socket, so it is
+// found among our descriptors by the stream's local UDP port and given the frame size now.
+void presizeStreamSocket(ArvStream* stream, guint payload) {
+  if (!ARV_IS_GV_STREAM(stream)) return;
+  const guint16 port = arv_gv_stream_get_port(ARV_GV_STREAM(stream));
+  const int size = static_cast<int>(std::min<guint>(payload, 1u << 30));
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd", error)) {
+    int fd = -1;
+    try {
+      fd = std::stoi(entry.path().filename().string());
+    } catch (const std::exception&) {
+      continue;
+    }
+    sockaddr_in address{};
+    socklen_t length = sizeof address;
+    int type = 0;
+    socklen_t type_length = sizeof type;
+    if (getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0 ||
+        address.sin_family != AF_INET || ntohs(address.sin_port) != port ||
+        getsockopt(fd, SOL_SOCKET, SO_TYPE, &type, &type_length) != 0 || type != SOCK_DGRAM)
+      continue;
+    if (setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &size, sizeof size) != 0)
+      spdlog::debug("GVSP socket: cannot set a {} byte receive buffer", size);
+  }
+}
+
 bool isLoopbackCamera(ArvCamera* camera) {
   if (!arv_camera_is_gv_device(camera)) return false;
   GSocketAddress* address =
@@ -117,8 +157,20 @@ AravisCamera::~AravisCamera() {
 }
 
 void AravisCamera::onControlLost(void* /*device*/, void* self) {
-  // Called from Aravis' heartbeat thread: only flag it, grab() does the rest.
-  static_cast<AravisCamera*>(self)->control_lost_ = true;
+  // Called from Aravis' heartbeat thread: only flag it, grab() or the watch thread does the rest.
+  static_cast<AravisCamera*>(self)->flagLost("control channel lost (heartbeat)");
+}
+
+void AravisCamera::flagLost(const std::string& why) {
+  std::lock_guard lock(health_mutex_);
+  if (control_lost_.exchange(true)) return;
+  loss_reason_ = why;
+  health_.connected = false;
+  health_.last_error = "camera lost: " + why;
+}
+
+void AravisCamera::noteSignOfLife() {
+  last_sign_of_life_ = Clock::now().time_since_epoch().count();
 }
 
 void AravisCamera::connect() {
@@ -218,6 +270,7 @@ void AravisCamera::startStream() {
     g_object_unref(stream);
     throw CameraError("aravis camera " + label_ + ": cannot read payload size: " + error.message());
   }
+  presizeStreamSocket(stream, payload);
   for (int i = 0; i < settings_.buffer_count; ++i)
     arv_stream_push_buffer(stream, arv_buffer_new_allocate(payload));
   arv_camera_start_acquisition(camera, &error);
@@ -227,7 +280,7 @@ void AravisCamera::startStream() {
   }
   std::lock_guard lock(device_mutex_);
   stream_ = stream;
-  last_frame_ = Clock::now();
+  noteSignOfLife();
 }
 
 void AravisCamera::releaseDevice(bool device_alive) {
@@ -265,12 +318,16 @@ void AravisCamera::start() {
   ids_.restart();
   startStream();
   streaming_ = true;
-  std::lock_guard lock(health_mutex_);
-  health_.streaming = true;
+  {
+    std::lock_guard lock(health_mutex_);
+    health_.streaming = true;
+  }
+  startWatching();
 }
 
 void AravisCamera::stop() {
   if (!streaming_) return;
+  stopWatching();
   streaming_ = false;
   if (lost_) {
     stopReconnecting();
@@ -308,26 +365,42 @@ void AravisCamera::softwareTrigger() {
   if (!camera_ || lost_) return;
   ErrorSlot error;
   arv_camera_software_trigger(camera_, &error);
-  if (error) {
-    spdlog::warn("aravis camera {}: software trigger failed: {}", label_, error.message());
-    std::lock_guard health_lock(health_mutex_);
-    health_.last_error = "software trigger failed: " + error.message();
+  if (!error) return;
+  spdlog::warn("aravis camera {}: software trigger failed: {}", label_, error.message());
+  if (g_error_matches(error.error, ARV_DEVICE_ERROR, ARV_DEVICE_ERROR_TIMEOUT)) {
+    // Unanswered after Aravis' retries: the same evidence the watch thread's probe looks for,
+    // and a part is waiting on it.
+    flagLost("software trigger not answered");
+    return;
   }
+  std::lock_guard health_lock(health_mutex_);
+  health_.last_error = "software trigger failed: " + error.message();
 }
 
-bool AravisCamera::controlChannelAlive() {
+std::string AravisCamera::controlChannelProblem() {
   // A register read through GVCP; Aravis retries internally, so a failure means the camera does
-  // not answer at all.
+  // not answer at all. A camera that answers but no longer counts us as its controller was
+  // restarted (or taken over): our stream settings are gone with it.
   std::lock_guard lock(device_mutex_);
-  if (!camera_) return false;
+  if (!camera_) return "no device";
+  if (control_lost_) return {};  // found out (e.g. by a trigger) while we waited for the lock
   ErrorSlot error;
   guint32 value = 0;
-  arv_device_read_register(arv_camera_get_device(camera_), 0x0000 /* GVBS version */, &value,
+  arv_device_read_register(arv_camera_get_device(camera_), kControlChannelPrivilege, &value,
                            &error);
-  return !error;
+  if (error) return "no answer on control channel";
+  if ((value & kControlBits) == 0) return "control channel privilege lost (camera restarted?)";
+  return {};
 }
 
-void AravisCamera::markLost(const std::string& why) {
+void AravisCamera::markLost() {
+  std::string why;
+  {
+    std::lock_guard lock(health_mutex_);
+    why = loss_reason_;
+    health_.connected = false;
+    health_.last_error = "camera lost: " + why;
+  }
   spdlog::error("aravis camera {} lost: {}; reconnecting with backoff", label_, why);
   lost_ = true;
   ArvCamera* dead_camera = nullptr;
@@ -340,13 +413,59 @@ void AravisCamera::markLost(const std::string& why) {
     reconnected_ = false;
     stop_reconnecting_ = false;
   }
-  {
-    std::lock_guard lock(health_mutex_);
-    health_.connected = false;
-    health_.last_error = "camera lost: " + why;
-  }
   if (reconnect_thread_.joinable()) reconnect_thread_.join();
   reconnect_thread_ = std::thread(&AravisCamera::reconnectLoop, this, dead_camera, dead_stream);
+}
+
+void AravisCamera::startWatching() {
+  {
+    std::lock_guard lock(watch_mutex_);
+    stop_watching_ = false;
+  }
+  watch_thread_ = std::thread([this] {
+    std::unique_lock lock(watch_mutex_);
+    while (!watch_cv_.wait_for(lock, kWatchPeriod, [&] { return stop_watching_; })) {
+      lock.unlock();
+      watch();
+      lock.lock();
+    }
+  });
+}
+
+void AravisCamera::stopWatching() {
+  {
+    std::lock_guard lock(watch_mutex_);
+    stop_watching_ = true;
+  }
+  watch_cv_.notify_all();
+  if (watch_thread_.joinable()) watch_thread_.join();
+}
+
+void AravisCamera::watch() {
+  if (lost_) {
+    // Reconnected while no grab() waited for it: finish here, so health() tells the truth.
+    bool reconnected = false;
+    {
+      std::lock_guard lock(device_mutex_);
+      reconnected = reconnected_;
+    }
+    std::unique_lock grabbing(grab_mutex_, std::try_to_lock);
+    if (reconnected && grabbing && lost_) finishReconnect();
+    return;
+  }
+  const auto silence = Clock::now().time_since_epoch() - Clock::duration(last_sign_of_life_);
+  if (!control_lost_ && silence > kSilenceBeforeProbe) {
+    const std::string problem = controlChannelProblem();
+    if (problem.empty())
+      noteSignOfLife();
+    else
+      flagLost(problem);
+  }
+  if (control_lost_) {
+    // A grab() in progress handles it when it returns; otherwise release and reconnect now.
+    std::unique_lock grabbing(grab_mutex_, std::try_to_lock);
+    if (grabbing && !lost_ && control_lost_) markLost();
+  }
 }
 
 void AravisCamera::reconnectLoop(ArvCamera* dead_camera, ArvStream* dead_stream) {
@@ -411,12 +530,13 @@ void AravisCamera::finishReconnect() {
 GrabResult AravisCamera::grab(std::chrono::milliseconds timeout) {
   const auto deadline = Clock::now() + timeout;
   if (!streaming_) return {GrabStatus::NotStarted, {}, name() + ": not started"};
+  std::lock_guard grabbing(grab_mutex_);
   if (lost_) {
     GrabResult r = waitForReconnect(deadline);
     if (lost_) return r;
   }
   if (control_lost_) {
-    markLost("control channel lost (heartbeat)");
+    markLost();
     return {GrabStatus::Disconnected, {}, "aravis camera " + label_ + " lost"};
   }
 
@@ -424,17 +544,15 @@ GrabResult AravisCamera::grab(std::chrono::milliseconds timeout) {
       0, std::chrono::duration_cast<std::chrono::microseconds>(deadline - Clock::now()).count());
   ArvBuffer* buffer = arv_stream_timeout_pop_buffer(stream_, static_cast<guint64>(remaining));
   if (!buffer) {
-    const bool expect_frames = settings_.trigger == TriggerMode::FreeRun;
-    if (control_lost_ || (expect_frames && Clock::now() - last_frame_ > kSilenceBeforeProbe &&
-                          !controlChannelAlive())) {
-      markLost(control_lost_ ? "control channel lost (heartbeat)" : "no answer on control channel");
+    if (control_lost_) {  // seen by the watch thread or the heartbeat meanwhile
+      markLost();
       return {GrabStatus::Disconnected, {}, "aravis camera " + label_ + " lost"};
     }
     std::lock_guard lock(health_mutex_);
     ++health_.timeouts;
     return {GrabStatus::Timeout, {}, "no frame within timeout"};
   }
-  last_frame_ = Clock::now();
+  noteSignOfLife();
 
   Frame frame;
   frame.timestamp = std::chrono::system_clock::now();

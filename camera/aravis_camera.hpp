@@ -3,14 +3,20 @@
 //
 // - Opened by address (GigE, no discovery needed), serial number, Aravis device id, or the
 //   first camera found, in that order of preference.
-// - The stream uses Aravis' automatic socket buffer. The packet-socket fast path is turned off
+// - The stream uses Aravis' automatic socket buffer, sized to a frame before acquisition starts
+//   (Aravis waits for the first packet). The packet-socket fast path is turned off
 //   for cameras on a loopback address (it cannot capture there, e.g. the fake camera as root).
 // - A frame with missing packets is returned as GrabStatus::Incomplete without pixels and is
 //   counted; it is never handed out as a good frame.
-// - When the camera is lost (control-lost signal, or its control channel stops answering after
-//   a silent free-running stream), grab() reports Disconnected while a background thread
-//   releases the dead device (Aravis blocks for seconds on it) and reconnects with exponential
-//   backoff. grab() overruns its timeout only once, by the probe (about 2.5 s).
+// - While streaming, a watch thread asks the control channel whether the camera is still there
+//   (and still ours) once no frame has come for a second, whatever the trigger mode: a triggered
+//   camera waiting for its next part is silent too, and Aravis' own heartbeat never reports a
+//   camera that stopped answering. A software trigger left unanswered counts as the same
+//   evidence. A lost camera shows in health() at once (connected = false);
+//   grab() reports Disconnected while a background thread releases the dead device (Aravis
+//   blocks for seconds on it) and reconnects with exponential backoff. When no grab() runs
+//   (e.g. waiting for a PLC trigger), the watch thread does the same, so health() also shows the
+//   return without a part being spent on it.
 
 #include <atomic>
 #include <chrono>
@@ -50,12 +56,17 @@ class AravisCamera final : public Camera {
   void connect();  // open + configure; throws CameraError
   void startStream();
   void releaseDevice(bool device_alive);
-  void markLost(const std::string& why);
+  void flagLost(const std::string& why);
+  void markLost();
   void reconnectLoop(ArvCamera* dead_camera, ArvStream* dead_stream);
   void stopReconnecting();
   void finishReconnect();
   GrabResult waitForReconnect(std::chrono::steady_clock::time_point deadline);
-  bool controlChannelAlive();
+  std::string controlChannelProblem();  // empty while the camera answers and is ours
+  void startWatching();
+  void stopWatching();
+  void watch();
+  void noteSignOfLife();
   static void onControlLost(void* device, void* self);
 
   AravisSettings settings_;
@@ -67,14 +78,24 @@ class AravisCamera final : public Camera {
   std::string device_id_;
   bool streaming_ = false;
   std::atomic<bool> lost_{false};
-  std::atomic<bool> control_lost_{false};
+  std::atomic<bool> control_lost_{false};  // seen lost, not yet handled by markLost()
+  std::string loss_reason_;                // guarded by health_mutex_
+
+  // grab(), and the watch thread when it handles a loss or a return, hold `grab_mutex_`: only
+  // one of them swaps the device and stream at a time.
+  std::mutex grab_mutex_;
+  std::thread watch_thread_;
+  std::mutex watch_mutex_;
+  std::condition_variable watch_cv_;
+  bool stop_watching_ = false;  // guarded by watch_mutex_
+  // Last frame or answer on the control channel, in steady_clock ticks.
+  std::atomic<std::chrono::steady_clock::rep> last_sign_of_life_{0};
 
   // Reconnection runs on its own thread; grab() waits on `reconnect_cv_` for it.
   std::thread reconnect_thread_;
   std::condition_variable reconnect_cv_;
   bool reconnected_ = false;        // guarded by device_mutex_
   bool stop_reconnecting_ = false;  // guarded by device_mutex_
-  std::chrono::steady_clock::time_point last_frame_{};
   FrameIdUnwrapper ids_{16, true};
   bool extended_ids_ = false;
 

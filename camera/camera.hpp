@@ -60,7 +60,7 @@ const char* toString(GrabStatus status);
 // The result of Camera::grab(): a frame or the typed reason why there is none.
 struct GrabResult {
   GrabStatus status = GrabStatus::Error;
-  Frame frame;          // valid for Ok and Incomplete
+  Frame frame;          // valid for Ok and Incomplete (replay Error: source, see ReplaySettings)
   std::string message;  // human-readable detail for anything but Ok
 
   bool ok() const { return status == GrabStatus::Ok; }

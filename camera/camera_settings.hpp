@@ -47,6 +47,12 @@ struct ReplaySettings {
   // Files whose header announces more pixels (width * height) than this are skipped before
   // any pixel memory is allocated (guards against corrupt or hostile headers). Default 2^28.
   std::uint64_t max_pixels = std::uint64_t{1} << 28;
+  // false: an unreadable file is skipped, and grab() goes on to the next one (counted in
+  // CameraHealth::skipped_files). true: grab() returns GrabStatus::Error for it, with
+  // frame.source naming the file and frame.metadata its sidecar, so that a caller that treats
+  // every recorded file as a part (facetd) can answer it as "not inspected". Once per file: a
+  // looping replay skips it on later passes.
+  bool report_unreadable = false;
 };
 
 // A GigE Vision / USB3 Vision camera through Aravis.

@@ -34,6 +34,7 @@ void ReplayCamera::open() {
   auto sidecar = SidecarMetadata::loadFolder(settings_.folder);
   std::lock_guard lock(mutex_);
   files_ = std::move(files);
+  reported_.assign(files_.size(), false);
   sidecar_ = std::move(sidecar);
   next_file_ = 0;
   health_.connected = true;
@@ -98,7 +99,8 @@ GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
       if (!settings_.loop) return {GrabStatus::EndOfStream, {}, "replay finished"};
       next_file_ = 0;
     }
-    const std::filesystem::path file = files_[next_file_++];
+    const std::size_t index = next_file_++;
+    const std::filesystem::path file = files_[index];
     // Decode without the lock: health() and softwareTrigger() must not wait for a PNG.
     lock.unlock();
     ImageFileContent content = readImageFile(file, settings_.max_pixels);
@@ -118,7 +120,13 @@ GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
     if (!content.ok()) {
       ++health_.skipped_files;
       health_.last_error = content.error;
-      continue;
+      // Reported once: a looping replay must not turn one bad file into a stream of parts.
+      if (!settings_.report_unreadable || reported_[index]) continue;
+      reported_[index] = true;
+      Frame refused;  // no image and no frame number: only where it came from
+      refused.source = file.string();
+      refused.metadata = sidecar_.forImage(file, &sidecar_error);
+      return {GrabStatus::Error, std::move(refused), content.error};
     }
     if (!sidecar_error.empty()) health_.last_error = sidecar_error;
     frame.id = next_id_++;

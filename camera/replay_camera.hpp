@@ -42,6 +42,7 @@ class ReplayCamera final : public Camera {
   std::vector<std::filesystem::path> files_;
   SidecarMetadata sidecar_;
   std::size_t next_file_ = 0;
+  std::vector<bool> reported_;  // report_unreadable: files already returned as an Error
   std::uint64_t next_id_ = 0;
   std::uint64_t pending_triggers_ = 0;
   std::chrono::steady_clock::time_point next_due_{};

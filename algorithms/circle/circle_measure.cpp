@@ -17,6 +17,10 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+// Largest angle between an edge point's gradient and the radial of a RANSAC hypothesis through
+// it, degrees. Facet normals of a rim are radial within a few degrees even at 15 grey levels of
+// contrast (noise 2); unlike the test against the coarse centre, this one knows the circle.
+constexpr double kHypothesisToleranceDeg = 12.0;
 
 struct Circle {
   Eigen::Vector2d centre;
@@ -212,7 +216,8 @@ std::vector<cv::Point2d> foreignEdges(const AnnulusEdges& edges, const Circle& c
 // Edge point relative to the expected centre, with its radial alignment.
 struct Candidate {
   Eigen::Vector2d p;
-  double radialCos = 0;  // cosine between the gradient (dark -> light) and the outward radial
+  Eigen::Vector2d normal;  // unit gradient direction (dark -> light)
+  double radialCos = 0;    // cosine between the gradient and the outward radial
 };
 
 }  // namespace
@@ -280,7 +285,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     const bool keep = params.polarity == CirclePolarity::DarkToLight   ? darkToLight
                       : params.polarity == CirclePolarity::LightToDark ? lightToDark
                                                                        : darkToLight || lightToDark;
-    if (keep) candidates.push_back({p, cosA});
+    if (keep) candidates.push_back({p, {e.normal.x, e.normal.y}, cosA});
   }
   m.candidates = static_cast<int>(candidates.size());
   if (m.candidates < params.minInliers)
@@ -298,9 +303,12 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::size_t bestCount = 0;
   int rimSign = +1;  // +1: gradient points outwards (dark inside), -1: inwards
   for (int sign : {+1, -1}) {
-    std::vector<Eigen::Vector2d> pts;
+    std::vector<Eigen::Vector2d> pts, normals;
     for (const Candidate& c : candidates)
-      if (c.radialCos * sign > 0) pts.push_back(c.p);
+      if (c.radialCos * sign > 0) {
+        pts.push_back(c.p);
+        normals.push_back(sign * c.normal);  // outwards for either polarity
+      }
     if (static_cast<int>(pts.size()) < params.minInliers || pts.size() <= bestCount) continue;
     const Eigen::Vector2d e0{c0.x, c0.y};
     auto fit = [&](const std::vector<std::size_t>& s) -> std::optional<Circle> {
@@ -311,7 +319,17 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
         return std::nullopt;
       return c;
     };
-    auto res = [&](const Circle& c, std::size_t i) { return std::abs(residual(c, pts[i])); };
+    // An inlier lies near the circle AND its gradient points along the circle's radial: a
+    // straight edge (an occluder's border) just outside an occluded sector meets a wrong circle
+    // in a few points at the right distance, but its normals fan away from that circle's radials.
+    const double cosHyp = std::cos(kHypothesisToleranceDeg * kPi / 180.0);
+    auto res = [&](const Circle& c, std::size_t i) {
+      const Eigen::Vector2d radial = pts[i] - c.centre;
+      const double n = radial.norm();
+      if (n == 0.0 || normals[i].dot(radial) < cosHyp * n)
+        return std::numeric_limits<double>::infinity();
+      return std::abs(n - c.radius);
+    };
     auto found = ransac<Circle>(pts.size(), 3, fit, res, rp);
     if (found && found->inliers.size() > bestCount) {
       bestCount = found->inliers.size();

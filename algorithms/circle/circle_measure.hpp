@@ -8,13 +8,17 @@
 //      (annulus_edges.hpp);
 //   3. subpixel Facet-model edge points (algorithms/edges);
 //   4. outliers removed by gradient direction: near-radial within a tolerance, expected polarity;
-//   5. RANSAC circle, then a geometric (orthogonal distance) least-squares fit on the inliers by
+//   5. RANSAC circle (an inlier lies near the hypothesis AND its gradient is radial to it within
+//      12 degrees, so a straight edge next to an occluded sector cannot lend a wrong circle its
+//      points), then a geometric (orthogonal distance) least-squares fit on the inliers by
 //      Levenberg-Marquardt, optionally with a robust Huber/Tukey weight (IRLS); the curvature
 //      bias of second-derivative edges (-k / r) is corrected with a measured k;
 //   6. (default) a grey-value refinement on the rim the inliers cover (circle_profile_fit.hpp):
 //      a blurred-disc model fitted to every pixel of a band around the rim. It reaches the
 //      Cramer-Rao bound where edge points stay about 2x above it (small circles) and corrects the
-//      curvature bias from the fitted blur instead of a constant.
+//      curvature bias from the fitted blur instead of a constant. Angular sectors whose grey
+//      residuals are too large for the noise (faint clutter near the rim) are dropped and the
+//      fit repeated.
 // RMS, roundness, inliers and coverage always describe the edge points of step 5.
 //
 // Failures are reported as flags with a cause and a message, never as a bogus circle: when

@@ -3,14 +3,17 @@
 //
 // Edge points use one estimate per rim pixel from a 5x5 window; near the Cramer-Rao bound of a
 // small circle (r = 10 px, noise 2, contrast 100: about 0.01 px in the centre) that is not
-// enough. This fit instead uses every pixel of a band around the rim and fits the grey values
-// directly with the model of a blurred disc,
+// enough. This fit instead uses every pixel of a band (6 px either side) around the rim and fits
+// the grey values directly with the model of a blurred disc,
 //   I(x, y) = a(theta) + b(theta) * Phi(-(|p - c| - R) / s),
 // where Phi is the standard normal CDF, s the blur (PSF sigma and pixel size combined), b the
 // contrast (inside minus outside) and a(x, y) = a0 + g . (p - c0) the outside grey with an
 // illumination ramp g. In a thin band a ramp looks much like a shifted rim (it would cost half
 // the precision of a small circle), so g is kept only when it is significant (chi-square, 99.9%).
-// Levenberg-Marquardt; Tukey weights on the grey residuals reject clutter.
+// Levenberg-Marquardt; Tukey weights on the grey residuals (from the first step on) reject
+// clutter, and angular sectors whose residuals stay too large for the noise (the blurred tail of
+// a blob next to the rim, each pixel within the Tukey weight's reach) are dropped before a final
+// solve.
 //
 // The 50% level of a blurred disc lies s^2 / (2 R) inside its true rim (the disc is convex, so
 // it covers less than half of the PSF centred on its rim); the fitted s corrects that bias

@@ -1,7 +1,11 @@
 #include "service/daemon/image_archive.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
-#include <fstream>
+#include <cerrno>
+#include <cstring>
 #include <stdexcept>
 #include <vector>
 
@@ -10,6 +14,37 @@
 namespace facet::service {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::string_view kPartialSuffix = ".partial";
+
+std::runtime_error writeError(const fs::path& file, int error) {
+  return std::runtime_error(file.string() + ": " + std::strerror(error) +
+                            (error == ENOSPC || error == EDQUOT ? " (archive disk full)" : ""));
+}
+
+// Writes every byte or throws with errno's reason; a write(2) may store only part of the buffer
+// (a filling disk), so loop until it is all written or the disk refuses more.
+void writeAll(const fs::path& file, const std::vector<unsigned char>& bytes) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw writeError(file, errno);
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int error = n < 0 ? errno : ENOSPC;
+      ::close(fd);
+      throw writeError(file, error);
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  // Some filesystems (NFS, quotas) report a full disk only when the file is closed.
+  if (::close(fd) != 0) throw writeError(file, errno);
+}
+
+}  // namespace
 
 ImageArchive::ImageArchive(ArchivePolicy policy) : policy_(std::move(policy)) {
   std::error_code ec;
@@ -20,10 +55,14 @@ ImageArchive::ImageArchive(ArchivePolicy policy) : policy_(std::move(policy)) {
     return;
   }
   std::vector<std::pair<fs::file_time_type, std::pair<fs::path, std::uint64_t>>> found;
+  std::vector<fs::path> stale;
   for (const auto& entry : fs::recursive_directory_iterator(policy_.folder, ec)) {
+    if (entry.is_regular_file() && entry.path().extension() == kPartialSuffix)
+      stale.push_back(entry.path());  // a write cut short by a crash or power loss
     if (!entry.is_regular_file() || entry.path().extension() != ".png") continue;
     found.push_back({entry.last_write_time(), {entry.path(), entry.file_size()}});
   }
+  for (const auto& file : stale) fs::remove(file, ec);
   std::sort(found.begin(), found.end());
   for (auto& [time, file] : found) {
     bytes_ += file.second;
@@ -42,18 +81,15 @@ void ImageArchive::writeFile(const fs::path& file, const cv::Mat& image) {
   if (!cv::imencode(".png", image, png))
     throw std::runtime_error(file.string() + ": cannot encode");
   // Written to a temporary name and renamed, so a full disk never leaves a truncated PNG behind.
-  const fs::path partial = file.string() + ".partial";
-  {
-    std::ofstream out(partial, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(png.data()), static_cast<std::streamsize>(png.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ignore;
-      fs::remove(partial, ignore);
-      throw std::runtime_error(file.string() + ": write failed (disk full?)");
-    }
+  const fs::path partial = file.string() + std::string(kPartialSuffix);
+  try {
+    writeAll(partial, png);
+    fs::rename(partial, file);
+  } catch (...) {
+    std::error_code ignore;
+    fs::remove(partial, ignore);
+    throw;
   }
-  fs::rename(partial, file);
   files_.push_back({file, png.size()});
   bytes_ += png.size();
 }

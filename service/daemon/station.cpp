@@ -90,6 +90,8 @@ Station::Station(config::StationConfig config, StationOptions options)
   active_ = inspectionFor(first, &error);
   if (!active_) throw std::runtime_error("recipe " + std::to_string(first) + ": " + error);
 
+  // Every recorded file is a part: one the replay cannot read is answered "not inspected".
+  config_.camera.replay.report_unreadable = true;
   camera_ = makeCamera(config_.camera);
   if (!config_.camera.scans.folder.empty()) scans_ = makeScanReplay(config_.camera.scans);
   if (options_.usePlc)
@@ -297,9 +299,22 @@ void Station::acquisitionLoop() {
       case GrabStatus::EndOfStream:
         endOfStream = true;
         break;
+      case GrabStatus::Error:
+        if (!grab.frame.source.empty()) {
+          // A recorded file the replay refused (truncated, empty, not an image, oversized): a
+          // part that was not inspected, stored under its file name, never skipped silently.
+          metrics_.counter("facet_refused_files_total", "Replay files refused as not inspected")
+              .increment();
+          job->partId = nextPartId_++;
+          ++partsTaken_;
+          job->frame = std::move(grab.frame);
+          job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
+          publishNotInspected(std::move(*job), "not inspected: " + grab.message);
+          continue;
+        }
+        [[fallthrough]];
       case GrabStatus::Disconnected:
       case GrabStatus::NotStarted:
-      case GrabStatus::Error:
         metrics_.counter("facet_camera_errors_total", "Grabs that failed").increment();
         spdlog::warn("camera: {}: {}", toString(grab.status), grab.message);
         if (trigger) {
@@ -519,8 +534,18 @@ void Station::publish(PartResult part, const cv::Mat& image, const Overlay& over
     last.pass = part.verdict == Verdict::Pass;
     if (archive_) archive_->archive(part, image, [&last] { return last.draw(); });
   }
+  const bool archiveDegraded = archive_ && archive_->degraded();
   metrics_.gauge("facet_archive_degraded", "1 while the image archive cannot write")
-      .set(archive_ && archive_->degraded() ? 1 : 0);
+      .set(archiveDegraded ? 1 : 0);
+  // Logged when the state changes, not per part: a full disk must not flood the journal.
+  if (archiveDegraded != archiveDegradedLogged_) {
+    archiveDegradedLogged_ = archiveDegraded;
+    if (archiveDegraded)
+      spdlog::error("archive degraded: {} (parts are still inspected and stored)",
+                    archive_->lastError());
+    else
+      spdlog::info("archive writable again: {}", config_.archive.folder.string());
+  }
   std::lock_guard lock(recentMutex_);
   ++shiftCounts_[verdictName(part.verdict)];
   recent_.push_back(std::move(part));

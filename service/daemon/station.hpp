@@ -7,9 +7,10 @@
 //   publishing   PLC registers, results store, image archive, metrics, last result for HTTP
 //
 // Every part that was triggered or grabbed gets a result: a frame that could not be grabbed,
-// was incomplete, or was dropped because inspection fell behind is published as Verdict::Error
-// ("not inspected"), never as good. Results are never dropped between inspection and
-// publishing (that queue blocks); the PLC link keeps its own bounded, counted queue.
+// was incomplete, was a replay file that could not be read, or was dropped because inspection
+// fell behind is published as Verdict::Error ("not inspected"), never as good. Results are
+// never dropped between inspection and publishing (that queue blocks); the PLC link keeps its
+// own bounded, counted queue.
 
 #include <atomic>
 #include <chrono>
@@ -126,6 +127,7 @@ class Station : public StationView {
   std::atomic<bool> finished_{false};
   std::atomic<bool> drained_{false};
   bool scansEnded_ = false;  // the scan replay has delivered every file (acquisition thread)
+  bool archiveDegradedLogged_ = false;  // the archive state last logged (publishing thread)
   std::atomic<std::uint64_t> nextPartId_{1};
   std::uint64_t firstPartId_ = 1;  // the first id of this run (the store may hold older ones)
   std::atomic<std::uint64_t> partsTaken_{0};

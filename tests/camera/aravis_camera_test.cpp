@@ -283,5 +283,66 @@ TEST(AravisCamera, SurvivesTheCameraGoingAwayAndComingBack) {
   EXPECT_GT(next.frame.id, r.frame.id);
 }
 
+// Aravis sizes the GVSP socket's receive buffer only when the first frame arrives: a frame
+// bigger than the system's default buffer, sent as one burst on loopback, used to lose packets
+// on the first frame of every stream (the first part after each reconnection).
+TEST(AravisCamera, FirstFrameOfEveryStreamIsComplete) {
+  FakeGigECamera fake;
+  ASSERT_TRUE(fake.running());
+  auto s = settingsFor(640, 480);
+  s.region = {0, 0, 640, 480};  // 300 KB: more than a default 208 KB socket buffer
+  s.frame_rate_hz.reset();
+  s.trigger = TriggerMode::Software;
+  const cv::Mat expected = FakeGigECamera::sensor8()(cv::Rect(0, 0, 640, 480));
+  for (int run = 0; run < 4; ++run) {
+    AravisCamera camera(s);
+    camera.open();
+    camera.start();
+    camera.softwareTrigger();
+    GrabResult r = camera.grab(2s);
+    ASSERT_TRUE(r.ok()) << "stream " << run << ": " << r.message;
+    EXPECT_TRUE(sameImage(r.frame.image, expected)) << "stream " << run;
+  }
+}
+
+// A software-triggered camera waiting for its next part is silent, like a dead one: the loss
+// must show in health() without a grab() (a station waiting for the PLC's trigger grabs
+// nothing), and so must the return, so that no part is spent on discovering either.
+TEST(AravisCamera, TriggeredCameraLossAndReturnShowInHealthWithoutGrabbing) {
+  FakeGigECamera fake;
+  ASSERT_TRUE(fake.running());
+  auto s = settingsFor();
+  s.frame_rate_hz.reset();
+  s.trigger = TriggerMode::Software;
+  AravisCamera camera(s);
+  camera.open();
+  camera.start();
+  camera.softwareTrigger();
+  ASSERT_TRUE(camera.grab(2s).ok());
+  auto waitFor = [&](auto done) {
+    for (int i = 0; i < 150 && !done(camera.health()); ++i) std::this_thread::sleep_for(100ms);
+    return done(camera.health());
+  };
+  std::this_thread::sleep_for(1500ms);
+  EXPECT_TRUE(camera.health().connected) << "a quiet triggered camera is not a lost camera";
+
+  fake.unplug();
+  ASSERT_TRUE(waitFor([](const CameraHealth& h) { return !h.connected; }))
+      << "the loss was not noticed without grab()";
+  EXPECT_NE(camera.health().last_error.find("lost"), std::string::npos)
+      << camera.health().last_error;
+  EXPECT_EQ(camera.grab(100ms).status, GrabStatus::Disconnected);
+
+  fake.plugIn();
+  ASSERT_TRUE(fake.running());
+  ASSERT_TRUE(waitFor([](const CameraHealth& h) { return h.connected && h.reconnects == 1; }))
+      << "the return was not noticed without grab(): " << camera.health().last_error;
+  camera.softwareTrigger();
+  GrabResult r = camera.grab(2s);
+  ASSERT_TRUE(r.ok()) << "the first part after the return: " << r.message;
+  EXPECT_TRUE(sameImage(r.frame.image, FakeGigECamera::sensor8()(cv::Rect(16, 8, 160, 120))));
+  EXPECT_EQ(camera.health().reconnects, 1u);
+}
+
 }  // namespace
 }  // namespace facet

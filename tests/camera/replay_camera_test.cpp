@@ -253,6 +253,39 @@ TEST(ReplayCamera, LoopOverOnlyBrokenFilesEndsWithError) {
   EXPECT_EQ(camera.health().skipped_files, 2u);
 }
 
+TEST(ReplayCamera, ReportUnreadableReturnsEachBadFileOnceAsAnErrorNamingIt) {
+  TempFolder folder;
+  const cv::Mat good = randomImage(16, 16, CV_8UC1, 3);
+  cv::imwrite((folder / "a1.png").string(), good);
+  folder.write("a2.png", "junk");
+  folder.write("a2.png.json", R"({"serial": "S-2", "expected_verdict": "pass"})");
+  cv::imwrite((folder / "a3.png").string(), good);
+  auto settings = replayOf(folder);
+  settings.loop = true;
+  settings.report_unreadable = true;
+  ReplayCamera camera(settings);
+  camera.open();
+  camera.start();
+  const GrabResult first = camera.grab(1s);
+  ASSERT_TRUE(first.ok()) << first.message;
+  const GrabResult refused = camera.grab(1s);
+  ASSERT_EQ(refused.status, GrabStatus::Error);
+  EXPECT_EQ(refused.frame.source, (folder / "a2.png").string());
+  EXPECT_NE(refused.message.find("a2.png"), std::string::npos) << refused.message;
+  EXPECT_TRUE(refused.frame.image.empty());
+  EXPECT_EQ(refused.frame.metadata.at("serial"), "S-2");
+  const GrabResult third = camera.grab(1s);
+  ASSERT_TRUE(third.ok()) << third.message;
+  EXPECT_EQ(third.frame.id, 1u) << "a refused file takes no frame number";
+  // The second pass skips it: a1, a3, a1.
+  for (const char* name : {"a1.png", "a3.png", "a1.png"}) {
+    const GrabResult r = camera.grab(1s);
+    ASSERT_TRUE(r.ok()) << r.message;
+    EXPECT_NE(r.frame.source.find(name), std::string::npos) << r.frame.source;
+  }
+  EXPECT_EQ(camera.health().skipped_files, 2u);
+}
+
 TEST(ReplayCamera, MissingOrEmptyFolderIsAnErrorNamingIt) {
   TempFolder folder;
   auto settings = replayOf(folder);

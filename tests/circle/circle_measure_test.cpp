@@ -1,5 +1,6 @@
 // CircleMeasure on generated scenes with exact ground truth: accuracy for both polarities, a ring
 // measured as two concentric circles, partial arcs, every failure flag and bad input.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -281,6 +282,76 @@ TEST(CircleMeasure, CircleCutByTheImageBorderIsAPartialArc) {
   EXPECT_NEAR(m.radius, 30.2, 0.1);
   EXPECT_LT(m.coverageDeg, 250.0);
   EXPECT_GT(m.coverageDeg, 150.0);
+}
+
+// An occluding strip hides 30% of a small rim and its far border, a straight edge of the rim's
+// polarity, runs 2 px outside the hidden sector; blobs next to the rim pull a few true edge points
+// off it. A circle through the border and the visible rim then fits almost as many edge points at
+// the RANSAC threshold as the true one, but their gradients fan away from its radials. The wrong
+// circle wins only now and then (here once in 160 scenes, 1.3 px off, without the radial test in
+// RANSAC), hence the many scenes; they are the bench's hard case at r = 10. Large dark blobs
+// inside the rim must not drag the grey-value fit either (one scene measured 0.15 px too large a
+// radius while that fit's first step was unweighted).
+TEST(CircleMeasure, StraightBorderBesideAnOccludedSectorDoesNotMakeACircle) {
+  std::mt19937_64 rng(48);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double worst = 0.0;
+  for (int trial = 0; trial < 160; ++trial) {
+    SceneSpec sp = spec(80, 70);
+    sp.seed = rng();
+    Scene s(sp);
+    const cv::Point2d c{39.5 + u(rng) - 0.5, 39.5 + u(rng) - 0.5};
+    const double radius = 9.7 + 0.6 * u(rng);
+    s.addDisc(c, radius, 170);
+    for (int k = 0; k < 3; ++k) {  // blobs 3 to 4.5 px off the rim, at least 1.5 px clear of it
+      const double a = 2 * std::numbers::pi * u(rng);
+      const double off = (u(rng) < 0.5 ? -1.0 : 1.0) * (3.0 + 1.5 * u(rng));
+      const double grey = 255.0 * u(rng);
+      const double blob = 0.7 + (std::abs(off) - 2.2) * u(rng);
+      s.addDisc(c + (radius + off) * cv::Point2d(std::cos(a), std::sin(a)), blob, grey, "clutter");
+    }
+    s.addOccluder({c.x - radius, c.y - radius, 2 * radius, 2 * radius}, 0.206,
+                  100.0 + 60.0 * u(rng));
+    const double a = 2 * std::numbers::pi * u(rng);
+    const auto m = measureCircle(s.render(), params(c + 1.8 * cv::Point2d(std::cos(a), std::sin(a)),
+                                                    10, CirclePolarity::LightToDark));
+    ASSERT_TRUE(m.ok()) << "trial " << trial << ": " << m.message;
+    worst = std::max(worst, std::hypot(m.centre.x - c.x, m.centre.y - c.y));
+    worst = std::max(worst, std::abs(m.radius - radius));
+  }
+  EXPECT_LT(worst, 0.1);
+}
+
+// Clutter blobs 1.5 to 2 px clear of a small rim, 75 to 90 grey levels off their surroundings:
+// pixels near their detected edges stay out of the grey-value fit, but the blur carries a few grey
+// levels of their contrast onto the rim pixels of their sectors, which no single pixel's Tukey
+// weight notices. Those sectors' residuals stand out, and the sectors leave the fit (without that
+// step the centre RMS here is about 0.026 px).
+TEST(CircleMeasure, ClutterBlobsNextToASmallRimLeaveTheGreyValueFit) {
+  std::mt19937_64 rng(14);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  double sum2 = 0.0;
+  const int trials = 16;
+  for (int trial = 0; trial < trials; ++trial) {
+    SceneSpec sp = spec(80, 70);
+    sp.seed = rng();
+    Scene s(sp);
+    const cv::Point2d c{39.5 + u(rng) - 0.5, 39.5 + u(rng) - 0.5};
+    s.addDisc(c, 10.0, 170);
+    // Blob: distance of its centre from the rim (negative: inside), its radius, its grey.
+    const double blobs[3][3] = {{-4.4, 2.8, 244}, {3.3, 1.35, 159}, {4.4, 1.65, 160}};
+    for (int k = 0; k < 3; ++k) {
+      const double a = 2 * std::numbers::pi * (k + 0.3 * u(rng)) / 3.0;
+      s.addDisc(c + (10.0 + blobs[k][0]) * cv::Point2d(std::cos(a), std::sin(a)), blobs[k][1],
+                blobs[k][2], "clutter");
+    }
+    const auto m = measureCircle(s.render(), params({39.5, 39.5}, 10, CirclePolarity::LightToDark));
+    ASSERT_TRUE(m.ok()) << "trial " << trial << ": " << m.message;
+    ASSERT_TRUE(m.greyRefined);
+    sum2 += std::pow(m.centre.x - c.x, 2) + std::pow(m.centre.y - c.y, 2);
+  }
+  const double rms = std::sqrt(sum2 / trials);
+  EXPECT_LT(rms, 0.02);
 }
 
 TEST(CircleMeasure, AbsurdAnnulusIsBadInput) {

@@ -1,14 +1,10 @@
 #include "tests/daemon/line_run.hpp"
 
-#include <arpa/inet.h>
-#include <netinet/in.h>
 #include <sqlite3.h>
-#include <sys/socket.h>
-#include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
+#include <memory>
 #include <stdexcept>
 #include <thread>
 
@@ -24,24 +20,21 @@ std::string text(sqlite3_stmt* s, int column) {
   return p ? reinterpret_cast<const char*>(p) : "";
 }
 
-// Runs `sql` on a read-only connection and calls `row` per result row.
+// Runs `sql` on a read-only connection and calls `row` per result row. The connection and the
+// statement are released even when `row` throws (callers poll while facetd is still writing).
 template <typename Row>
 void query(const std::string& database, const std::string& sql, Row row) {
-  sqlite3* db = nullptr;
-  if (sqlite3_open_v2(database.c_str(), &db, SQLITE_OPEN_READONLY, nullptr) != SQLITE_OK) {
-    sqlite3_close(db);
-    throw std::runtime_error(database + ": cannot open");
-  }
-  sqlite3_busy_timeout(db, 5000);  // facetd may be writing (WAL) or creating the schema
-  sqlite3_stmt* s = nullptr;
-  if (sqlite3_prepare_v2(db, sql.c_str(), -1, &s, nullptr) != SQLITE_OK) {
-    const std::string message = sqlite3_errmsg(db);
-    sqlite3_close(db);
-    throw std::runtime_error(database + ": " + message);
-  }
-  while (sqlite3_step(s) == SQLITE_ROW) row(s);
-  sqlite3_finalize(s);
-  sqlite3_close(db);
+  sqlite3* raw = nullptr;
+  const int opened = sqlite3_open_v2(database.c_str(), &raw, SQLITE_OPEN_READONLY, nullptr);
+  const std::unique_ptr<sqlite3, int (*)(sqlite3*)> db(raw, sqlite3_close);
+  if (opened != SQLITE_OK) throw std::runtime_error(database + ": cannot open");
+  sqlite3_busy_timeout(db.get(), 5000);  // facetd may be writing (WAL) or creating the schema
+  sqlite3_stmt* rawStatement = nullptr;
+  if (sqlite3_prepare_v2(db.get(), sql.c_str(), -1, &rawStatement, nullptr) != SQLITE_OK)
+    throw std::runtime_error(database + ": " + sqlite3_errmsg(db.get()));
+  const std::unique_ptr<sqlite3_stmt, int (*)(sqlite3_stmt*)> statement(rawStatement,
+                                                                        sqlite3_finalize);
+  while (sqlite3_step(statement.get()) == SQLITE_ROW) row(statement.get());
 }
 
 }  // namespace
@@ -64,7 +57,7 @@ std::vector<StoredPart> storedParts(const std::string& database) {
   std::map<std::int64_t, std::size_t> index;
   query(database,
         "SELECT part_id, recipe_id, frame_id, source, serial, expected, verdict, failed_checks, "
-        "error "
+        "error, recipe_name, recipe_version "
         "FROM parts ORDER BY part_id",
         [&](sqlite3_stmt* s) {
           StoredPart p;
@@ -77,6 +70,8 @@ std::vector<StoredPart> storedParts(const std::string& database) {
           p.verdict = text(s, 6);
           p.failedChecks = text(s, 7);
           p.error = text(s, 8);
+          p.recipeName = text(s, 9);
+          p.recipeVersion = text(s, 10);
           index[p.partId] = parts.size();
           parts.push_back(p);
         });
@@ -91,6 +86,23 @@ std::vector<StoredPart> storedParts(const std::string& database) {
   return parts;
 }
 
+std::optional<std::vector<StoredPart>> waitForStored(
+    const std::string& database, const std::function<bool(const std::vector<StoredPart>&)>& done,
+    std::chrono::milliseconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (true) {
+    std::vector<StoredPart> parts;
+    try {
+      if (std::filesystem::exists(database)) parts = storedParts(database);
+    } catch (const std::exception&) {
+      // facetd has created the file but not yet its tables
+    }
+    if (done(parts)) return parts;
+    if (std::chrono::steady_clock::now() > until) return std::nullopt;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+}
+
 std::string integrityCheck(const std::string& database) {
   std::string answer;
   query(database, "PRAGMA integrity_check", [&](sqlite3_stmt* s) { answer += text(s, 0); });
@@ -103,64 +115,18 @@ std::string journalMode(const std::string& database) {
   return answer;
 }
 
-std::string httpGet(int port, const std::string& path) {
-  const int fd = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
-  sockaddr_in address{};
-  address.sin_family = AF_INET;
-  address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  address.sin_port = htons(static_cast<std::uint16_t>(port));
-  if (fd < 0 || ::connect(fd, reinterpret_cast<sockaddr*>(&address), sizeof(address)) != 0) {
-    if (fd >= 0) ::close(fd);
-    throw std::runtime_error("facetd does not answer on port " + std::to_string(port));
-  }
-  const std::string request =
-      "GET " + path + " HTTP/1.1\r\nHost: 127.0.0.1\r\nConnection: close\r\n\r\n";
-  std::string reply;
-  if (::send(fd, request.data(), request.size(), MSG_NOSIGNAL) == ssize_t(request.size())) {
-    char chunk[8192];
-    ssize_t n = 0;
-    while ((n = ::recv(fd, chunk, sizeof chunk, 0)) > 0)
-      reply.append(chunk, static_cast<std::size_t>(n));
-  }
-  ::close(fd);
-  const auto body = reply.find("\r\n\r\n");
-  if (reply.rfind("HTTP/1.1 200", 0) != 0 || body == std::string::npos)
-    throw std::runtime_error("GET " + path + ": " + reply.substr(0, reply.find('\r')));
-  return reply.substr(body + 4);
-}
-
-std::optional<double> metricValue(const std::string& exposition, const std::string& series) {
-  std::istringstream lines(exposition);
-  std::string line;
-  while (std::getline(lines, line))
-    if (line.size() > series.size() && line.rfind(series, 0) == 0 && line[series.size()] == ' ')
-      return std::stod(line.substr(series.size() + 1));
-  return std::nullopt;
-}
-
-int readHttpPort(const std::string& portFile, std::chrono::milliseconds timeout) {
-  const auto until = std::chrono::steady_clock::now() + timeout;
-  do {
-    std::stringstream content;
-    content << std::ifstream(portFile).rdbuf();
-    const std::string text = content.str();  // complete once the newline is there
-    if (!text.empty() && text.back() == '\n') return std::stoi(text);
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  } while (std::chrono::steady_clock::now() < until);
-  return 0;
-}
-
 std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort,
-                             const std::string& plcMode, const std::string& plcOptions) {
+                             const StationFileOptions& options) {
   const std::string recipes = std::string(FACET_SOURCE_DIR) + "/recipes";
   std::ofstream f(dir + "/station.yaml");
   f << "schema_version: 1\nname: integration-station\ncamera:\n" << camera;
   f << "  scans:\n    folder: " << recipes << "/demo/scan_offset\n    glob: \"*.csv\"\n";
   {  // facetd --no-plc ignores the section, but the station file needs one
-    f << "plc:\n  role: client\n  mode: " << plcMode << "\n  transport: tcp\n  host: 127.0.0.1\n"
+    f << "plc:\n  role: client\n  mode: " << options.plcMode
+      << "\n  transport: tcp\n  host: 127.0.0.1\n"
       << "  port: " << (plcPort > 0 ? plcPort : 502) << "\n  unit_id: 1\n  word_order: ABCD\n"
       << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
-      << plcOptions << "  register_map:\n    address_base: 0\n    control:\n"
+      << options.plcExtra << "  register_map:\n    address_base: 0\n    control:\n"
       << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n"
       << "      recipe_select: {register: 0}\n    status:\n"
       << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
@@ -169,9 +135,10 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
       << "      error_code: {register: 10}\n      heartbeat: {register: 11}\n"
       << "      inspection_counter: {register: 12}\n      active_recipe: {register: 13}\n";
   }
-  f << "recipes: " << recipes << "\n";
+  f << "recipes: " << (options.recipes.empty() ? recipes : options.recipes) << "\n";
   f << "results:\n  database: " << dir << "/results.db\n";
-  f << "archive:\n  folder: " << dir << "/archive\n  quota_mb: 50\n  keep: fail\n";
+  f << "archive:\n  folder: " << dir << "/archive\n  quota_mb: " << options.archiveQuotaMb
+    << "\n  keep: " << options.archiveKeep << "\n";
   f << "http:\n  bind: 127.0.0.1\n  port: 0\n";
   f << "calibration:\n  file: " << recipes << "/calibration.yaml\n";
   return dir + "/station.yaml";

@@ -4,6 +4,7 @@
 // triggers, and, afterwards, what facetd left in its SQLite results store.
 
 #include <chrono>
+#include <functional>
 #include <map>
 #include <optional>
 #include <string>
@@ -32,32 +33,38 @@ struct StoredPart {
   int recipeId = 0;
   std::int64_t frameId = 0;
   std::string source, serial, expected, verdict, failedChecks, error;
+  std::string recipeName, recipeVersion;  // recipe_version: the recipe file's content hash
   std::map<std::string, StoredMeasurement> measurements;
 };
 
-// The body of GET http://127.0.0.1:<port><path>; throws std::runtime_error when facetd does not
-// answer 200.
-std::string httpGet(int port, const std::string& path);
-// The value of one sample of a Prometheus exposition (`series` with its labels, e.g.
-// facet_queue_depth{queue="plc"}); nullopt when absent.
-std::optional<double> metricValue(const std::string& exposition, const std::string& series);
-// The HTTP port facetd wrote to --http-port-file, waiting for it at most `timeout`; 0 if none.
-int readHttpPort(const std::string& portFile, std::chrono::milliseconds timeout);
-
 // Every row of the results store, in part order.
 std::vector<StoredPart> storedParts(const std::string& database);
+// Polls the store (every 100 ms) until `done` holds for its rows; returns them then, or nullopt
+// when `timeout` passes first. A store facetd has not created yet counts as no rows.
+std::optional<std::vector<StoredPart>> waitForStored(
+    const std::string& database, const std::function<bool(const std::vector<StoredPart>&)>& done,
+    std::chrono::milliseconds timeout);
 // PRAGMA integrity_check's answer ("ok" when the file is sound).
 std::string integrityCheck(const std::string& database);
 // PRAGMA journal_mode as stored in the file ("wal" for facetd's store).
 std::string journalMode(const std::string& database);
 
+// What a test may change in the station file; the defaults are the repository's recipes folder
+// and an archive of failed parts.
+struct StationFileOptions {
+  std::string recipes;                // recipes folder; empty: FACET_SOURCE_DIR/recipes
+  std::string archiveKeep = "fail";   // archive.keep: none, fail or all
+  double archiveQuotaMb = 50;         // archive.quota_mb
+  std::string plcMode = "triggered";  // plc.mode: triggered or free_run
+  std::string plcExtra;               // more keys of the plc section, YAML lines indented by two
+                                      // spaces (e.g. "  queue_capacity: 16\n")
+};
+
 // The station file for a test: results, archive and HTTP in `dir`; `camera` is the YAML of the
 // camera section (indented by two spaces); plcPort 0: a placeholder PLC section for facetd
-// --no-plc. `plcMode`: triggered or free_run; `plcOptions`: more keys of the plc section
-// (YAML lines indented by two spaces, e.g. "  queue_capacity: 16\n").
+// --no-plc.
 std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort,
-                             const std::string& plcMode = "triggered",
-                             const std::string& plcOptions = "");
+                             const StationFileOptions& options = {});
 
 // The pymodbus peer's config for that station and the bracket_shape recipe's PLC outputs. In
 // free run the peer reports every write of the inspection counter (report_writes).

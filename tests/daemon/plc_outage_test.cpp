@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "tests/daemon/child_process.hpp"
+#include "tests/daemon/facetd_http.hpp"
 #include "tests/daemon/line_run.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
 
@@ -71,7 +72,9 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
       "  backend: replay\n  replay:\n    folder: " + images +
           "\n    glob: \"*.png\"\n    loop: false\n    fps: 40\n    trigger: free_run\n"
           "    colour: mono\n",
-      plcPort, "free_run", "  queue_capacity: " + std::to_string(kQueueCapacity) + "\n");
+      plcPort,
+      {.plcMode = "free_run",
+       .plcExtra = "  queue_capacity: " + std::to_string(kQueueCapacity) + "\n"});
   const std::string peerConfig = writePeerConfig(station, /*freeRun=*/true);
   plc::test::PymodbusPlc plc(peerConfig, plcPort);
   plc.start();
@@ -79,8 +82,8 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
   ChildProcess facetd({FACETD_PATH, "--config", station, "--recipe", "2", "--http-port-file",
                        dir / "http.port", "--log-level", "info"},
                       {}, dir / "facetd.log");
-  const int httpPort = readHttpPort(dir / "http.port", 30s);
-  ASSERT_GT(httpPort, 0) << "facetd did not start; see " << dir / "facetd.log";
+  const auto httpPort = waitForHttpPort(dir / "http.port", 30s);
+  ASSERT_TRUE(httpPort) << "facetd did not start; see " << dir / "facetd.log";
 
   // The highest inspection counter the PLC has seen so far.
   auto seenUpTo = [&](int counter) {
@@ -124,7 +127,7 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
   bool settled = false;
   while (!settled && Clock::now() < until) {
     std::this_thread::sleep_for(200ms);
-    metrics = httpGet(httpPort, "/metrics");
+    metrics = httpGet(*httpPort, "/metrics").value_or("");
     const auto parts = metricValue(metrics, "facet_parts_total{verdict=\"pass\"}").value_or(0) +
                        metricValue(metrics, "facet_parts_total{verdict=\"fail\"}").value_or(0) +
                        metricValue(metrics, "facet_parts_total{verdict=\"error\"}").value_or(0);

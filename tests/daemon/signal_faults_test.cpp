@@ -59,7 +59,7 @@ std::size_t storedCount(const std::string& database) {
   }
 }
 
-bool waitForStored(const std::string& database, std::size_t n, std::chrono::seconds timeout) {
+bool waitForCount(const std::string& database, std::size_t n, std::chrono::seconds timeout) {
   const auto until = Clock::now() + timeout;
   while (Clock::now() < until) {
     if (storedCount(database) >= n) return true;
@@ -84,7 +84,8 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
   }
   // A free-run PLC that reports every result as it lands: the finished part must reach it too.
   const int plcPort = plc::test::freeTcpPort();
-  const auto station = writeStationFile(dir.path(), replayCamera(images, 2), plcPort, "free_run");
+  const auto station =
+      writeStationFile(dir.path(), replayCamera(images, 2), plcPort, {.plcMode = "free_run"});
   const std::string peerConfig = writePeerConfig(station, /*freeRun=*/true);
   plc::test::PymodbusPlc plc(peerConfig, plcPort);
   plc.start();
@@ -153,7 +154,7 @@ TEST(SignalFaults, RepeatedSigkillKeepsTheStoreSoundInWalAndPartIdsContinue) {
   int walLeftBehind = 0;
   for (int round = 0; round < 3; ++round) {
     auto facetd = startFacetd(dir, station, "warn");
-    ASSERT_TRUE(waitForStored(database, before.size() + 30, 60s))
+    ASSERT_TRUE(waitForCount(database, before.size() + 30, 60s))
         << "round " << round << ": facetd stores no parts; see " << dir / "facetd.log";
     std::this_thread::sleep_for(std::chrono::milliseconds(random() % 200));
     facetd->signal(SIGKILL);
@@ -181,7 +182,7 @@ TEST(SignalFaults, RepeatedSigkillKeepsTheStoreSoundInWalAndPartIdsContinue) {
 
   // A last clean run continues after the last part of the third kill.
   auto facetd = startFacetd(dir, station, "warn");
-  ASSERT_TRUE(waitForStored(database, before.size() + 10, 60s));
+  ASSERT_TRUE(waitForCount(database, before.size() + 10, 60s));
   facetd->signal(SIGTERM);
   EXPECT_EQ(facetd->wait(20s), std::optional<int>(0));
   const auto last = storedParts(database);

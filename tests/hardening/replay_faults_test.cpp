@@ -3,8 +3,6 @@
 // none crashes the replay, the good frames around them still arrive byte-exact, and memory stays
 // bounded even when headers announce gigabytes of pixels.
 
-#include <zlib.h>
-
 #include <chrono>
 #include <cstdint>
 #include <filesystem>
@@ -15,9 +13,9 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include "camera/replay_camera.hpp"
+#include "tests/hardening/bad_image_files.hpp"
 
 namespace facet {
 namespace {
@@ -47,35 +45,6 @@ class Folder {
   fs::path path_;
 };
 
-std::string encode(const std::string& ext, const cv::Mat& image) {
-  std::vector<std::uint8_t> bytes;
-  cv::imencode(ext, image, bytes);
-  return {bytes.begin(), bytes.end()};
-}
-
-std::string bigEndian32(std::uint32_t v) {
-  return {static_cast<char>(v >> 24), static_cast<char>(v >> 16), static_cast<char>(v >> 8),
-          static_cast<char>(v)};
-}
-
-// A PNG chunk with a correct CRC, so that only the announced size is wrong.
-std::string pngChunk(const std::string& type, const std::string& data) {
-  const std::string body = type + data;
-  const auto crc = static_cast<std::uint32_t>(
-      ::crc32(0, reinterpret_cast<const Bytef*>(body.data()), static_cast<uInt>(body.size())));
-  return bigEndian32(static_cast<std::uint32_t>(data.size())) + body + bigEndian32(crc);
-}
-
-// A PNG whose header announces width x height (bit depth, colour type), with a few bytes of
-// pixel data: what a hostile or corrupt file looks like.
-std::string pngHeaderOnly(std::uint32_t width, std::uint32_t height, char depth, char colour) {
-  std::string ihdr = bigEndian32(width) + bigEndian32(height);
-  ihdr += std::string{depth, colour, 0, 0, 0};
-  const std::string idat = "\x78\x9c\x63\x00\x00\x00\x01\x00\x01";  // zlib of one zero byte
-  return std::string("\x89PNG\r\n\x1a\n", 8) + pngChunk("IHDR", ihdr) + pngChunk("IDAT", idat) +
-         pngChunk("IEND", "");
-}
-
 // Peak resident memory of this process so far, bytes.
 std::uint64_t peakResidentBytes() {
   std::ifstream status("/proc/self/status");
@@ -95,12 +64,12 @@ TEST(ReplayFaults, EveryBadFileIsRefusedWithItsNameAndGoodFramesStillArrive) {
   Folder folder;
   cv::Mat good(48, 64, CV_8UC1);
   cv::randu(good, 0, 256);
-  const std::string png = encode(".png", good);
+  const std::string png = test::encodeImage(".png", good);
   folder.write("part_00_good.png", png);
   folder.write("part_01_truncated.png", png.substr(0, png.size() / 2));
   folder.write("part_02_zero_bytes.png", "");
   folder.write("part_03_text_named_png.png", "serial;verdict\n4711;good\n");
-  folder.write("part_04_huge_30000x30000.png", pngHeaderOnly(30000, 30000, 8, 0));
+  folder.write("part_04_huge_30000x30000.png", test::pngHeaderOnly(30000, 30000, 8, 0));
   folder.write("part_05_huge_pgm.pgm", "P5\n30000 30000\n255\n\x01\x02");
   folder.write("part_06_tiff_named_bmp.bmp", "II*\0garbage");
   folder.write("part_07_good.png", png);
@@ -150,11 +119,11 @@ TEST(ReplayFaults, HugeHeadersUnderThePixelLimitKeepMemoryBounded) {
   // Headers that pass the pixel limit (2^28 by default) but whose data is missing: the reader
   // may reserve the announced size, but must not fill it, and must give it back.
   Folder folder;
-  folder.write("a_16000x16000_mono8.png", pngHeaderOnly(16000, 16000, 8, 0));
-  folder.write("b_16000x16000_rgb16.png", pngHeaderOnly(16000, 16000, 16, 2));
+  folder.write("a_16000x16000_mono8.png", test::pngHeaderOnly(16000, 16000, 8, 0));
+  folder.write("b_16000x16000_rgb16.png", test::pngHeaderOnly(16000, 16000, 16, 2));
   folder.write("c_12000x12000.pgm", "P5\n12000 12000\n65535\n\x01\x02\x03\x04");
   cv::Mat good(32, 32, CV_8UC1, cv::Scalar(7));
-  folder.write("d_good.png", encode(".png", good));
+  folder.write("d_good.png", test::encodeImage(".png", good));
 
   ReplaySettings settings;
   settings.folder = folder.path();

@@ -1,6 +1,8 @@
 #include <filesystem>
+#include <fstream>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "service/daemon/image_archive.hpp"
 #include "service/daemon/metrics.hpp"
@@ -62,6 +64,21 @@ TEST(ImageArchive, KeepsFailedPartsAndSampleOfGoodOnesUnderQuota) {
   // A restarted archive counts the files already there.
   ImageArchive again({.folder = dir, .quotaBytes = 200'000});
   EXPECT_EQ(again.bytesUsed(), onDisk);
+  fs::remove_all(dir);
+}
+
+TEST(ImageArchive, StartRemovesPartialFilesOfAnInterruptedWrite) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("facet-archive-partial-" + std::to_string(::getpid()));
+  fs::create_directories(dir / "20261122");
+  std::ofstream(dir / "20261122/part-7-fail.png.partial") << "\x89PNG half a file";
+  cv::Mat img(10, 10, CV_8U, cv::Scalar(1));
+  ImageArchive archive({.folder = dir});
+  EXPECT_FALSE(fs::exists(dir / "20261122/part-7-fail.png.partial"));
+  EXPECT_EQ(archive.bytesUsed(), 0u);
+  const auto saved = archive.archive(partWith(7, Verdict::Fail), img, img);
+  ASSERT_TRUE(saved);
+  EXPECT_FALSE(cv::imread(saved->raw.string(), cv::IMREAD_UNCHANGED).empty());
   fs::remove_all(dir);
 }
 
