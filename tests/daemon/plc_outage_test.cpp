@@ -85,7 +85,7 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
   const auto httpPort = waitForHttpPort(dir / "http.port", 30s);
   ASSERT_TRUE(httpPort) << "facetd did not start; see " << dir / "facetd.log";
 
-  // The highest inspection counter the PLC has seen so far.
+  // Holds once the PLC has seen an inspection counter of at least `counter`.
   auto seenUpTo = [&](int counter) {
     return [counter](const std::vector<nlohmann::json>& events) {
       for (const auto& e : events)
@@ -214,7 +214,7 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
         << "part " << part.partId;
   }
   EXPECT_EQ(delivered.size() + undelivered.size(), static_cast<std::size_t>(kParts));
-  // Each outage was longer than the queue: some results were dropped in each, the rest waited.
+  // The outages outlast the queue (about 0.6 s of parts): some results had to be dropped.
   EXPECT_GT(dropped.size(), 0u);
   EXPECT_GT(passes, 0);
 
