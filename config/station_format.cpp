@@ -197,7 +197,7 @@ StationFormat::StationFormat() {
        integer("poll_period_ms", "Control signal poll period, ms.", 1, 60000, 2),
        integer("heartbeat_period_ms", "Heartbeat period, ms; 0 = off.", 0, 600000, 1000),
        integer("reconnect_initial_ms", "First wait after a lost link, ms.", 1, 600000, 100),
-       integer("reconnect_max_ms", "Longest wait between reconnections, ms.", 1, 600000, 5000),
+       integer("reconnect_max_ms", "Longest wait between reconnections, ms.", 1, 600000, 500),
        integer("queue_capacity", "Results waiting for the PLC at most.", 1, 100000, 64),
        choice("word_order", "Byte order of recipe outputs that do not name their own.",
               {"ABCD", "CDAB", "BADC", "DCBA"}, "ABCD"),

@@ -79,6 +79,7 @@ struct PlcLink::State {
   mutable std::mutex mutex;
   std::condition_variable wake;            // the I/O thread's sleep
   std::condition_variable triggerArrived;  // waitTrigger()
+  std::condition_variable queueChanged;    // flush(): a result left the queue, or the link fell
   std::deque<Pending> queue;
   std::deque<TriggerEvent> triggers;
   std::deque<HandshakeTiming> timings;
@@ -472,6 +473,7 @@ void PlcLink::State::deliverHead() {
     if (timings.size() > kTimingHistory) timings.pop_front();
     queue.pop_front();
     headWritten = false;
+    queueChanged.notify_all();
   }
 }
 
@@ -512,6 +514,7 @@ void PlcLink::State::step() {
       headTrigger.reset();
       queue.pop_front();
       ++stats.acknowledged;
+      queueChanged.notify_all();
     }
   } else if (map.control.recipeSelect) {
     const int recipe = readNumber("control.recipe_select", *map.control.recipeSelect);
@@ -546,6 +549,7 @@ void PlcLink::State::run() {
       std::lock_guard lock(mutex);
       stats.connected = false;
       ++stats.connectionLosses;
+      queueChanged.notify_all();
       spdlog::warn("PLC: link to {} lost ({}); {} results waiting", bus->describe(), e.what(),
                    queue.size());
       continue;
@@ -611,6 +615,7 @@ void PlcLink::stop() {
     state_->stopping = true;
   }
   state_->wake.notify_all();
+  state_->queueChanged.notify_all();
   if (state_->thread.joinable()) state_->thread.join();
   state_->bus->close();
   state_->connected = false;
@@ -619,6 +624,17 @@ void PlcLink::stop() {
   for (const auto& pending : state_->queue)
     spdlog::error("PLC: result of part '{}' (inspection counter {}) not delivered: link stopped",
                   pending.result.partId, pending.counter);
+  state_->stats.abandoned += state_->queue.size();
+  state_->queue.clear();
+  state_->headWritten = false;
+}
+
+bool PlcLink::flush(std::chrono::milliseconds timeout) {
+  State& s = *state_;
+  std::unique_lock lock(s.mutex);
+  s.queueChanged.wait_for(lock, timeout,
+                          [&] { return s.queue.empty() || !s.stats.connected || s.stopping; });
+  return s.queue.empty();
 }
 
 bool PlcLink::publish(InspectionResult result) {

@@ -82,6 +82,7 @@ struct PlcLinkStats {
   std::uint64_t written = 0;         // results whose result valid (or counter) was written
   std::uint64_t acknowledged = 0;    // results the PLC acknowledged (triggered)
   std::uint64_t dropped = 0;         // results dropped because the queue was full
+  std::uint64_t abandoned = 0;       // results still waiting when the link stopped (logged)
   std::uint64_t triggers = 0;        // triggers accepted
   std::uint64_t missedTriggers = 0;  // triggers while busy
   std::uint64_t connects = 0;        // successful connects (first one included)
@@ -102,8 +103,13 @@ class PlcLink {
 
   // Starts the I/O thread; returns at once (the PLC may be unreachable).
   void start();
-  // Stops the I/O thread. Results still queued are logged as undelivered.
+  // Stops the I/O thread. Results still queued are counted as abandoned and logged as
+  // undelivered, part by part.
   void stop();
+  // Waits until every queued result has left the queue (free run: written; triggered:
+  // acknowledged), the link is down, or `timeout` has passed; returns whether the queue is
+  // empty. For a clean shutdown: the last parts reach a PLC that is there.
+  bool flush(std::chrono::milliseconds timeout);
 
   // Queues a result for the PLC. Never blocks on the network. Returns false when the queue was
   // full and the result was dropped (counted and logged as an error naming the part).

@@ -52,8 +52,10 @@ struct PlcSettings {
   std::chrono::milliseconds heartbeatPeriod{1000};
 
   // Reconnect after a lost link: first wait reconnectInitial, then double up to reconnectMax.
+  // The cap bounds how late the daemon notices a PLC that came back (a restarted PLC is back on
+  // the line within reconnectMax); a refused connect on a plant network costs next to nothing.
   std::chrono::milliseconds reconnectInitial{100};
-  std::chrono::milliseconds reconnectMax{5000};
+  std::chrono::milliseconds reconnectMax{500};
 
   // Results waiting for the PLC (written but not yet acknowledged, or produced while the link is
   // down). When full, a new result is dropped, counted and logged as an error naming its part.

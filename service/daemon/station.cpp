@@ -15,6 +15,9 @@ namespace facet::service {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
+// How long a stopping station waits for a connected PLC to take the results still queued.
+constexpr std::chrono::milliseconds kPlcFlushTimeout{2000};
+
 struct Station::Job {
   std::uint64_t partId = 0;
   Frame frame;
@@ -163,6 +166,9 @@ void Station::join() {
   if (inspection_.joinable()) inspection_.join();
   if (publishing_.joinable()) publishing_.join();
   if (plc_) {
+    // The last parts were published a moment ago: let a connected PLC take them before the
+    // link goes (what is still queued after this is logged part by part as undelivered).
+    plc_->flush(kPlcFlushTimeout);
     plc_->setReady(false);
     plc_->stop();
   }
@@ -402,6 +408,7 @@ void Station::inspectionLoop() {
       continue;
     }
     Job& j = **job;
+    spdlog::debug("part={} inspecting {}", j.partId, j.frame.source);
     InspectionInput input;
     input.image = j.frame.image;
     input.scan = j.scan;

@@ -109,6 +109,12 @@ std::string integrityCheck(const std::string& database) {
   return answer;
 }
 
+std::string journalMode(const std::string& database) {
+  std::string answer;
+  query(database, "PRAGMA journal_mode", [&](sqlite3_stmt* s) { answer += text(s, 0); });
+  return answer;
+}
+
 std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort,
                              const StationFileOptions& options) {
   const std::string recipes = std::string(FACET_SOURCE_DIR) + "/recipes";
@@ -116,10 +122,11 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
   f << "schema_version: 1\nname: integration-station\ncamera:\n" << camera;
   f << "  scans:\n    folder: " << recipes << "/demo/scan_offset\n    glob: \"*.csv\"\n";
   {  // facetd --no-plc ignores the section, but the station file needs one
-    f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
+    f << "plc:\n  role: client\n  mode: " << options.plcMode
+      << "\n  transport: tcp\n  host: 127.0.0.1\n"
       << "  port: " << (plcPort > 0 ? plcPort : 502) << "\n  unit_id: 1\n  word_order: ABCD\n"
       << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
-      << "  register_map:\n    address_base: 0\n    control:\n"
+      << options.plcExtra << "  register_map:\n    address_base: 0\n    control:\n"
       << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n"
       << "      recipe_select: {register: 0}\n    status:\n"
       << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
@@ -137,7 +144,7 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
   return dir + "/station.yaml";
 }
 
-std::string writePeerConfig(const std::string& stationFile) {
+std::string writePeerConfig(const std::string& stationFile, bool freeRun) {
   const auto loaded = config::loadStationConfig(stationFile);
   if (!loaded.station) throw std::runtime_error(loaded.diagnostics.text());
   plc::RegisterMap map = loaded.station->registerMap;
@@ -154,7 +161,8 @@ std::string writePeerConfig(const std::string& stationFile) {
   map.results = {output("label.count", 110, plc::ValueType::Int16, 1.0),
                  output("bore_to_edge.distance", 111, plc::ValueType::Float32, 1.0),
                  output("label_angle.angle", 113, plc::ValueType::ScaledInt16, 100.0)};
-  return plc::test::writePeerConfig(map, false);
+  return freeRun ? plc::test::writePeerConfig(map, true, 512, 128, {{"report_writes", true}})
+                 : plc::test::writePeerConfig(map, false);
 }
 
 }  // namespace facet::daemon_test

@@ -46,13 +46,18 @@ std::optional<std::vector<StoredPart>> waitForStored(
     std::chrono::milliseconds timeout);
 // PRAGMA integrity_check's answer ("ok" when the file is sound).
 std::string integrityCheck(const std::string& database);
+// PRAGMA journal_mode as stored in the file ("wal" for facetd's store).
+std::string journalMode(const std::string& database);
 
 // What a test may change in the station file; the defaults are the repository's recipes folder
 // and an archive of failed parts.
 struct StationFileOptions {
-  std::string recipes;               // recipes folder; empty: FACET_SOURCE_DIR/recipes
-  std::string archiveKeep = "fail";  // archive.keep: none, fail or all
-  double archiveQuotaMb = 50;        // archive.quota_mb
+  std::string recipes;                // recipes folder; empty: FACET_SOURCE_DIR/recipes
+  std::string archiveKeep = "fail";   // archive.keep: none, fail or all
+  double archiveQuotaMb = 50;         // archive.quota_mb
+  std::string plcMode = "triggered";  // plc.mode: triggered or free_run
+  std::string plcExtra;               // more keys of the plc section, YAML lines indented by two
+                                      // spaces (e.g. "  queue_capacity: 16\n")
 };
 
 // The station file for a test: results, archive and HTTP in `dir`; `camera` is the YAML of the
@@ -61,7 +66,8 @@ struct StationFileOptions {
 std::string writeStationFile(const std::string& dir, const std::string& camera, int plcPort,
                              const StationFileOptions& options = {});
 
-// The pymodbus peer's config for that station and the bracket_shape recipe's PLC outputs.
-std::string writePeerConfig(const std::string& stationFile);
+// The pymodbus peer's config for that station and the bracket_shape recipe's PLC outputs. In
+// free run the peer reports every write of the inspection counter (report_writes).
+std::string writePeerConfig(const std::string& stationFile, bool freeRun = false);
 
 }  // namespace facet::daemon_test

@@ -274,8 +274,9 @@ TEST(PlcLinkWithPymodbus, NoResultLostWhenThePlcRestarts) {
     }
   });
   ASSERT_TRUE(plc->waitFor([&](const auto& all) { return countIn(all, "result") >= 10; }, 10s));
-  std::vector<nlohmann::json> received = plc->events("result");
   plc->kill();
+  // Read after the kill: a result the PLC reported (and acknowledged) just before it died counts.
+  std::vector<nlohmann::json> received = plc->events("result");
   std::this_thread::sleep_for(150ms);  // results keep coming while the PLC is down
   plc = std::make_unique<PymodbusPlc>(config, port);
   plc->start();
@@ -372,6 +373,62 @@ TEST(PlcLinkWithPymodbus, FreeRunWritesEveryResultWithTheNextCounter) {
   for (int i = 0; i < 6; ++i) expectDelivered(map, sent[i], results[i], i + 1);
   EXPECT_EQ(link.stats().written, 6u);
   EXPECT_EQ(link.stats().queueDepth, 0u);
+}
+
+// A stopping daemon flushes: every queued result reaches a connected PLC (each counter write
+// seen by the peer as it lands). With the PLC gone, flush() does not wait for it, and stop()
+// counts what is left as abandoned and logs each part once (stop() runs twice: by hand and in
+// the destructor).
+TEST(PlcLinkWithPymodbus, FlushDeliversTheQueueAndStopCountsWhatIsLeft) {
+  RegisterMap map = fullMap();
+  map.control = {};
+  const int port = test::freeTcpPort();
+  PymodbusPlc plc(test::writePeerConfig(map, true, 512, 128, {{"report_writes", true}}), port);
+  plc.start();
+  std::ostringstream log;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("plc-test", sink));
+  PlcSettings settings = fastSettings(port);
+  settings.mode = HandshakeMode::FreeRun;
+  {
+    PlcLink link(map, settings);
+    link.start();
+    ASSERT_TRUE(waitUntil([&] { return link.stats().connected; }, 5s));
+    constexpr int kBurst = 20;
+    for (int i = 0; i < kBurst; ++i)
+      ASSERT_TRUE(link.publish(sampleResult(map, i, "burst-" + std::to_string(i))));
+    EXPECT_TRUE(link.flush(10s));
+    EXPECT_EQ(link.stats().queueDepth, 0u);
+    EXPECT_EQ(link.stats().written, std::uint64_t(kBurst));
+    // The peer printed each result before answering its write; the pipe may still hold them.
+    EXPECT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "result") >= kBurst; }, 5s));
+    std::vector<int> counters;
+    for (const auto& e : plc.events("result")) counters.push_back(e["counter"].get<int>());
+    std::vector<int> expected(kBurst);
+    for (int i = 0; i < kBurst; ++i) expected[i] = i + 1;
+    EXPECT_EQ(counters, expected) << "the PLC saw every counter once, in order";
+
+    plc.kill();
+    ASSERT_TRUE(waitUntil([&] { return !link.stats().connected; }, 5s));
+    ASSERT_TRUE(link.publish(sampleResult(map, 0, "late-a")));
+    ASSERT_TRUE(link.publish(sampleResult(map, 1, "late-b")));
+    const auto t0 = std::chrono::steady_clock::now();
+    EXPECT_FALSE(link.flush(5s));
+    EXPECT_LT(std::chrono::steady_clock::now() - t0, 1s) << "flush waited for a PLC that is gone";
+    link.stop();
+    EXPECT_EQ(link.stats().abandoned, 2u);
+    EXPECT_EQ(link.stats().queueDepth, 0u);
+  }
+  spdlog::set_default_logger(previous);
+  const std::string text = log.str();
+  for (const std::string part : {"late-a", "late-b"}) {
+    const std::string line = "result of part '" + part + "'";
+    const auto first = text.find(line);
+    EXPECT_NE(first, std::string::npos) << part << " not logged";
+    EXPECT_EQ(text.find(line, first + 1), std::string::npos) << part << " logged twice";
+  }
+  EXPECT_THAT(text, HasSubstr("(inspection counter 22) not delivered: link stopped"));
 }
 
 // A result register beyond the PLC's table: the PLC answers "illegal data address"; the log

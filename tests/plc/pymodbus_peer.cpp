@@ -35,7 +35,8 @@ nlohmann::json locationJson(const RegisterMap& map, const Location& at) {
 }
 }  // namespace
 
-std::string writePeerConfig(const RegisterMap& map, bool freeRun, int registers, int coils) {
+std::string writePeerConfig(const RegisterMap& map, bool freeRun, int registers, int coils,
+                            const nlohmann::json& options) {
   nlohmann::json config = {{"coils", coils},
                            {"registers", registers},
                            {"mode", freeRun ? "free_run" : "triggered"},
@@ -54,6 +55,7 @@ std::string writePeerConfig(const RegisterMap& map, bool freeRun, int registers,
                        {"word_order", toString(output.wordOrder)},
                        {"factor", output.factor}});
   config["results"] = results;
+  config.update(options);
   char path[] = "/tmp/facet-plc-peer-XXXXXX";
   const int fd = ::mkstemp(path);
   if (fd < 0) throw std::runtime_error("cannot create a temporary file");
@@ -75,6 +77,11 @@ void PymodbusPlc::start() {
   ::signal(SIGPIPE, SIG_IGN);
   const std::string script = std::string(FACET_SOURCE_DIR) + "/tests/plc/pymodbus_plc.py";
   const std::string port = std::to_string(port_);
+  std::size_t firstEvent = 0;
+  {
+    std::lock_guard lock(mutex_);
+    firstEvent = events_.size();
+  }
   pid_ = ::fork();
   if (pid_ == 0) {
     ::dup2(toChild[0], STDIN_FILENO);
@@ -99,7 +106,9 @@ void PymodbusPlc::start() {
   std::string failure;
   const bool up = waitFor(
       [&](const std::vector<nlohmann::json>& all) {
-        for (const auto& e : all) {
+        // Only this run's events: after a restart the earlier run's "listening" is still there.
+        for (std::size_t i = firstEvent; i < all.size(); ++i) {
+          const auto& e = all[i];
           if (e["event"] == "error") failure = e["message"];
           if ((e["event"] == "listening" || e["event"] == "connected") && e["port"] == port_)
             return true;

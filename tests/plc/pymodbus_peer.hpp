@@ -21,9 +21,11 @@ namespace facet::plc::test {
 // A TCP port on 127.0.0.1 that was free a moment ago.
 int freeTcpPort();
 
-// The peer's JSON config for `map` (wire addresses), written to a temporary file.
+// The peer's JSON config for `map` (wire addresses), written to a temporary file. `options` are
+// merged into it (e.g. {"report_writes": true}, see pymodbus_plc.py).
 std::string writePeerConfig(const RegisterMap& map, bool freeRun, int registers = 512,
-                            int coils = 128);
+                            int coils = 128,
+                            const nlohmann::json& options = nlohmann::json::object());
 
 class PymodbusPlc {
  public:

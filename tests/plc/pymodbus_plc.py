@@ -14,6 +14,10 @@ plc.json (wire addresses, i.e. zero-based as sent on the wire):
      "results": [{"name": "d", "address": 100, "type": "float32", "word_order": "CDAB",
                   "factor": 1.0}],
      "auto_ack": true, "mode": "triggered"}   (mode "free_run": report each new counter)
+    "report_writes": true (free run): report a result on every write of the inspection counter
+    as the daemon's request arrives, repeats included, instead of scanning for a changed counter,
+    so that no result escapes between two scans; and emit {"event": "first_write"} on the first
+    write of any kind after start (a reconnected daemon).
 
 stdin commands, one per line: "trigger" (raise the trigger; cleared when busy or result valid
 rises, or after 5 s; 0.5 s when raised while busy), "untrigger" (clear it now), "report <signal>" (emit {"event": "report", ...} with its value),
@@ -21,6 +25,8 @@ rises, or after 5 s; 0.5 s when raised while busy), "untrigger" (clear it now), 
 stdout: one JSON object per line: {"event": "listening", "port": P}, then
 {"event": "result", ...} per result valid rising edge (decoded here with struct, independently
 of facet's encoder, plus the raw words), {"event": "missed_trigger"} per rising edge.
+"listening", "first_write" and "result" carry "t": time.monotonic() (CLOCK_MONOTONIC, the clock
+of C++'s steady_clock on Linux), so a test can time them against its own events.
 """
 import argparse
 import asyncio
@@ -51,6 +57,23 @@ def emit(obj):
     print(json.dumps(obj), flush=True)
 
 
+WRITE_CODES = (5, 6, 15, 16)  # write single/multiple coils/registers, as requests arrive
+
+
+class WatchedSlave(ModbusSlaveContext):
+    """The server's tables, telling the PLC program about the daemon's writes as they land (before
+    the server answers them): a result counted as written by the daemon was seen here."""
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.on_write = lambda fc, address, count: None
+
+    def setValues(self, fc_as_hex, address, values):  # pylint: disable=invalid-name
+        super().setValues(fc_as_hex, address, values)
+        if fc_as_hex in WRITE_CODES:
+            self.on_write(fc_as_hex, address, len(values))
+
+
 class Plc:
     def __init__(self, config, slave):
         self.config = config
@@ -59,6 +82,7 @@ class Plc:
         self.trigger_since = None
         self.trigger_while_busy = False
         self.last = {}
+        self.wrote = False
 
     def flag(self, name):
         at = self.signals.get(name)
@@ -120,8 +144,19 @@ class Plc:
         self.last[name] = now
         return rising, falling
 
+    def on_write(self, fc, address, count):
+        if not self.wrote:
+            self.wrote = True
+            emit({"event": "first_write", "t": time.monotonic()})
+        at = self.signals.get("inspection_counter")
+        if (self.config.get("report_writes") and self.config.get("mode") == "free_run"
+                and at is not None and fc in (6, 16) and address <= at["address"] < address + count):
+            emit(dict(self.read_result(), t=time.monotonic()))
+
     def scan(self):
         if self.config.get("mode") == "free_run":
+            if self.config.get("report_writes"):
+                return  # on_write reports
             # No trigger, no ack: a new inspection counter announces a result.
             counter = self.number("inspection_counter")
             if counter != self.last.get("counter", 0):
@@ -241,18 +276,19 @@ async def main():
         run_client(config, args.port)
         return
 
-    slave = ModbusSlaveContext(
-        co=ModbusSequentialDataBlock(0, [False] * config.get("coils", 64)),
-        hr=ModbusSequentialDataBlock(0, [0] * config.get("registers", 256)),
-        zero_mode=True)
+    slave = WatchedSlave(co=ModbusSequentialDataBlock(0, [False] * config.get("coils", 64)),
+                         hr=ModbusSequentialDataBlock(0, [0] * config.get("registers", 256)),
+                         zero_mode=True)
+    plc = Plc(config, slave)
+    slave.on_write = plc.on_write  # before the server starts: it sees every write
     context = ModbusServerContext(slaves=slave, single=True)
     server = await StartAsyncTcpServer(context=context, address=("127.0.0.1", args.port),
                                        allow_reuse_address=True, defer_start=True)
     serving = asyncio.create_task(server.serve_forever())
     await server.serving
-    emit({"event": "listening", "port": args.port, "pymodbus": pymodbus.__version__})
+    emit({"event": "listening", "port": args.port, "pymodbus": pymodbus.__version__,
+          "t": time.monotonic()})
 
-    plc = Plc(config, slave)
     commands = StdinCommands()
     while True:
         for line in commands.take():
