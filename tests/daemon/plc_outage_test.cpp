@@ -30,6 +30,13 @@ namespace fs = std::filesystem;
 
 constexpr int kParts = 1000;
 constexpr int kQueueCapacity = 24;  // about 0.6 s of parts at the replay rate
+// The bound. An instrumented (ASan) facetd on a loaded CI machine gets twice that: the
+// policy (backoff capped at 500 ms) is the same, only the machine is slower.
+#if defined(__SANITIZE_ADDRESS__)
+constexpr double kReconnectBoundMs = 2000.0;
+#else
+constexpr double kReconnectBoundMs = 1000.0;
+#endif
 const std::string kDemo = std::string(FACET_SOURCE_DIR) + "/recipes/demo/bracket_shape";
 
 // `count` images named part_0000.png ... (with their sidecars): the 12 demo images over and
@@ -223,7 +230,7 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
   // a connect can land in the backlog of the dying PLC's listening socket, which the kernel
   // closes just after the connections (the link then sees the reset and tries again).
   for (int k = 0; k < 3; ++k)
-    EXPECT_LT(reconnectMs[k], 1000.0)
+    EXPECT_LT(reconnectMs[k], kReconnectBoundMs)
         << "reconnect after restart " << k + 1 << "; PLC kill at " << killedAt[k]
         << " s, listening at " << listeningAt[k] << " s (CLOCK_MONOTONIC)";
   EXPECT_GE(metricValue(metrics, "facet_plc_reconnects").value_or(0), 4.0);
