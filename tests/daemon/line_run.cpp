@@ -136,7 +136,7 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
       << "      inspection_counter: {register: 12}\n      active_recipe: {register: 13}\n";
   }
   f << "recipes: " << (options.recipes.empty() ? recipes : options.recipes) << "\n";
-  f << "results:\n  database: " << dir << "/results.db\n";
+  f << "results:\n  database: " << dir << "/results.db\n" << options.resultsExtra;
   f << "archive:\n  folder: " << dir << "/archive\n  quota_mb: " << options.archiveQuotaMb
     << "\n  keep: " << options.archiveKeep << "\n";
   f << "http:\n  bind: 127.0.0.1\n  port: 0\n";

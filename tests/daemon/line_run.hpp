@@ -58,6 +58,7 @@ struct StationFileOptions {
   std::string plcMode = "triggered";  // plc.mode: triggered or free_run
   std::string plcExtra;               // more keys of the plc section, YAML lines indented by two
                                       // spaces (e.g. "  queue_capacity: 16\n")
+  std::string resultsExtra;           // more keys of the results section (e.g. "  keep_parts: 5\n")
 };
 
 // The station file for a test: results, archive and HTTP in `dir`; `camera` is the YAML of the
