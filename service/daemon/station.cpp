@@ -1,6 +1,7 @@
 #include "service/daemon/station.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <spdlog/spdlog.h>
 
@@ -520,6 +521,12 @@ void Station::publishPart(Job& j) {
     r.partId = std::to_string(p.partId);
     r.pass = p.verdict == Verdict::Pass;
     for (const auto& m : p.measurements) r.values[m.name] = m.value;
+    // This recipe's outputs that were not measured (a part not inspected, a failed step) are
+    // written as "not measured" (NaN / 0): the PLC must not read the previous part's values as
+    // this part's. Other recipes' outputs keep their registers (onlyGivenValues).
+    if (j.inspection)
+      for (const auto& [check, step] : j.inspection->recipe().plcOutputs())
+        r.values.try_emplace(check->plc->output.name, std::numeric_limits<double>::quiet_NaN());
     r.onlyGivenValues = true;  // other recipes' outputs keep their registers
     r.errorCode = p.verdict == Verdict::Error ? 1 : 0;
     r.triggerSequence = j.trigger ? j.trigger->sequence : 0;

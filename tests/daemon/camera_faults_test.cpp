@@ -181,6 +181,10 @@ void expectPlcSaw(const nlohmann::json& result, const StoredPart& part) {
   EXPECT_EQ(result.at("pass").get<bool>(), part.verdict == "pass") << where;
   EXPECT_EQ(result.at("error").get<bool>(), part.verdict == "error") << where;
   EXPECT_EQ(result.at("error_code").get<int>() != 0, part.verdict == "error") << where;
+  // An error part's outputs read "not measured", never an earlier part's values.
+  if (part.verdict == "error") {
+    EXPECT_TRUE(result.at("values").at("bore_to_edge.distance").is_null()) << where;
+  }
 }
 
 // Maps stored parts to the frames a camera served. facetd's frame ids are the camera's block

@@ -31,6 +31,7 @@ of C++'s steady_clock on Linux), so a test can time them against its own events.
 import argparse
 import asyncio
 import json
+import math
 import logging
 import struct
 import sys
@@ -53,8 +54,19 @@ logging.getLogger("pymodbus").setLevel(logging.CRITICAL)  # keeps kill/restart r
 COILS, HOLDING = 1, 3  # function codes selecting pymodbus' tables
 
 
+def json_safe(obj):
+    """NaN (an output written as "not measured") becomes null: JSON has no NaN."""
+    if isinstance(obj, float) and math.isnan(obj):
+        return None
+    if isinstance(obj, dict):
+        return {k: json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [json_safe(v) for v in obj]
+    return obj
+
+
 def emit(obj):
-    print(json.dumps(obj), flush=True)
+    print(json.dumps(json_safe(obj), allow_nan=False), flush=True)
 
 
 WRITE_CODES = (5, 6, 15, 16)  # write single/multiple coils/registers, as requests arrive
