@@ -47,6 +47,11 @@ struct ReplaySettings {
   // Files whose header announces more pixels (width * height) than this are skipped before
   // any pixel memory is allocated (guards against corrupt or hostile headers). Default 2^28.
   std::uint64_t max_pixels = std::uint64_t{1} << 28;
+  // Files read and decoded ahead of grab() by a background thread, as a real camera has its
+  // frame in memory when it is triggered (exposure and transfer aside). Bounds the memory held:
+  // at most `prefetch` decoded frames plus the one being read. 0 = each file is read inside
+  // grab(), on the caller's time.
+  int prefetch = 2;
 };
 
 // A GigE Vision / USB3 Vision camera through Aravis.

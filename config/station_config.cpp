@@ -141,6 +141,7 @@ class StationReader {
       s.replay.colour = parseColourConversion(text(r["colour"])).value_or(s.replay.colour);
       s.replay.max_pixels = static_cast<std::uint64_t>(
           integer(r["max_pixels"], static_cast<long long>(s.replay.max_pixels)));
+      s.replay.prefetch = static_cast<int>(integer(r["prefetch"], s.replay.prefetch));
     }
     if (const YAML::Node a = c["aravis"]; map(a)) {
       AravisSettings& v = s.aravis;
