@@ -69,7 +69,10 @@ class StationReader {
     station_.schemaVersion = static_cast<int>(readInteger(root["schema_version"]).value_or(1));
     station_.name = text(root["name"]);
     if (map(root["camera"])) readCamera(root["camera"]);
-    if (map(root["plc"])) readPlc(root["plc"]);
+    if (map(root["plc"])) {
+      station_.hasPlc = true;
+      readPlc(root["plc"]);
+    }
     if (const auto folder = folderPath(root["recipes"], "recipes"))
       station_.recipesFolder = *folder;
     if (map(root["results"])) readResults(root["results"]);

@@ -234,7 +234,7 @@ StationFormat::StationFormat() {
       {integer("schema_version", "Version of this format; 1.", 1, 1),
        text("name", "Station name, shown on the dashboard."),
        section("camera", "Where frames come from.", &camera, true),
-       section("plc", "The line's PLC.", &plc, true),
+       section("plc", "The line's PLC; without it facetd runs without a PLC link.", &plc),
        path("recipes", "Recipes folder, relative to the station file.", true),
        section("results", "Results store.", &results, true),
        section("archive", "Image archive.", &archive), section("http", "HTTP server.", &http),

@@ -139,16 +139,17 @@ fs::path writeStation(const fs::path& dir, const fs::path& frames, int plcPort) 
   f << "schema_version: 1\nname: bench\ncamera:\n  backend: replay\n  replay:\n    folder: "
     << frames.string() << "\n    glob: \"*.png\"\n    loop: true\n    fps: 0\n"
     << "    trigger: software\n    colour: mono\n";
-  // The free run uses no PLC (StationOptions::usePlc), but a station file always has one.
-  f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
-    << "  port: " << (plcPort > 0 ? plcPort : 502) << "\n  unit_id: 1\n  word_order: ABCD\n"
-    << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
-    << "  register_map:\n    address_base: 0\n    control:\n"
-    << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n    status:\n"
-    << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
-    << "      pass: {coil: 19}\n      completed_toggle: {coil: 20}\n"
-    << "      missed_trigger: {coil: 21}\n      error: {coil: 22}\n"
-    << "      error_code: {register: 10}\n      inspection_counter: {register: 12}\n";
+  // The free run has no PLC: its station file has no plc section.
+  if (plcPort > 0)
+    f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
+      << "  port: " << plcPort << "\n  unit_id: 1\n  word_order: ABCD\n"
+      << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
+      << "  register_map:\n    address_base: 0\n    control:\n"
+      << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n    status:\n"
+      << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
+      << "      pass: {coil: 19}\n      completed_toggle: {coil: 20}\n"
+      << "      missed_trigger: {coil: 21}\n      error: {coil: 22}\n"
+      << "      error_code: {register: 10}\n      inspection_counter: {register: 12}\n";
   f << "recipes: recipes\nresults:\n  database: " << (dir / "results.db").string()
     << "\narchive:\n  folder: " << (dir / "archive").string()
     << "\n  quota_mb: 20\n  keep: fail\nhttp:\n  bind: 127.0.0.1\n  port: 0\n"
@@ -333,7 +334,6 @@ struct FreeRun {
 FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, int parts) {
   auto station = loadStation(writeStation(dir / "free", frames, 0));
   service::StationOptions options;
-  options.usePlc = false;
   options.overflow = service::OverflowPolicy::Block;  // sustained rate: no part dropped
   options.maxParts = static_cast<std::uint64_t>(parts);
   FreeRun out;

@@ -89,7 +89,9 @@ Station::Station(config::StationConfig config, StationOptions options)
 
   camera_ = makeCamera(config_.camera);
   if (!config_.camera.scans.folder.empty()) scans_ = makeScanReplay(config_.camera.scans);
-  if (options_.usePlc)
+  if (options_.usePlc && !config_.hasPlc)
+    spdlog::info("station {}: no plc section, running without a PLC link", config_.file.string());
+  if (options_.usePlc && config_.hasPlc)
     plc_ = std::make_unique<plc::PlcLink>(fullRegisterMap(config_, recipes), config_.plc);
   metrics_.gauge("facet_up", "1 while facetd runs").set(1);
 }

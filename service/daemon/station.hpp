@@ -44,7 +44,7 @@ struct StationOptions {
   std::optional<int> recipe;       // recipe to start with (default: the lowest id)
   std::uint64_t maxParts = 0;      // stop after this many parts (0 = run until stopped)
   bool stopAtEndOfStream = false;  // replay without loop: stop once every file was inspected
-  bool usePlc = true;              // false: no PLC link even if configured
+  bool usePlc = true;              // false: no PLC link even if configured (none if not)
   std::function<void(const PartResult&)> onPart;  // called by the publishing stage, per part
 };
 
