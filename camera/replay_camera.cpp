@@ -49,7 +49,6 @@ void ReplayCamera::start() {
   if (!health_.connected) throw CameraError("replay camera " + name() + ": start() before open()");
   health_.streaming = true;
   pending_triggers_ = 0;
-  next_due_ = std::chrono::steady_clock::now();
   if (settings_.prefetch > 0 && !read_ahead_.joinable()) {
     // Reading resumes at the first file not delivered yet (a restart loses no frame).
     ready_.clear();
@@ -58,6 +57,8 @@ void ReplayCamera::start() {
     read_ahead_running_ = true;
     read_ahead_ = std::thread([this] { readAheadLoop(); });
   }
+  // The first frame is due now, once start() is done (starting a thread may take a while).
+  next_due_ = std::chrono::steady_clock::now();
 }
 
 void ReplayCamera::softwareTrigger() {
