@@ -83,7 +83,7 @@ StationFormat::StationFormat() {
        choice("trigger", "free_run or software.", {"free_run", "software"}, "free_run"),
        choice("colour", "keep, mono or colour.", kColour, "keep"),
        integer("max_pixels", "Files announcing more pixels are skipped.", 1, 9.0e15, 268435456),
-       integer("prefetch", "Files read ahead of the trigger; 0 = read when grabbed.", 0, 64, 2)}};
+       integer("prefetch", "Files read ahead of the trigger; 0 = read when grabbed.", 0, 16, 2)}};
   aravis = {
       "aravis camera",
       "A GigE Vision / USB3 Vision camera through Aravis.",
