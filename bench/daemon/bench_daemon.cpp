@@ -19,7 +19,9 @@
 //               and of the label (alignment, shape match; no rotation search), cv::HoughCircles
 //               in the two bore windows (circles)
 //
-//   bench_daemon [--smoke] [--parts N] [--triggers N]
+//   frames      PNG as recorded (default), or binary PGM with --pgm (raw pixels, no decoding)
+//
+//   bench_daemon [--smoke] [--pgm] [--parts N] [--triggers N]
 #include <time.h>
 
 #include <algorithm>
@@ -100,8 +102,9 @@ steps:
 )";
 
 // 1280x1024 frames: each recorded 640x480 bracket scene pasted at a different place on a
-// background of the same grey and noise.
-std::vector<fs::path> makeFrames(const fs::path& folder) {
+// background of the same grey and noise. Stored as PNG (as recorded), or as binary PGM
+// (`extension` ".pgm": raw pixels, as a high-rate recording would keep them).
+std::vector<fs::path> makeFrames(const fs::path& folder, const std::string& extension) {
   fs::create_directories(folder);
   std::vector<fs::path> demo;
   for (const auto& e : fs::directory_iterator(kSource / "recipes/demo/bracket_shape"))
@@ -121,7 +124,7 @@ std::vector<fs::path> makeFrames(const fs::path& folder) {
     const int x = static_cast<int>((i * 97) % (1280 - 640));
     const int y = static_cast<int>((i * 131) % (1024 - 480));
     scene.copyTo(frame(cv::Rect(x, y, scene.cols, scene.rows)));
-    const fs::path out = folder / demo[i].filename();
+    const fs::path out = folder / demo[i].filename().replace_extension(extension);
     cv::imwrite(out.string(), frame);
     fs::copy_file(demo[i].string() + ".json", out.string() + ".json",
                   fs::copy_options::overwrite_existing);
@@ -130,14 +133,15 @@ std::vector<fs::path> makeFrames(const fs::path& folder) {
   return frames;
 }
 
-fs::path writeStation(const fs::path& dir, const fs::path& frames, int plcPort) {
+fs::path writeStation(const fs::path& dir, const fs::path& frames, int plcPort,
+                      const std::string& extension) {
   fs::create_directories(dir / "recipes");
   fs::copy(kSource / "recipes/models", dir / "recipes/models",
            fs::copy_options::recursive | fs::copy_options::skip_existing);
   std::ofstream(dir / "recipes/bench.recipe.yaml") << kRecipe;
   std::ofstream f(dir / "station.yaml");
   f << "schema_version: 1\nname: bench\ncamera:\n  backend: replay\n  replay:\n    folder: "
-    << frames.string() << "\n    glob: \"*.png\"\n    loop: true\n    fps: 0\n"
+    << frames.string() << "\n    glob: \"*" << extension << "\"\n    loop: true\n    fps: 0\n"
     << "    trigger: software\n    colour: mono\n";
   // The free run has no PLC: its station file has no plc section.
   if (plcPort > 0)
@@ -263,8 +267,9 @@ struct Latency {
 };
 
 // One part at a time: trigger, wait for the result registers, next trigger.
-Latency measureLatency(const fs::path& dir, const fs::path& frames, int triggers) {
-  const auto probe = loadStation(writeStation(dir / "probe", frames, 1));
+Latency measureLatency(const fs::path& dir, const fs::path& frames, const std::string& extension,
+                       int triggers) {
+  const auto probe = loadStation(writeStation(dir / "probe", frames, 1, extension));
   plc::RegisterMap map = probe.registerMap;
   for (const auto& [name, reg] :
        {std::pair{"big_bore.diameter", 140}, {"corner_bore.diameter", 142}}) {
@@ -283,7 +288,7 @@ Latency measureLatency(const fs::path& dir, const fs::path& frames, int triggers
     arrived.notify_all();
   });
   plc.start();
-  auto station = loadStation(writeStation(dir / "latency", frames, plc.port()));
+  auto station = loadStation(writeStation(dir / "latency", frames, plc.port(), extension));
   service::StationOptions options;
   Latency out;
   options.onPart = [&](const service::PartResult& p) {
@@ -331,8 +336,9 @@ struct FreeRun {
   std::map<std::string, int> verdicts;  // written by the publishing thread only
 };
 
-FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, int parts) {
-  auto station = loadStation(writeStation(dir / "free", frames, 0));
+FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, const std::string& extension,
+                       int parts) {
+  auto station = loadStation(writeStation(dir / "free", frames, 0, extension));
   service::StationOptions options;
   options.overflow = service::OverflowPolicy::Block;  // sustained rate: no part dropped
   options.maxParts = static_cast<std::uint64_t>(parts);
@@ -406,18 +412,20 @@ Baseline openCvBaseline(const std::vector<fs::path>& frames, int rounds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool smoke = false;
+  bool smoke = false, pgm = false;
   int parts = 20000, triggers = 500;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--smoke")
       smoke = true;
+    else if (a == "--pgm")
+      pgm = true;
     else if (a == "--parts" && i + 1 < argc)
       parts = std::stoi(argv[++i]);
     else if (a == "--triggers" && i + 1 < argc)
       triggers = std::stoi(argv[++i]);
     else {
-      std::cerr << "usage: bench_daemon [--smoke] [--parts N] [--triggers N]\n";
+      std::cerr << "usage: bench_daemon [--smoke] [--pgm] [--parts N] [--triggers N]\n";
       return 1;
     }
   }
@@ -430,17 +438,20 @@ int main(int argc, char** argv) {
   const fs::path dir = ::mkdtemp(name);
   try {
     const std::string loadBefore = loadAverage();
-    const auto frames = makeFrames(dir / "frames");
-    const Latency latency = measureLatency(dir, dir / "frames", triggers);
-    FreeRun run = measureFreeRun(dir, dir / "frames", parts);
+    const std::string extension = pgm ? ".pgm" : ".png";
+    const auto frames = makeFrames(dir / "frames", extension);
+    const Latency latency = measureLatency(dir, dir / "frames", extension, triggers);
+    FreeRun run = measureFreeRun(dir, dir / "frames", extension, parts);
     const Baseline cv = openCvBaseline(frames, smoke ? 1 : 5);
     const std::string loadAfter = loadAverage();
     const double median = percentile(latency.ms, 0.5), p99 = percentile(latency.ms, 0.99);
     const long rssFirst = run.rss.empty() ? 0 : run.rss.front();
     const long rssMax = run.rss.empty() ? 0 : *std::max_element(run.rss.begin(), run.rss.end());
     const double growth = rssFirst ? 100.0 * (rssMax - rssFirst) / rssFirst : 0;
-    std::printf("bench_daemon%s: 1280x1024 Mono8 replay, recipe align(shape) + shape + 2 circles\n",
-                smoke ? " --smoke" : "");
+    std::printf(
+        "bench_daemon%s%s: 1280x1024 Mono8 replay of %s files, recipe align(shape) + shape"
+        " + 2 circles\n",
+        smoke ? " --smoke" : "", pgm ? " --pgm" : "", pgm ? "PGM" : "PNG");
     std::printf("%d triggered parts, %d free-run parts, hardware threads %u\n",
                 static_cast<int>(latency.ms.size()), parts, std::thread::hardware_concurrency());
     std::printf("load average (1/5/15 min) at start %s, at end %s\n\n", loadBefore.c_str(),
@@ -495,8 +506,8 @@ int main(int argc, char** argv) {
     const double facetPart = f.stage("grab") + f.stage("inspect") + f.stage("publish");
     std::printf("| stage (free run, mean)  | facet     | OpenCV baseline              | ratio |\n");
     std::printf("| ----------------------- | --------- | ---------------------------- | ----- |\n");
-    std::printf("| PNG decode (read ahead) | %6.2f ms | %6.2f ms cv::imread          | %5.2f |\n",
-                cv.facetDecode, cv.grab, cv.facetDecode / cv.grab);
+    std::printf("| %s decode (read ahead) | %6.2f ms | %6.2f ms cv::imread          | %5.2f |\n",
+                pgm ? "PGM" : "PNG", cv.facetDecode, cv.grab, cv.facetDecode / cv.grab);
     std::printf("| grab (wait for a frame) | %6.2f ms | %6.2f ms cv::imread          | %5.2f |\n",
                 f.stage("grab"), cv.grab, f.stage("grab") / cv.grab);
     std::printf("| inspect                 | %6.2f ms | %6.2f ms matchTemplate+Hough | %5.2f |\n",
