@@ -466,8 +466,10 @@ int main(int argc, char** argv) {
                 run.partsPerSecond, run.partsPerSecond >= 40 ? "yes" : "NO ");
     std::printf("| VmRSS growth over the run         | %+7.1f %%  | within 5 %%  | %s |\n", growth,
                 std::abs(growth) <= 5 ? "yes" : "NO ");
-    std::printf("  (VmRSS samples: %zu, first %ld kB, max %ld kB)\n", run.rss.size(), rssFirst,
+    std::printf("  (VmRSS samples: %zu, first %ld kB, max %ld kB; MB:", run.rss.size(), rssFirst,
                 rssMax);
+    for (long kb : run.rss) std::printf(" %ld", kb / 1024);
+    std::printf(")\n");
     std::printf("  CPU time per part (all threads): triggered %.1f ms, free run %.1f ms\n",
                 latency.cpuMsPerPart, run.cpuMsPerPart);
     // The bench recipe checks fewer things than bracket_shape (no label angle, no bore-to-edge
