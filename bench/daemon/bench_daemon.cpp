@@ -470,6 +470,15 @@ int main(int argc, char** argv) {
                 rssMax);
     for (long kb : run.rss) std::printf(" %ld", kb / 1024);
     std::printf(")\n");
+    // The first sample and the maximum both depend on how many frames happen to be queued (up to
+    // inspect + publish queue + read-ahead, ~20 MB); a leak shows as a trend instead.
+    if (run.rss.size() >= 10) {
+      double head = 0, tail = 0;
+      for (std::size_t i = 0; i < 5; ++i)
+        head += run.rss[i], tail += run.rss[run.rss.size() - 1 - i];
+      std::printf("  VmRSS trend (mean of the last 5 samples vs the first 5): %+.1f %%\n",
+                  100.0 * (tail - head) / head);
+    }
     std::printf("  CPU time per part (all threads): triggered %.1f ms, free run %.1f ms\n",
                 latency.cpuMsPerPart, run.cpuMsPerPart);
     // The bench recipe checks fewer things than bracket_shape (no label angle, no bore-to-edge
