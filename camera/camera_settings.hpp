@@ -53,6 +53,11 @@ struct ReplaySettings {
   // every recorded file as a part (facetd) can answer it as "not inspected". Once per file: a
   // looping replay skips it on later passes.
   bool report_unreadable = false;
+  // Files read and decoded ahead of grab() by a background thread, as a real camera has its
+  // frame in memory when it is triggered (exposure and transfer aside). Bounds the memory held:
+  // at most `prefetch` decoded frames plus the one being read. 0 = each file is read inside
+  // grab(), on the caller's time.
+  int prefetch = 2;
 };
 
 // A GigE Vision / USB3 Vision camera through Aravis.

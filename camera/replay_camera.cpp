@@ -5,7 +5,6 @@
 #include <spdlog/spdlog.h>
 
 #include "camera/image_file_list.hpp"
-#include "camera/image_file_reader.hpp"
 #include "camera/sensor_image.hpp"
 
 namespace facet {
@@ -22,8 +21,13 @@ const std::vector<std::string>& imageExtensions() {
 ReplayCamera::ReplayCamera(ReplaySettings settings) : settings_(std::move(settings)) {
   if (settings_.folder.empty()) throw CameraError("replay camera: no folder given");
   if (settings_.fps < 0.0) throw CameraError("replay camera: fps must be >= 0");
+  if (settings_.prefetch < 0) throw CameraError("replay camera: prefetch must be >= 0");
   if (settings_.trigger == TriggerMode::Hardware)
     throw CameraError("replay camera: hardware trigger is not possible, use software");
+}
+
+ReplayCamera::~ReplayCamera() {
+  stop();
 }
 
 void ReplayCamera::open() {
@@ -34,9 +38,9 @@ void ReplayCamera::open() {
   auto sidecar = SidecarMetadata::loadFolder(settings_.folder);
   std::lock_guard lock(mutex_);
   files_ = std::move(files);
-  reported_.assign(files_.size(), false);
   sidecar_ = std::move(sidecar);
   next_file_ = 0;
+  reported_.assign(files_.size(), false);
   health_.connected = true;
   spdlog::info("replay: {} images in {}", files_.size(), settings_.folder.string());
 }
@@ -46,6 +50,15 @@ void ReplayCamera::start() {
   if (!health_.connected) throw CameraError("replay camera " + name() + ": start() before open()");
   health_.streaming = true;
   pending_triggers_ = 0;
+  if (settings_.prefetch > 0 && !read_ahead_.joinable()) {
+    // Reading resumes at the first file not delivered yet (a restart loses no frame).
+    ready_.clear();
+    end_queued_ = false;
+    next_to_read_ = next_file_;
+    read_ahead_running_ = true;
+    read_ahead_ = std::thread([this] { readAheadLoop(); });
+  }
+  // The first frame is due now, once start() is done (starting a thread may take a while).
   next_due_ = std::chrono::steady_clock::now();
 }
 
@@ -92,43 +105,74 @@ GrabResult ReplayCamera::grab(std::chrono::milliseconds timeout) {
   return readNext(lock);
 }
 
-GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
-  // At most one pass over the folder per grab: a folder of only broken files must end.
-  for (std::size_t attempts = 0; attempts < files_.size(); ++attempts) {
+ReplayCamera::ReadFile ReplayCamera::readFile(std::size_t index,
+                                              const std::filesystem::path& file) const {
+  ReadFile read;
+  read.index = index;
+  read.content = readImageFile(file, settings_.max_pixels);
+  if (read.content.ok()) {
+    applyColourConversion(read.content.image, read.content.format, settings_.colour);
+    read.metadata = sidecar_.forImage(file, &read.sidecar_error);
+  }
+  return read;
+}
+
+bool ReplayCamera::nextRead(std::unique_lock<std::mutex>& lock, ReadFile& out) {
+  if (settings_.prefetch == 0) {
     if (next_file_ >= files_.size()) {
-      if (!settings_.loop) return {GrabStatus::EndOfStream, {}, "replay finished"};
+      if (!settings_.loop) {
+        out.end_of_files = true;
+        return true;
+      }
       next_file_ = 0;
     }
     const std::size_t index = next_file_++;
     const std::filesystem::path file = files_[index];
     // Decode without the lock: health() and softwareTrigger() must not wait for a PNG.
     lock.unlock();
-    ImageFileContent content = readImageFile(file, settings_.max_pixels);
-    Frame frame;
-    std::string sidecar_error;
-    if (content.ok()) {
-      frame.image = std::move(content.image);
-      frame.format = content.format;
-      applyColourConversion(frame.image, frame.format, settings_.colour);
-      frame.timestamp = std::chrono::system_clock::now();
-      frame.source = file.string();
-      frame.metadata = sidecar_.forImage(file, &sidecar_error);
-    } else {
-      spdlog::error("replay: skipping {}", content.error);
-    }
+    out = readFile(index, file);
     lock.lock();
-    if (!content.ok()) {
+    return true;
+  }
+  ready_cv_.wait(lock, [&] { return !ready_.empty() || !health_.streaming; });
+  if (!health_.streaming) return false;
+  if (ready_.front().end_of_files) {
+    out.end_of_files = true;  // stays queued: every later grab ends the same way
+    return true;
+  }
+  out = std::move(ready_.front());
+  ready_.pop_front();
+  next_file_ = out.index + 1;
+  space_cv_.notify_all();
+  return true;
+}
+
+GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
+  // At most one pass over the folder per grab: a folder of only broken files must end.
+  for (std::size_t attempts = 0; attempts < files_.size(); ++attempts) {
+    ReadFile read;
+    if (!nextRead(lock, read)) return {GrabStatus::NotStarted, {}, name() + ": stopped"};
+    if (read.end_of_files) return {GrabStatus::EndOfStream, {}, "replay finished"};
+    if (!read.content.ok()) {
+      spdlog::error("replay: skipping {}", read.content.error);
       ++health_.skipped_files;
-      health_.last_error = content.error;
+      health_.last_error = read.content.error;
       // Reported once: a looping replay must not turn one bad file into a stream of parts.
-      if (!settings_.report_unreadable || reported_[index]) continue;
-      reported_[index] = true;
+      if (!settings_.report_unreadable || reported_[read.index]) continue;
+      reported_[read.index] = true;
       Frame refused;  // no image and no frame number: only where it came from
-      refused.source = file.string();
-      refused.metadata = sidecar_.forImage(file, &sidecar_error);
-      return {GrabStatus::Error, std::move(refused), content.error};
+      refused.source = files_[read.index].string();
+      std::string sidecar_error;
+      refused.metadata = sidecar_.forImage(files_[read.index], &sidecar_error);
+      return {GrabStatus::Error, std::move(refused), read.content.error};
     }
-    if (!sidecar_error.empty()) health_.last_error = sidecar_error;
+    if (!read.sidecar_error.empty()) health_.last_error = read.sidecar_error;
+    Frame frame;
+    frame.image = std::move(read.content.image);
+    frame.format = read.content.format;
+    frame.timestamp = std::chrono::system_clock::now();
+    frame.source = files_[read.index].string();
+    frame.metadata = std::move(read.metadata);
     frame.id = next_id_++;
     ++health_.frames;
     return {GrabStatus::Ok, std::move(frame), {}};
@@ -138,12 +182,58 @@ GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
   return {GrabStatus::Error, {}, "no readable image in " + settings_.folder.string()};
 }
 
+void ReplayCamera::readAheadLoop() {
+  std::unique_lock lock(mutex_);
+  while (true) {
+    space_cv_.wait(lock, [&] {
+      return !read_ahead_running_ ||
+             (ready_.size() < static_cast<std::size_t>(settings_.prefetch) && !end_queued_);
+    });
+    if (!read_ahead_running_) return;
+    if (next_to_read_ >= files_.size()) {
+      if (!settings_.loop) {
+        ReadFile end;
+        end.end_of_files = true;
+        ready_.push_back(std::move(end));
+        end_queued_ = true;
+        ready_cv_.notify_all();
+        continue;
+      }
+      next_to_read_ = 0;
+    }
+    const std::size_t index = next_to_read_++;
+    const std::filesystem::path file = files_[index];
+    lock.unlock();
+    ReadFile read = readFile(index, file);
+    lock.lock();
+    if (!read_ahead_running_) return;
+    ready_.push_back(std::move(read));
+    ready_cv_.notify_all();
+  }
+}
+
+void ReplayCamera::stopReadAhead(std::unique_lock<std::mutex>& lock) {
+  if (!read_ahead_.joinable()) return;
+  read_ahead_running_ = false;
+  space_cv_.notify_all();
+  ready_cv_.notify_all();
+  std::thread reader = std::move(read_ahead_);
+  lock.unlock();
+  reader.join();
+  lock.lock();
+  // Files read but not delivered are read again after a restart (start() resumes there).
+  ready_.clear();
+  end_queued_ = false;
+}
+
 void ReplayCamera::stop() {
   {
-    std::lock_guard lock(mutex_);
+    std::unique_lock lock(mutex_);
     health_.streaming = false;
+    stopReadAhead(lock);
   }
   trigger_cv_.notify_all();
+  ready_cv_.notify_all();
 }
 
 void ReplayCamera::close() {

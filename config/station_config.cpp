@@ -69,7 +69,10 @@ class StationReader {
     station_.schemaVersion = static_cast<int>(readInteger(root["schema_version"]).value_or(1));
     station_.name = text(root["name"]);
     if (map(root["camera"])) readCamera(root["camera"]);
-    if (map(root["plc"])) readPlc(root["plc"]);
+    if (map(root["plc"])) {
+      station_.hasPlc = true;
+      readPlc(root["plc"]);
+    }
     if (const auto folder = folderPath(root["recipes"], "recipes"))
       station_.recipesFolder = *folder;
     if (map(root["results"])) readResults(root["results"]);
@@ -141,6 +144,7 @@ class StationReader {
       s.replay.colour = parseColourConversion(text(r["colour"])).value_or(s.replay.colour);
       s.replay.max_pixels = static_cast<std::uint64_t>(
           integer(r["max_pixels"], static_cast<long long>(s.replay.max_pixels)));
+      s.replay.prefetch = static_cast<int>(integer(r["prefetch"], s.replay.prefetch));
     }
     if (const YAML::Node a = c["aravis"]; map(a)) {
       AravisSettings& v = s.aravis;

@@ -51,6 +51,7 @@ struct StationConfig {
   std::string name;
   std::filesystem::path file;  // the station file, absolute
   CameraSettings camera;
+  bool hasPlc = false;  // the file has a plc section (else: no PLC link, as with --no-plc)
   plc::PlcSettings plc;
   plc::RegisterMap registerMap;
   plc::WordOrder wordOrder = plc::WordOrder::ABCD;  // default for recipe outputs

@@ -82,7 +82,8 @@ StationFormat::StationFormat() {
         .defaultValue = 0.0},
        choice("trigger", "free_run or software.", {"free_run", "software"}, "free_run"),
        choice("colour", "keep, mono or colour.", kColour, "keep"),
-       integer("max_pixels", "Files announcing more pixels are skipped.", 1, 9.0e15, 268435456)}};
+       integer("max_pixels", "Files announcing more pixels are skipped.", 1, 9.0e15, 268435456),
+       integer("prefetch", "Files read ahead of the trigger; 0 = read when grabbed.", 0, 16, 2)}};
   aravis = {
       "aravis camera",
       "A GigE Vision / USB3 Vision camera through Aravis.",
@@ -235,7 +236,7 @@ StationFormat::StationFormat() {
       {integer("schema_version", "Version of this format; 1.", 1, 1),
        text("name", "Station name, shown on the dashboard."),
        section("camera", "Where frames come from.", &camera, true),
-       section("plc", "The line's PLC.", &plc, true),
+       section("plc", "The line's PLC; without it facetd runs without a PLC link.", &plc),
        path("recipes", "Recipes folder, relative to the station file.", true),
        section("results", "Results store.", &results, true),
        section("archive", "Image archive.", &archive), section("http", "HTTP server.", &http),

@@ -262,13 +262,25 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     search.minScore = params.minScore * (l > 0                                   ? kMiddleFactor
                                          : params.subpixel == SubpixelMode::None ? 1.0
                                                                                  : kFinalFactor);
+    // Each candidate is tracked on its own (the field is read-only here), in parallel when
+    // threads > 1; kept in their order, so the result is the same for any number of threads.
+    std::vector<Candidate> tracked(candidates.size());
+    auto track = [&](const cv::Range& r) {
+      for (int i = r.start; i < r.end; ++i) {
+        Candidate c = candidates[static_cast<std::size_t>(i)];
+        c.x *= 2.0;
+        c.y *= 2.0;
+        tracked[static_cast<std::size_t>(i)] = refineOnLevel(search, c, 2);
+      }
+    };
+    const cv::Range all(0, static_cast<int>(candidates.size()));
+    if (params.threads > 1 && candidates.size() > 1)
+      cv::parallel_for_(all, track, static_cast<double>(candidates.size()));
+    else
+      track(all);
     std::vector<Candidate> next;
-    for (Candidate c : candidates) {
-      c.x *= 2.0;
-      c.y *= 2.0;
-      const Candidate r = refineOnLevel(search, c, 2);
+    for (const Candidate& r : tracked)
       if (r.score >= search.minScore) next.push_back(r);
-    }
     candidates.swap(next);
   }
   if (top == 0) {

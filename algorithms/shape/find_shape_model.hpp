@@ -57,7 +57,9 @@ struct FindParams {
   SubpixelMode subpixel = SubpixelMode::LeastSquares;
   // Number of pyramid levels used, 0 = all of the model's. Fewer levels = slower, more robust.
   int numLevels = 0;
-  // Parallel stripes of the top-level search (1..8), run on OpenCV's worker pool. Default 2.
+  // Parallelism on OpenCV's worker pool: stripes of the top-level search (1..8), and, when > 1,
+  // the candidates tracked down the pyramid in parallel. The matches do not depend on it.
+  // Default 2.
   int threads = 2;
 };
 

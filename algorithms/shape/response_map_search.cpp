@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <numbers>
 
 #include "algorithms/shape/image_gradients.hpp"
@@ -53,18 +54,35 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
     cosB[b] = static_cast<float>(std::cos(b * kTwoPi / kBins));
     sinB[b] = static_cast<float>(std::sin(b * kTwoPi / kBins));
   }
-  for (int y = 0; y < h; ++y) {
-    const auto* row = field.ptr<Direction>(y);
-    const std::size_t base = static_cast<std::size_t>(y + border) * stride + border;
-    for (int x = 0; x < w; ++x) {
-      if (row[x][0] == 0 && row[x][1] == 0) continue;
-      for (int b = 0; b < kBins; ++b) {
-        float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
-        if (local) v = std::abs(v);
-        maps[b * plane + base + x] = static_cast<std::int8_t>(std::lround(v));
+  threads = std::clamp(threads, 1, 8);
+  // Rows in parallel stripes on OpenCV's worker pool (the algorithms start no threads of their
+  // own); every stripe writes its own rows, so the result does not depend on the stripes.
+  auto inStripes = [&](const std::function<void(int, int)>& rows) {
+    if (threads == 1 || h < 2 * threads) {
+      rows(0, h);
+      return;
+    }
+    cv::parallel_for_(
+        cv::Range(0, threads),
+        [&](const cv::Range& r) {
+          for (int k = r.start; k < r.end; ++k) rows(h * k / threads, h * (k + 1) / threads);
+        },
+        threads);
+  };
+  inStripes([&](int y0, int y1) {
+    for (int y = y0; y < y1; ++y) {
+      const auto* row = field.ptr<Direction>(y);
+      const std::size_t base = static_cast<std::size_t>(y + border) * stride + border;
+      for (int x = 0; x < w; ++x) {
+        if (row[x][0] == 0 && row[x][1] == 0) continue;
+        for (int b = 0; b < kBins; ++b) {
+          float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
+          if (local) v = std::abs(v);
+          maps[b * plane + base + x] = static_cast<std::int8_t>(std::lround(v));
+        }
       }
     }
-  }
+  });
 
   std::vector<TopTemplate> templates;
   for (double s : scales) {
@@ -106,18 +124,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
       }
     }
   };
-  threads = std::clamp(threads, 1, 8);
-  if (threads == 1 || h < 2 * threads) {
-    work(0, h);
-  } else {
-    // OpenCV's worker pool: the algorithms start no threads of their own.
-    cv::parallel_for_(
-        cv::Range(0, threads),
-        [&](const cv::Range& r) {
-          for (int k = r.start; k < r.end; ++k) work(h * k / threads, h * (k + 1) / threads);
-        },
-        threads);
-  }
+  inStripes(work);
 
   // Local maxima above the threshold.
   const double norm = 127.0 * static_cast<double>(points.size());

@@ -3,15 +3,27 @@
 // circle measurements (bench recipe below, models of recipes/models).
 //
 //   latency     PLC trigger raised -> result registers read by the PLC (plc::PlcSimulator, a
-//               Modbus TCP server in this process; the station is its client), one part at a time
+//               Modbus TCP server in this process; the station is its client), one part at a time.
+//               Includes: the simulator's scan (0.5 ms) raising the coil, the link's trigger poll
+//               (2 ms period) and busy write, the frame taken from the replay camera, the
+//               inspection, the queue hand-overs, the link writing every result register and
+//               result valid, and the simulator's scan reading them. The replay camera reads
+//               the next PNGs ahead (prefetch 2), as a real camera has its frame in memory at the
+//               trigger; exposure and transfer of a real camera are not modelled.
 //   throughput  free run, no PLC: parts per second
 //   memory      VmRSS sampled every 1000 parts over the free run (20,000 parts in a full run)
-//   stages      mean grab / inspect / publish times from the station's facet_stage_ms histograms
-//   baseline    OpenCV for the same stages: cv::imread (grab), cv::matchTemplate of the part and
-//               of the label (alignment, shape match; no rotation search), cv::HoughCircles in
-//               the two bore windows (circles)
+//   stages      mean times per stage from the station's facet_stage_ms histograms, and per
+//               recipe step from the parts' step timings
+//   cpu         process CPU time (all threads) per part in each phase
+//   baseline    OpenCV for the same stages: cv::imread (decode), cv::matchTemplate of the part
+//               and of the label (alignment, shape match; no rotation search), cv::HoughCircles
+//               in the two bore windows (circles)
 //
-//   bench_daemon [--smoke] [--parts N] [--triggers N]
+//   frames      PNG as recorded (default), or binary PGM with --pgm (raw pixels, no decoding)
+//
+//   bench_daemon [--smoke] [--pgm] [--parts N] [--triggers N]
+#include <time.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -32,6 +44,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "camera/image_file_reader.hpp"
 #include "config/station_config.hpp"
 #include "plc/plc_simulator.hpp"
 #include "service/daemon/station.hpp"
@@ -89,8 +102,9 @@ steps:
 )";
 
 // 1280x1024 frames: each recorded 640x480 bracket scene pasted at a different place on a
-// background of the same grey and noise.
-std::vector<fs::path> makeFrames(const fs::path& folder) {
+// background of the same grey and noise. Stored as PNG (as recorded), or as binary PGM
+// (`extension` ".pgm": raw pixels, as a high-rate recording would keep them).
+std::vector<fs::path> makeFrames(const fs::path& folder, const std::string& extension) {
   fs::create_directories(folder);
   std::vector<fs::path> demo;
   for (const auto& e : fs::directory_iterator(kSource / "recipes/demo/bracket_shape"))
@@ -110,7 +124,7 @@ std::vector<fs::path> makeFrames(const fs::path& folder) {
     const int x = static_cast<int>((i * 97) % (1280 - 640));
     const int y = static_cast<int>((i * 131) % (1024 - 480));
     scene.copyTo(frame(cv::Rect(x, y, scene.cols, scene.rows)));
-    const fs::path out = folder / demo[i].filename();
+    const fs::path out = folder / demo[i].filename().replace_extension(extension);
     cv::imwrite(out.string(), frame);
     fs::copy_file(demo[i].string() + ".json", out.string() + ".json",
                   fs::copy_options::overwrite_existing);
@@ -119,25 +133,27 @@ std::vector<fs::path> makeFrames(const fs::path& folder) {
   return frames;
 }
 
-fs::path writeStation(const fs::path& dir, const fs::path& frames, int plcPort) {
+fs::path writeStation(const fs::path& dir, const fs::path& frames, int plcPort,
+                      const std::string& extension) {
   fs::create_directories(dir / "recipes");
   fs::copy(kSource / "recipes/models", dir / "recipes/models",
            fs::copy_options::recursive | fs::copy_options::skip_existing);
   std::ofstream(dir / "recipes/bench.recipe.yaml") << kRecipe;
   std::ofstream f(dir / "station.yaml");
   f << "schema_version: 1\nname: bench\ncamera:\n  backend: replay\n  replay:\n    folder: "
-    << frames.string() << "\n    glob: \"*.png\"\n    loop: true\n    fps: 0\n"
+    << frames.string() << "\n    glob: \"*" << extension << "\"\n    loop: true\n    fps: 0\n"
     << "    trigger: software\n    colour: mono\n";
-  // The free run uses no PLC (StationOptions::usePlc), but a station file always has one.
-  f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
-    << "  port: " << (plcPort > 0 ? plcPort : 502) << "\n  unit_id: 1\n  word_order: ABCD\n"
-    << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
-    << "  register_map:\n    address_base: 0\n    control:\n"
-    << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n    status:\n"
-    << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
-    << "      pass: {coil: 19}\n      completed_toggle: {coil: 20}\n"
-    << "      missed_trigger: {coil: 21}\n      error: {coil: 22}\n"
-    << "      error_code: {register: 10}\n      inspection_counter: {register: 12}\n";
+  // The free run has no PLC: its station file has no plc section.
+  if (plcPort > 0)
+    f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
+      << "  port: " << plcPort << "\n  unit_id: 1\n  word_order: ABCD\n"
+      << "  response_timeout_ms: 500\n  heartbeat_period_ms: 1000\n"
+      << "  register_map:\n    address_base: 0\n    control:\n"
+      << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n    status:\n"
+      << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
+      << "      pass: {coil: 19}\n      completed_toggle: {coil: 20}\n"
+      << "      missed_trigger: {coil: 21}\n      error: {coil: 22}\n"
+      << "      error_code: {register: 10}\n      inspection_counter: {register: 12}\n";
   f << "recipes: recipes\nresults:\n  database: " << (dir / "results.db").string()
     << "\narchive:\n  folder: " << (dir / "archive").string()
     << "\n  quota_mb: 20\n  keep: fail\nhttp:\n  bind: 127.0.0.1\n  port: 0\n"
@@ -149,6 +165,12 @@ config::StationConfig loadStation(const fs::path& file) {
   auto loaded = config::loadStationConfig(file);
   if (!loaded.station) throw std::runtime_error(loaded.diagnostics.text());
   return *loaded.station;
+}
+
+double mean(const std::vector<double>& v) {
+  double sum = 0;
+  for (double x : v) sum += x;
+  return v.empty() ? 0 : sum / static_cast<double>(v.size());
 }
 
 double percentile(std::vector<double> v, double q) {
@@ -176,13 +198,78 @@ double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
 
+double cpuSeconds() {
+  timespec t{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+
+std::string loadAverage() {
+  std::ifstream f("/proc/loadavg");
+  std::string a, b, c;
+  f >> a >> b >> c;
+  return a + " " + b + " " + c;
+}
+
+// Mean per stage (facet_stage_ms) and per recipe step of one station's parts.
+struct StageSplit {
+  std::map<std::string, double> stageMs;
+  std::map<std::string, double> stepMs;  // summed by the publishing thread, divided at the end
+  int parts = 0;
+  double stepMean(const std::string& step) const {
+    const auto it = stepMs.find(step);
+    return it == stepMs.end() || parts == 0 ? 0 : it->second / parts;
+  }
+  double stage(const std::string& name) const {
+    const auto it = stageMs.find(name);
+    return it == stageMs.end() ? 0 : it->second;
+  }
+};
+
+// Sum and count of one stage's histogram.
+std::pair<double, double> stageTotals(service::Station& s, const char* stage) {
+  auto& h =
+      s.metrics().histogram("facet_stage_ms", "Latency per stage", service::latencyBucketsMs(),
+                            std::string("stage=\"") + stage + "\"");
+  return {h.sum(), static_cast<double>(h.count())};
+}
+
+constexpr const char* kStages[] = {"trigger", "grab", "inspect", "publish", "plc_write", "total"};
+
+// Means of the parts observed since `before` (stage -> sum, count), e.g. after warm-up parts.
+void readStages(service::Station& s, StageSplit& split,
+                const std::map<std::string, std::pair<double, double>>& before = {}) {
+  for (const char* stage : kStages) {
+    auto [sum, count] = stageTotals(s, stage);
+    if (const auto it = before.find(stage); it != before.end()) {
+      sum -= it->second.first;
+      count -= it->second.second;
+    }
+    split.stageMs[stage] = count > 0 ? sum / count : 0;
+  }
+}
+
+std::map<std::string, std::pair<double, double>> stageSnapshot(service::Station& s) {
+  std::map<std::string, std::pair<double, double>> out;
+  for (const char* stage : kStages) out[stage] = stageTotals(s, stage);
+  return out;
+}
+
+void addSteps(const service::PartResult& p, StageSplit& split) {
+  ++split.parts;
+  for (const auto& t : p.timings) split.stepMs[t.step] += t.ms;
+}
+
 struct Latency {
   std::vector<double> ms;
+  StageSplit split;
+  double cpuMsPerPart = 0;
 };
 
 // One part at a time: trigger, wait for the result registers, next trigger.
-Latency measureLatency(const fs::path& dir, const fs::path& frames, int triggers) {
-  const auto probe = loadStation(writeStation(dir / "probe", frames, 1));
+Latency measureLatency(const fs::path& dir, const fs::path& frames, const std::string& extension,
+                       int triggers) {
+  const auto probe = loadStation(writeStation(dir / "probe", frames, 1, extension));
   plc::RegisterMap map = probe.registerMap;
   for (const auto& [name, reg] :
        {std::pair{"big_bore.diameter", 140}, {"corner_bore.diameter", 142}}) {
@@ -201,12 +288,24 @@ Latency measureLatency(const fs::path& dir, const fs::path& frames, int triggers
     arrived.notify_all();
   });
   plc.start();
-  auto station = loadStation(writeStation(dir / "latency", frames, plc.port()));
+  auto station = loadStation(writeStation(dir / "latency", frames, plc.port(), extension));
   service::StationOptions options;
+  Latency out;
+  options.onPart = [&](const service::PartResult& p) {
+    std::lock_guard lock(mutex);
+    addSteps(p, out.split);
+  };
   service::Station s(station, options);
   s.start();
-  Latency out;
+  double cpu0 = 0;
+  std::map<std::string, std::pair<double, double>> afterWarmUp;
   for (int i = -5; i < triggers; ++i) {  // 5 warm-up parts (and the PLC link connecting)
+    if (i == 0) {
+      cpu0 = cpuSeconds();
+      afterWarmUp = stageSnapshot(s);
+      std::lock_guard lock(mutex);
+      out.split = {};
+    }
     std::unique_lock lock(mutex);
     const std::size_t before = received.size();
     const auto t0 = Clock::now();
@@ -221,30 +320,26 @@ Latency measureLatency(const fs::path& dir, const fs::path& frames, int triggers
     lock.unlock();
     std::this_thread::sleep_for(10ms);  // the PLC acknowledges and lowers its trigger
   }
+  out.cpuMsPerPart = 1000.0 * (cpuSeconds() - cpu0) / std::max<std::size_t>(1, out.ms.size());
   s.requestStop();
   s.join();
   plc.stop();
+  readStages(s, out.split, afterWarmUp);
   return out;
 }
 
 struct FreeRun {
   double partsPerSecond = 0;
+  double cpuMsPerPart = 0;
   std::vector<long> rss;
-  double grab = 0, inspect = 0, publish = 0;
+  StageSplit split;
   std::map<std::string, int> verdicts;  // written by the publishing thread only
 };
 
-double stageMean(service::Station& s, const char* stage) {
-  auto& h =
-      s.metrics().histogram("facet_stage_ms", "Latency per stage", service::latencyBucketsMs(),
-                            std::string("stage=\"") + stage + "\"");
-  return h.count() ? h.sum() / static_cast<double>(h.count()) : 0;
-}
-
-FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, int parts) {
-  auto station = loadStation(writeStation(dir / "free", frames, 0));
+FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, const std::string& extension,
+                       int parts) {
+  auto station = loadStation(writeStation(dir / "free", frames, 0, extension));
   service::StationOptions options;
-  options.usePlc = false;
   options.overflow = service::OverflowPolicy::Block;  // sustained rate: no part dropped
   options.maxParts = static_cast<std::uint64_t>(parts);
   FreeRun out;
@@ -253,6 +348,7 @@ FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, int parts) {
   options.onPart = [&](const service::PartResult& p) {
     const int n = ++done;
     ++out.verdicts[service::verdictName(p.verdict)];
+    addSteps(p, out.split);
     if (n % 1000 == 0 || n == parts / 10) {
       std::lock_guard lock(mutex);
       out.rss.push_back(rssKb());
@@ -261,17 +357,18 @@ FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, int parts) {
   service::Station s(station, options);
   s.start();
   const auto t0 = Clock::now();
+  const double cpu0 = cpuSeconds();
   s.join();
   out.partsPerSecond = done / std::chrono::duration<double>(Clock::now() - t0).count();
+  out.cpuMsPerPart = 1000.0 * (cpuSeconds() - cpu0) / std::max(1, done.load());
   out.rss.push_back(rssKb());
-  out.grab = stageMean(s, "grab");
-  out.inspect = stageMean(s, "inspect");
-  out.publish = stageMean(s, "publish");
+  readStages(s, out.split);
   return out;
 }
 
 struct Baseline {
   double grab = 0, inspect = 0;
+  double facetDecode = 0;  // the replay camera's reader (OpenImageIO) on the same files
 };
 
 // OpenCV doing the same stages on the same frames (no rotation search, no subpixel fits).
@@ -280,11 +377,15 @@ Baseline openCvBaseline(const std::vector<fs::path>& frames, int rounds) {
       cv::imread((kSource / "recipes/models/bracket_template.png").string(), cv::IMREAD_GRAYSCALE);
   const cv::Mat label =
       cv::imread((kSource / "recipes/models/label_template.png").string(), cv::IMREAD_GRAYSCALE);
-  double grab = 0, inspect = 0;
+  double grab = 0, inspect = 0, facetDecode = 0;
   int n = 0;
   for (int r = 0; r < rounds; ++r)
     for (const auto& f : frames) {
       auto t0 = Clock::now();
+      const ImageFileContent content = readImageFile(f, std::uint64_t{1} << 28);
+      facetDecode += ms(Clock::now() - t0);
+      if (!content.ok()) throw std::runtime_error(content.error);
+      t0 = Clock::now();
       const cv::Mat image = cv::imread(f.string(), cv::IMREAD_GRAYSCALE);
       grab += ms(Clock::now() - t0);
       t0 = Clock::now();
@@ -305,24 +406,26 @@ Baseline openCvBaseline(const std::vector<fs::path>& frames, int rounds) {
       inspect += ms(Clock::now() - t0);
       ++n;
     }
-  return {grab / n, inspect / n};
+  return {grab / n, inspect / n, facetDecode / n};
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool smoke = false;
+  bool smoke = false, pgm = false;
   int parts = 20000, triggers = 500;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--smoke")
       smoke = true;
+    else if (a == "--pgm")
+      pgm = true;
     else if (a == "--parts" && i + 1 < argc)
       parts = std::stoi(argv[++i]);
     else if (a == "--triggers" && i + 1 < argc)
       triggers = std::stoi(argv[++i]);
     else {
-      std::cerr << "usage: bench_daemon [--smoke] [--parts N] [--triggers N]\n";
+      std::cerr << "usage: bench_daemon [--smoke] [--pgm] [--parts N] [--triggers N]\n";
       return 1;
     }
   }
@@ -334,19 +437,25 @@ int main(int argc, char** argv) {
   char name[] = "/tmp/facet-bench-daemon-XXXXXX";
   const fs::path dir = ::mkdtemp(name);
   try {
-    const auto frames = makeFrames(dir / "frames");
-    const Latency latency = measureLatency(dir, dir / "frames", triggers);
-    FreeRun run = measureFreeRun(dir, dir / "frames", parts);
+    const std::string loadBefore = loadAverage();
+    const std::string extension = pgm ? ".pgm" : ".png";
+    const auto frames = makeFrames(dir / "frames", extension);
+    const Latency latency = measureLatency(dir, dir / "frames", extension, triggers);
+    FreeRun run = measureFreeRun(dir, dir / "frames", extension, parts);
     const Baseline cv = openCvBaseline(frames, smoke ? 1 : 5);
+    const std::string loadAfter = loadAverage();
     const double median = percentile(latency.ms, 0.5), p99 = percentile(latency.ms, 0.99);
     const long rssFirst = run.rss.empty() ? 0 : run.rss.front();
     const long rssMax = run.rss.empty() ? 0 : *std::max_element(run.rss.begin(), run.rss.end());
     const double growth = rssFirst ? 100.0 * (rssMax - rssFirst) / rssFirst : 0;
-    const double facetPart = run.grab + run.inspect + run.publish;
-    std::printf("bench_daemon%s: 1280x1024 Mono8 replay, recipe align(shape) + shape + 2 circles\n",
-                smoke ? " --smoke" : "");
-    std::printf("%d triggered parts, %d free-run parts, hardware threads %u\n\n",
+    std::printf(
+        "bench_daemon%s%s: 1280x1024 Mono8 replay of %s files, recipe align(shape) + shape"
+        " + 2 circles\n",
+        smoke ? " --smoke" : "", pgm ? " --pgm" : "", pgm ? "PGM" : "PNG");
+    std::printf("%d triggered parts, %d free-run parts, hardware threads %u\n",
                 static_cast<int>(latency.ms.size()), parts, std::thread::hardware_concurrency());
+    std::printf("load average (1/5/15 min) at start %s, at end %s\n\n", loadBefore.c_str(),
+                loadAfter.c_str());
     std::printf("| figure                            | facet      | target      | met |\n");
     std::printf("| --------------------------------- | ---------- | ----------- | --- |\n");
     std::printf("| trigger -> result registers, p50  | %7.1f ms | <= 20 ms    | %s |\n", median,
@@ -357,25 +466,70 @@ int main(int argc, char** argv) {
                 run.partsPerSecond, run.partsPerSecond >= 40 ? "yes" : "NO ");
     std::printf("| VmRSS growth over the run         | %+7.1f %%  | within 5 %%  | %s |\n", growth,
                 std::abs(growth) <= 5 ? "yes" : "NO ");
-    std::printf("  (VmRSS samples: %zu, first %ld kB, max %ld kB)\n", run.rss.size(), rssFirst,
+    std::printf("  (VmRSS samples: %zu, first %ld kB, max %ld kB; MB:", run.rss.size(), rssFirst,
                 rssMax);
+    for (long kb : run.rss) std::printf(" %ld", kb / 1024);
+    std::printf(")\n");
+    // The first sample and the maximum both depend on how many frames happen to be queued (up to
+    // inspect + publish queue + read-ahead, ~20 MB); a leak shows as a trend instead.
+    if (run.rss.size() >= 10) {
+      double head = 0, tail = 0;
+      for (std::size_t i = 0; i < 5; ++i)
+        head += run.rss[i], tail += run.rss[run.rss.size() - 1 - i];
+      std::printf("  VmRSS trend (mean of the last 5 samples vs the first 5): %+.1f %%\n",
+                  100.0 * (tail - head) / head);
+    }
+    std::printf("  CPU time per part (all threads): triggered %.1f ms, free run %.1f ms\n",
+                latency.cpuMsPerPart, run.cpuMsPerPart);
     // The bench recipe checks fewer things than bracket_shape (no label angle, no bore-to-edge
     // distance), so parts the sidecars call "fail" may pass here; errors must be 0.
     std::printf("  free-run verdicts: pass %d, fail %d, error %d\n\n", run.verdicts["pass"],
                 run.verdicts["fail"], run.verdicts["error"]);
-    std::printf("| stage (mean per part)  | facet     | OpenCV baseline              | ratio |\n");
-    std::printf("| ---------------------- | --------- | ---------------------------- | ----- |\n");
-    std::printf("| grab (PNG decode)      | %6.2f ms | %6.2f ms cv::imread          | %5.2f |\n",
-                run.grab, cv.grab, run.grab / cv.grab);
-    std::printf("| inspect                | %6.2f ms | %6.2f ms matchTemplate+Hough | %5.2f |\n",
-                run.inspect, cv.inspect, run.inspect / cv.inspect);
-    std::printf("| publish                | %6.2f ms | -                            |   -   |\n",
-                run.publish);
-    std::printf("| total                  | %6.2f ms | %6.2f ms                     | %5.2f |\n",
+
+    const StageSplit& l = latency.split;
+    const double lMean = mean(latency.ms);
+    const double accounted =
+        l.stage("trigger") + l.stage("grab") + l.stage("inspect") + l.stage("plc_write");
+    std::printf("| triggered part, mean                                       | ms      |\n");
+    std::printf("| ---------------------------------------------------------- | ------- |\n");
+    std::printf("| trigger edge read -> acquisition (busy written, hand-over) | %7.2f |\n",
+                l.stage("trigger"));
+    std::printf("| grab: frame from the replay camera (read ahead)            | %7.2f |\n",
+                l.stage("grab"));
+    std::printf("| inspect                                                    | %7.2f |\n",
+                l.stage("inspect"));
+    std::printf("| publish() -> result registers + result valid written       | %7.2f |\n",
+                l.stage("plc_write"));
+    std::printf("| rest: PLC scan and poll, queues between stages, wake-ups   | %7.2f |\n",
+                lMean - accounted);
+    std::printf("| trigger raised -> result registers read by the PLC         | %7.2f |\n", lMean);
+    std::printf("| (off the latency path) results store + archive + metrics    | %7.2f |\n\n",
+                l.stage("publish"));
+
+    std::printf("| recipe step (mean)     | triggered | free run  |\n");
+    std::printf("| ---------------------- | --------- | --------- |\n");
+    for (const auto& [step, total] : run.split.stepMs)
+      std::printf("| %-22s | %6.2f ms | %6.2f ms |\n", step.c_str(), l.stepMean(step),
+                  run.split.stepMean(step));
+    std::printf("\n");
+
+    const StageSplit& f = run.split;
+    const double facetPart = f.stage("grab") + f.stage("inspect") + f.stage("publish");
+    std::printf("| stage (free run, mean)  | facet     | OpenCV baseline              | ratio |\n");
+    std::printf("| ----------------------- | --------- | ---------------------------- | ----- |\n");
+    std::printf("| %s decode (read ahead) | %6.2f ms | %6.2f ms cv::imread          | %5.2f |\n",
+                pgm ? "PGM" : "PNG", cv.facetDecode, cv.grab, cv.facetDecode / cv.grab);
+    std::printf("| grab (wait for a frame) | %6.2f ms | %6.2f ms cv::imread          | %5.2f |\n",
+                f.stage("grab"), cv.grab, f.stage("grab") / cv.grab);
+    std::printf("| inspect                 | %6.2f ms | %6.2f ms matchTemplate+Hough | %5.2f |\n",
+                f.stage("inspect"), cv.inspect, f.stage("inspect") / cv.inspect);
+    std::printf("| publish                 | %6.2f ms | -                            |   -   |\n",
+                f.stage("publish"));
+    std::printf("| grab + inspect + publish| %6.2f ms | %6.2f ms                     | %5.2f |\n",
                 facetPart, cv.grab + cv.inspect, facetPart / (cv.grab + cv.inspect));
     std::printf(
         "(the baseline searches no rotation and fits no subpixel edges: it is a floor, not"
-        " a peer)\n");
+        " a peer; the stages overlap in free run, so parts/s is not 1000 / their sum)\n");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_daemon: %s\n", e.what());
     fs::remove_all(dir);

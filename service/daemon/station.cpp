@@ -107,7 +107,9 @@ Station::Station(config::StationConfig config, StationOptions options)
   config_.camera.replay.report_unreadable = true;
   camera_ = makeCamera(config_.camera);
   if (!config_.camera.scans.folder.empty()) scans_ = makeScanReplay(config_.camera.scans);
-  if (options_.usePlc)
+  if (options_.usePlc && !config_.hasPlc)
+    spdlog::info("station {}: no plc section, running without a PLC link", config_.file.string());
+  if (options_.usePlc && config_.hasPlc)
     plc_ = std::make_unique<plc::PlcLink>(fullRegisterMap(config_, recipes), config_.plc);
   metrics_.gauge("facet_up", "1 while facetd runs").set(1);
 }
@@ -250,6 +252,11 @@ void Station::acquisitionLoop() {
     if (triggered) {
       trigger = plc_->waitTrigger(100ms);
       if (!trigger) continue;
+      // Trigger edge read by the link -> taken here (busy written, queue hand-over).
+      metrics_
+          .histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"trigger\"")
+          .observe(
+              std::chrono::duration<double, std::milli>(Clock::now() - trigger->seenAt).count());
       camera_->softwareTrigger();
     }
     const auto t0 = Clock::now();
@@ -533,6 +540,12 @@ void Station::publishPart(Job& j) {
     if (!plc_->publish(std::move(r)))
       spdlog::error("part {} recipe {}: result not delivered to the PLC (queue full)", p.partId,
                     p.recipeId);
+    // Handshakes completed so far (the link times each once the PLC has acknowledged it).
+    for (const auto& t : plc_->takeTimings())
+      metrics_
+          .histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(),
+                     "stage=\"plc_write\"")
+          .observe(std::chrono::duration<double, std::milli>(t.publishToResultValid).count());
   }
   // 2. The results store: a part that cannot be stored is counted and logged, never silent.
   try {

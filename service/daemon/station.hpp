@@ -41,11 +41,13 @@ namespace facet::service {
 struct StationOptions {
   OverflowPolicy overflow = OverflowPolicy::DropOldest;  // when inspection falls behind
   std::size_t inspectQueue = 4;                          // frames waiting for inspection
-  std::size_t publishQueue = 64;                         // results waiting for publishing
+  // Results waiting for publishing. Each holds its frame (1.3 MB at 1280x1024), so this bounds
+  // memory; a backlog beyond it waits upstream, where the overflow policy sees it.
+  std::size_t publishQueue = 8;
   std::optional<int> recipe;       // recipe to start with (default: the lowest id)
   std::uint64_t maxParts = 0;      // stop after this many parts (0 = run until stopped)
   bool stopAtEndOfStream = false;  // replay without loop: stop once every file was inspected
-  bool usePlc = true;              // false: no PLC link even if configured
+  bool usePlc = true;              // false: no PLC link even if configured (none if not)
   std::function<void(const PartResult&)> onPart;  // called by the publishing stage, per part
 };
 

@@ -355,6 +355,96 @@ TEST(ReplayCamera, FrameRatePacesFreeRun) {
   EXPECT_EQ(slow.health().timeouts, 1u);
 }
 
+TEST(ReplayCamera, ReadAheadIsBoundedAndBadFilesCountWhenReached) {
+  TempFolder folder;
+  for (int i = 0; i < 5; ++i)
+    cv::imwrite((folder / ("p" + std::to_string(i) + ".png")).string(),
+                cv::Mat(4, 4, CV_8UC1, cv::Scalar(i)));
+  auto settings = replayOf(folder);
+  settings.trigger = TriggerMode::Software;
+  settings.prefetch = 2;
+  ReplayCamera camera(settings);
+  camera.open();
+  camera.start();
+  // Time for the read-ahead to fill up (with p0 and p1), then break the files after those: with
+  // at most two files read ahead, p2 and p3 are read only once p0 has been delivered.
+  std::this_thread::sleep_for(300ms);
+  folder.write("p2.png", "broken after start");
+  folder.write("p3.png", "broken after start");
+  for (int expected : {0, 1}) {
+    camera.softwareTrigger();
+    GrabResult r = camera.grab(5s);
+    ASSERT_TRUE(r.ok()) << r.message;
+    EXPECT_EQ(r.frame.image.at<std::uint8_t>(0, 0), expected);
+    EXPECT_EQ(camera.health().skipped_files, 0u) << "a bad file counts when grab reaches it";
+  }
+  camera.softwareTrigger();
+  GrabResult r = camera.grab(5s);
+  ASSERT_TRUE(r.ok()) << r.message;
+  EXPECT_EQ(r.frame.image.at<std::uint8_t>(0, 0), 4);
+  EXPECT_EQ(r.frame.id, 2u);
+  EXPECT_EQ(camera.health().skipped_files, 2u);
+  EXPECT_NE(camera.health().last_error.find("p3.png"), std::string::npos)
+      << camera.health().last_error;
+  EXPECT_EQ(camera.grab(20ms).status, GrabStatus::Timeout);  // still one frame per trigger
+  camera.softwareTrigger();
+  EXPECT_EQ(camera.grab(5s).status, GrabStatus::EndOfStream);
+  camera.softwareTrigger();
+  EXPECT_EQ(camera.grab(5s).status, GrabStatus::EndOfStream);
+}
+
+TEST(ReplayCamera, ReadAheadDeliversWhatReadingOnGrabDelivers) {
+  TempFolder folder;
+  for (int i = 0; i < 4; ++i)
+    cv::imwrite((folder / ("q" + std::to_string(i) + ".png")).string(),
+                randomImage(24, 32, CV_8UC1, 10 + i));
+  folder.write("q2.png", "junk");
+  auto settings = replayOf(folder);
+  settings.loop = true;
+  settings.prefetch = 0;
+  ReplayCamera direct(settings);
+  settings.prefetch = 3;
+  ReplayCamera ahead(settings);
+  for (ReplayCamera* c : {&direct, &ahead}) {
+    c->open();
+    c->start();
+  }
+  for (int i = 0; i < 8; ++i) {
+    const GrabResult a = direct.grab(1s), b = ahead.grab(1s);
+    ASSERT_TRUE(a.ok() && b.ok()) << a.message << " / " << b.message;
+    EXPECT_EQ(a.frame.source, b.frame.source);
+    EXPECT_EQ(a.frame.id, b.frame.id);
+    EXPECT_TRUE(sameImage(a.frame.image, b.frame.image));
+  }
+  EXPECT_EQ(direct.health().skipped_files, ahead.health().skipped_files);
+  EXPECT_EQ(ahead.health().frames, 8u);
+}
+
+TEST(ReplayCamera, RestartResumesAtTheFirstFileNotDelivered) {
+  TempFolder folder;
+  const std::vector<std::string> names = {"r0.png", "r1.png", "r2.png", "r3.png"};
+  for (int i = 0; i < 4; ++i)
+    cv::imwrite((folder / names[static_cast<std::size_t>(i)]).string(),
+                cv::Mat(4, 4, CV_8UC1, cv::Scalar(i)));
+  auto settings = replayOf(folder);
+  settings.prefetch = 3;
+  ReplayCamera camera(settings);
+  camera.open();
+  camera.start();
+  ASSERT_EQ(camera.grab(1s).frame.image.at<std::uint8_t>(0, 0), 0);
+  std::this_thread::sleep_for(50ms);  // r1..r3 read ahead, then dropped by stop()
+  camera.stop();
+  EXPECT_EQ(camera.grab(10ms).status, GrabStatus::NotStarted);
+  camera.start();
+  for (int expected : {1, 2, 3}) {
+    GrabResult r = camera.grab(1s);
+    ASSERT_TRUE(r.ok()) << r.message;
+    EXPECT_EQ(r.frame.image.at<std::uint8_t>(0, 0), expected);
+    EXPECT_EQ(r.frame.id, static_cast<std::uint64_t>(expected));
+  }
+  EXPECT_EQ(camera.grab(1s).status, GrabStatus::EndOfStream);
+}
+
 TEST(ReplayCamera, SidecarMetadataFlowsIntoFrames) {
   TempFolder folder;
   for (const char* name : {"p1.png", "p2.png", "p3.png"})

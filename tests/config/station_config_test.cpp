@@ -97,6 +97,21 @@ TEST_F(StationProblems, ResultsRetentionIsReadAndCheckedWithItsLine) {
   EXPECT_TRUE(hasDiagnostic(r.diagnostics, 14, 15, "'keep_parts' must be")) << r.diagnostics.text();
 }
 
+TEST_F(StationProblems, ThePlcSectionIsOptional) {
+  const auto with = load(kMinimal);
+  ASSERT_TRUE(with.station.has_value()) << with.diagnostics.text();
+  EXPECT_TRUE(with.station->hasPlc);
+  std::string text = kMinimal;
+  const auto plc = text.find("plc:\n");
+  text.erase(plc, text.find("recipes:") - plc);
+  const auto without = load(text);
+  ASSERT_TRUE(without.station.has_value()) << without.diagnostics.text();
+  EXPECT_TRUE(without.diagnostics.empty()) << without.diagnostics.text();
+  EXPECT_FALSE(without.station->hasPlc);
+  EXPECT_FALSE(without.station->registerMap.control.trigger.has_value());
+  EXPECT_TRUE(without.station->reservedRegisters().empty());
+}
+
 TEST_F(StationProblems, UnknownKeysAndBadValuesAreReportedTogether) {
   std::string text = kMinimal;
   text.replace(text.find("  backend: replay"), 17, "  backend: replay\n  exposure: 100");

@@ -156,6 +156,37 @@ TEST(FindShapeModel, NumMatchesAndScoreOrder) {
   EXPECT_EQ(findShapeModel(image, bracketModel(), p).size(), 1u);
 }
 
+TEST(FindShapeModel, ThreadsDoNotChangeTheMatches) {
+  // Several parts, one of them half hidden by a later one, and a low min score: many candidates
+  // are tracked down the pyramid, in parallel with threads > 1.
+  const std::vector<Pose2D> poses = {{110.3, 110.6, radians(10.0), 1.0},
+                                     {330.8, 110.1, radians(-100.0), 1.0},
+                                     {220.2, 300.7, radians(170.0), 1.0},
+                                     {290.5, 250.4, radians(35.0), 1.0}};
+  const cv::Mat image = bracketScene({440, 420}, poses, 52);
+  for (SubpixelMode mode : {SubpixelMode::None, SubpixelMode::LeastSquares}) {
+    FindParams p;
+    p.numMatches = 0;
+    p.minScore = 0.4;
+    p.subpixel = mode;
+    p.threads = 1;
+    const auto sequential = findShapeModel(image, bracketModel(), p);
+    ASSERT_GE(sequential.size(), 3u);
+    for (int threads : {2, 4}) {
+      p.threads = threads;
+      const auto parallel = findShapeModel(image, bracketModel(), p);
+      ASSERT_EQ(parallel.size(), sequential.size()) << threads << " threads";
+      for (std::size_t i = 0; i < parallel.size(); ++i) {
+        // Bit for bit: the same candidates in the same order, whatever ran where.
+        EXPECT_EQ(parallel[i].x, sequential[i].x) << threads << " threads, match " << i;
+        EXPECT_EQ(parallel[i].y, sequential[i].y) << threads << " threads, match " << i;
+        EXPECT_EQ(parallel[i].angle, sequential[i].angle) << threads << " threads, match " << i;
+        EXPECT_EQ(parallel[i].score, sequential[i].score) << threads << " threads, match " << i;
+      }
+    }
+  }
+}
+
 TEST(FindShapeModel, MaxOverlapSuppressesOverlappingMatches) {
   // Two brackets side by side whose boxes overlap by about a quarter.
   const Pose2D left{150.0, 150.0, 0.0, 1.0};
