@@ -121,7 +121,7 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
   std::ofstream f(dir + "/station.yaml");
   f << "schema_version: 1\nname: integration-station\ncamera:\n" << camera;
   f << "  scans:\n    folder: " << recipes << "/demo/scan_offset\n    glob: \"*.csv\"\n";
-  {  // facetd --no-plc ignores the section, but the station file needs one
+  {  // always written (--no-plc ignores it); a station without one is covered by config tests
     f << "plc:\n  role: client\n  mode: " << options.plcMode
       << "\n  transport: tcp\n  host: 127.0.0.1\n"
       << "  port: " << (plcPort > 0 ? plcPort : 502) << "\n  unit_id: 1\n  word_order: ABCD\n"
