@@ -18,6 +18,7 @@
 #include "service/cli/command_line.hpp"
 #include "service/daemon/inspection.hpp"
 #include "service/daemon/overlay.hpp"
+#include "service/daemon/part_origin.hpp"
 #include "service/daemon/process_capability.hpp"
 #include "service/daemon/replay_report.hpp"
 
@@ -117,15 +118,7 @@ void runReplay(const ReplayOptions& opt) {
     service::PartResult& p = part.result;
     p.partId = partId;
     p.time = std::chrono::system_clock::now();
-    p.recipeId = loaded.recipe->id;
-    p.recipeName = loaded.recipe->name;
-    p.recipeVersion = loaded.recipe->contentHash;
-    p.frameId = grab.frame.id;
-    p.source = grab.frame.source;
-    if (auto it = grab.frame.metadata.find("serial"); it != grab.frame.metadata.end())
-      p.serial = it->second;
-    if (auto it = grab.frame.metadata.find("expected_verdict"); it != grab.frame.metadata.end())
-      p.expectedVerdict = it->second;
+    service::recordPartOrigin(p, &*loaded.recipe, grab.frame);
     if (!grab.ok()) {
       // A file the replay could not use is a part that was not inspected.
       p.verdict = service::Verdict::Error;

@@ -10,6 +10,7 @@
 #include "algorithms/scan/scan_file.hpp"
 #include "camera/camera_factory.hpp"
 #include "camera/sidecar_metadata.hpp"
+#include "service/daemon/part_origin.hpp"
 
 namespace facet::service {
 
@@ -509,18 +510,7 @@ void Station::publishPart(Job& j) {
   PartResult& p = j.result;
   p.partId = j.partId;
   p.time = std::chrono::system_clock::now();
-  if (j.inspection) {
-    const auto& recipe = j.inspection->recipe();
-    p.recipeId = recipe.id;
-    p.recipeName = recipe.name;
-    p.recipeVersion = recipe.contentHash;
-  }
-  p.frameId = j.frame.id;
-  p.source = j.frame.source;
-  if (auto it = j.frame.metadata.find("serial"); it != j.frame.metadata.end())
-    p.serial = it->second;
-  if (auto it = j.frame.metadata.find("expected_verdict"); it != j.frame.metadata.end())
-    p.expectedVerdict = it->second;
+  recordPartOrigin(p, j.inspection ? &j.inspection->recipe() : nullptr, j.frame);
   const auto t0 = Clock::now();
   // 1. The PLC first: it is what the line waits for.
   if (plc_) {
