@@ -13,6 +13,8 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 bash deploy/install-deps.sh
+# ccache (when installed) reuses objects across clones at other paths: paths become relative.
+export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
 
 run_release=${FACET_CI_RELEASE:-1}
 run_asan=${FACET_CI_ASAN:-1}
