@@ -16,6 +16,7 @@
 #include "tests/daemon/child_process.hpp"
 #include "tests/daemon/line_run.hpp"
 #include "tests/hardening/bad_image_files.hpp"
+#include "tests/support/process/peak_resident_memory.hpp"
 
 namespace facet::daemon_test {
 namespace {
@@ -28,21 +29,6 @@ std::string readFile(const std::string& file) {
   std::ostringstream s;
   s << std::ifstream(file, std::ios::binary).rdbuf();
   return s.str();
-}
-
-// VmHWM of a running process, bytes (0 once it is gone).
-std::uint64_t peakResidentBytes(pid_t pid) {
-  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmHWM:") {
-      std::uint64_t kb = 0;
-      status >> kb;
-      return kb * 1024;
-    }
-    status.ignore(1 << 20, '\n');
-  }
-  return 0;
 }
 
 // The largest peak resident memory of the children this test has waited for, bytes.
@@ -80,7 +66,7 @@ ReplayRun replay(const TempDir& dir, const std::string& folder, const std::strin
   const auto until = std::chrono::steady_clock::now() + 60s;
   std::optional<int> code;
   while (!code && std::chrono::steady_clock::now() < until) {
-    run.sampledPeak = std::max(run.sampledPeak, peakResidentBytes(facetd.pid()));
+    run.sampledPeak = std::max(run.sampledPeak, test::peakResidentBytes(facetd.pid()));
     code = facetd.wait(20ms);
   }
   run.exitCode = code.value_or(-1);

@@ -16,6 +16,7 @@
 
 #include "camera/replay_camera.hpp"
 #include "tests/hardening/bad_image_files.hpp"
+#include "tests/support/process/peak_resident_memory.hpp"
 
 namespace facet {
 namespace {
@@ -44,21 +45,6 @@ class Folder {
  private:
   fs::path path_;
 };
-
-// Peak resident memory of this process so far, bytes.
-std::uint64_t peakResidentBytes() {
-  std::ifstream status("/proc/self/status");
-  std::string key;
-  while (status >> key) {
-    if (key == "VmHWM:") {
-      std::uint64_t kb = 0;
-      status >> kb;
-      return kb * 1024;
-    }
-    status.ignore(1 << 20, '\n');
-  }
-  return 0;
-}
 
 TEST(ReplayFaults, EveryBadFileIsRefusedWithItsNameAndGoodFramesStillArrive) {
   Folder folder;
@@ -131,13 +117,13 @@ TEST(ReplayFaults, HugeHeadersUnderThePixelLimitKeepMemoryBounded) {
   ReplayCamera camera(settings);
   camera.open();
   camera.start();
-  const std::uint64_t before = peakResidentBytes();
+  const std::uint64_t before = test::ownPeakResidentBytes();
   for (int pass = 0; pass < 5; ++pass) {
     GrabResult r = camera.grab(1s);
     ASSERT_TRUE(r.ok()) << r.message;
     EXPECT_NE(r.frame.source.find("d_good.png"), std::string::npos);
   }
-  const std::uint64_t growth = peakResidentBytes() - before;
+  const std::uint64_t growth = test::ownPeakResidentBytes() - before;
   EXPECT_EQ(camera.health().skipped_files, 15u);
   EXPECT_NE(camera.health().last_error.find("c_12000x12000.pgm"), std::string::npos)
       << camera.health().last_error;
