@@ -20,6 +20,7 @@
 
 #include "tests/daemon/child_process.hpp"
 #include "tests/daemon/line_run.hpp"
+#include "tests/daemon/plc_line.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
 
 namespace facet::daemon_test {
@@ -72,63 +73,14 @@ std::unique_ptr<ChildProcess> startCamera(std::vector<std::string> options = {})
   return camera;
 }
 
-// facetd with the pymodbus PLC, which selects the recipe and raises one trigger at a time.
-struct Line {
-  TempDir dir;
-  int plcPort = plc::test::freeTcpPort();
-  std::unique_ptr<plc::test::PymodbusPlc> plc;
-  std::unique_ptr<ChildProcess> facetd;
-  std::string peerConfig;
+// The line with facetd's HTTP side: /healthz and /metrics.
+struct Line : PlcLine {
   int httpPort = 0;
 
-  ~Line() {
-    std::error_code ignored;
-    if (!peerConfig.empty()) std::filesystem::remove(peerConfig, ignored);
-  }
-
-  void start() {
-    const auto station = writeStationFile(dir.path(), kCameraSection, plcPort);
-    peerConfig = writePeerConfig(station);
-    plc = std::make_unique<plc::test::PymodbusPlc>(peerConfig, plcPort);
-    plc->start();
-    plc->command("set_register 0 " + std::to_string(kRecipe));
-    facetd = std::make_unique<ChildProcess>(
-        std::vector<std::string>{FACETD_PATH, "--config", station, "--http-port-file",
-                                 dir / "http.port", "--log-level", "info"},
-        std::map<std::string, std::string>{}, dir / "facetd.log");
-  }
-
-  std::size_t resultCount() const { return plc->events("result").size(); }
-
-  // Raises one trigger and waits for its result (the result count to reach `n`).
-  bool part(std::size_t n, std::chrono::milliseconds timeout) {
-    plc->command("trigger");
-    return plc->waitFor(
-        [n](const std::vector<nlohmann::json>& events) {
-          std::size_t count = 0;
-          for (const auto& e : events) count += e.value("event", "") == "result";
-          return count >= n;
-        },
-        timeout);
-  }
-
-  // `parts` parts one after the other; the very first trigger is repeated until facetd answers.
-  void runParts(int parts) {
-    std::size_t n = resultCount();
-    if (n == 0) {
-      bool first = false;
-      for (int attempt = 0; attempt < 40 && !first; ++attempt) first = part(1, 1500ms);
-      ASSERT_TRUE(first) << "facetd never answered a trigger; see " << dir / "facetd.log";
-      --parts;
-      n = 1;
-    }
-    for (int i = 0; i < parts; ++i)
-      ASSERT_TRUE(part(++n, 8000ms))
-          << "no result for trigger " << n << "; see " << dir / "facetd.log";
-  }
+  void start() { PlcLine::start(kCameraSection, kRecipe, "info"); }
 
   httplib::Result get(const std::string& path) {
-    if (httpPort == 0) std::ifstream(dir / "http.port") >> httpPort;
+    if (httpPort == 0) std::ifstream(dir() / "http.port") >> httpPort;
     httplib::Client client("127.0.0.1", httpPort);
     client.set_read_timeout(10, 0);
     return client.Get(path);
@@ -163,15 +115,6 @@ struct Line {
     }
     return std::nullopt;
   }
-
-  void stop() {
-    facetd->signal(SIGTERM);
-    const auto code = facetd->wait(20s);
-    ASSERT_TRUE(code.has_value()) << "facetd did not exit within 20 s of SIGTERM";
-    EXPECT_EQ(*code, 0) << "see " << dir / "facetd.log";
-  }
-
-  std::vector<nlohmann::json> results() const { return plc->events("result"); }
 };
 
 // What the PLC was told about a part matches what the store says: pass only for a pass, the
@@ -209,17 +152,17 @@ TEST(CameraFaults, LostPacketsGiveErrorsToThePlcNeverGoodParts) {
   Line line;
   line.start();
   constexpr int kParts = 60;
-  ASSERT_NO_FATAL_FAILURE(line.runParts(kParts));
+  ASSERT_NO_FATAL_FAILURE(line.runParts(kParts, 8000ms));
   const auto health = line.healthz();
   const double incompleteMetric = line.metric("facet_incomplete_frames_total");
   ASSERT_NO_FATAL_FAILURE(line.stop());
 
   const auto served = servedFrames(*camera);
-  const auto parts = storedParts(line.dir / "results.db");
+  const auto parts = storedParts(line.database());
   const auto results = line.results();
   ASSERT_EQ(parts.size(), static_cast<std::size_t>(kParts)) << "one row per trigger";
   ASSERT_EQ(results.size(), static_cast<std::size_t>(kParts)) << "one PLC result per trigger";
-  EXPECT_EQ(integrityCheck(line.dir / "results.db"), "ok");
+  EXPECT_EQ(integrityCheck(line.database()), "ok");
   const auto frames = framesOf(parts, served);
 
   int withheld = 0, otherIncomplete = 0, passes = 0, completeServed = 0;
@@ -270,7 +213,7 @@ TEST(CameraFaults, CameraThatDisappearsIsReportedDownAndInspectsAgainWhenBack) {
   Line line;
   line.start();
   constexpr int kBefore = 12, kDuring = 3, kAfter = 24;
-  ASSERT_NO_FATAL_FAILURE(line.runParts(kBefore));
+  ASSERT_NO_FATAL_FAILURE(line.runParts(kBefore, 8000ms));
   {
     const auto h = line.healthz();
     ASSERT_TRUE(h.at("camera").at("connected").get<bool>()) << h.dump();
@@ -283,17 +226,17 @@ TEST(CameraFaults, CameraThatDisappearsIsReportedDownAndInspectsAgainWhenBack) {
   ASSERT_TRUE(camera->wait(5s).has_value());
   const auto killedAt = Clock::now();
   // A part arriving before facetd can know: no frame comes, and it must not pass either.
-  line.plc->command("trigger");
+  line.plc().command("trigger");
   // Seen by facetd itself: /healthz says the camera is down.
   const auto detected = line.waitForHealth(
       [](const nlohmann::json& h) {
         return h.contains("camera") && !h["camera"]["connected"].get<bool>();
       },
       15s);
-  ASSERT_TRUE(detected) << "facetd did not notice the camera was gone; see "
-                        << line.dir / "facetd.log";
+  ASSERT_TRUE(detected) << "facetd did not notice the camera was gone\n"
+                        << line.facetd().outputTail();
   const auto downAfterKill = Clock::now() - killedAt;
-  ASSERT_TRUE(line.plc->waitFor(
+  ASSERT_TRUE(line.plc().waitFor(
       [](const std::vector<nlohmann::json>& events) {
         return std::count_if(events.begin(), events.end(), [](const nlohmann::json& e) {
                  return e.value("event", "") == "result";
@@ -326,19 +269,19 @@ TEST(CameraFaults, CameraThatDisappearsIsReportedDownAndInspectsAgainWhenBack) {
                h["camera"]["reconnects"].get<int>() == 1;
       },
       15s);
-  ASSERT_TRUE(recovered) << "facetd did not reconnect; see " << line.dir / "facetd.log";
+  ASSERT_TRUE(recovered) << "facetd did not reconnect\n" << line.facetd().outputTail();
   EXPECT_EQ(line.healthz().at("status"), "ok");
   EXPECT_EQ(line.metric("facet_camera_connected"), 1);
-  ASSERT_NO_FATAL_FAILURE(line.runParts(kAfter));
+  ASSERT_NO_FATAL_FAILURE(line.runParts(kAfter, 8000ms));
   ASSERT_NO_FATAL_FAILURE(line.stop());
 
   const auto servedAfter = servedFrames(*camera);
-  const auto parts = storedParts(line.dir / "results.db");
+  const auto parts = storedParts(line.database());
   const auto results = line.results();
   constexpr std::size_t kTotal = kBefore + 1 + kDuring + kAfter;
   ASSERT_EQ(parts.size(), kTotal) << "one row per trigger";
   ASSERT_EQ(results.size(), kTotal) << "one PLC result per trigger";
-  EXPECT_EQ(integrityCheck(line.dir / "results.db"), "ok");
+  EXPECT_EQ(integrityCheck(line.database()), "ok");
   for (std::size_t i = 0; i < kTotal; ++i) expectPlcSaw(results[i], parts[i]);
 
   const std::vector<StoredPart> before(parts.begin(), parts.begin() + kBefore);

@@ -6,14 +6,19 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
+#include <deque>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace facet::daemon_test {
 
 ChildProcess::ChildProcess(std::vector<std::string> argv,
-                           std::map<std::string, std::string> environment, std::string stderrFile) {
+                           std::map<std::string, std::string> environment, std::string stderrFile)
+    : stderrFile_(stderrFile) {
   int out[2];
   if (::pipe2(out, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
   ::signal(SIGPIPE, SIG_IGN);
@@ -121,6 +126,26 @@ TempDir::TempDir() {
 TempDir::~TempDir() {
   std::error_code ignored;
   if (!std::getenv("FACET_KEEP_TEST_DIRS")) std::filesystem::remove_all(path_, ignored);
+}
+
+std::string ChildProcess::outputTail(std::size_t count) const {
+  std::ostringstream out;
+  const auto all = lines();
+  out << "--- last " << std::min(count, all.size()) << " of " << all.size()
+      << " lines of stdout ---\n";
+  for (std::size_t i = all.size() - std::min(count, all.size()); i < all.size(); ++i)
+    out << all[i] << "\n";
+  if (!stderrFile_.empty()) {
+    std::deque<std::string> last;
+    std::ifstream in(stderrFile_);
+    for (std::string l; std::getline(in, l);) {
+      last.push_back(l);
+      if (last.size() > count) last.pop_front();
+    }
+    out << "--- last " << last.size() << " lines of stderr (" << stderrFile_ << ") ---\n";
+    for (const auto& l : last) out << l << "\n";
+  }
+  return out.str();
 }
 
 }  // namespace facet::daemon_test

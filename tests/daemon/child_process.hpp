@@ -34,11 +34,15 @@ class ChildProcess {
   std::optional<std::string> waitForLine(const std::function<bool(const std::string&)>& match,
                                          std::chrono::milliseconds timeout);
   std::vector<std::string> lines() const;
+  // The last `count` lines of stdout and of the stderr file, for a failure message: the test's
+  // temporary folder (and the file with it) is gone once the test has failed.
+  std::string outputTail(std::size_t count = 40) const;
 
  private:
   void readLoop(int fd);
 
   pid_t pid_ = -1;
+  std::string stderrFile_;
   std::optional<int> exitCode_;
   std::thread reader_;
   mutable std::mutex mutex_;

@@ -13,6 +13,7 @@
 
 #include "tests/daemon/child_process.hpp"
 #include "tests/daemon/line_run.hpp"
+#include "tests/daemon/plc_line.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
 
 namespace facet::daemon_test {
@@ -20,30 +21,8 @@ namespace {
 
 using namespace std::chrono_literals;
 const std::string kDemo = std::string(FACET_SOURCE_DIR) + "/recipes/demo/bracket_shape";
+// The PLC selects it; facetd starts with the lowest id (1), so the switch is tested.
 constexpr int kRecipe = 2;  // bracket_shape.recipe.yaml
-
-// Raises `parts` triggers one after the other, each once the previous result was acknowledged.
-// The first trigger is repeated until facetd has connected and answers.
-void runParts(plc::test::PymodbusPlc& plc, int parts) {
-  auto results = [&](std::size_t n) {
-    return [n](const std::vector<nlohmann::json>& events) {
-      std::size_t count = 0;
-      for (const auto& e : events) count += e.value("event", "") == "result";
-      return count >= n;
-    };
-  };
-  bool first = false;
-  for (int attempt = 0; attempt < 40 && !first; ++attempt) {
-    plc.command("trigger");
-    first = plc.waitFor(results(1), 1500ms);
-  }
-  ASSERT_TRUE(first) << "facetd never answered a trigger";
-  for (int i = 1; i < parts; ++i) {
-    plc.command("trigger");
-    ASSERT_TRUE(plc.waitFor(results(static_cast<std::size_t>(i) + 1), 5000ms))
-        << "no result for trigger " << i + 1;
-  }
-}
 
 // The result registers the PLC decoded equal what the store holds for the same part.
 void expectRegistersMatch(const nlohmann::json& result, const StoredPart& part) {
@@ -97,42 +76,6 @@ void expectRowConsistent(const StoredPart& part) {
       << where << " failed_checks=" << part.failedChecks;
 }
 
-struct Line {
-  TempDir dir;
-  int plcPort = plc::test::freeTcpPort();
-  std::unique_ptr<plc::test::PymodbusPlc> plc;
-  std::unique_ptr<ChildProcess> facetd;
-  std::string peerConfig;  // a /tmp file of writePeerConfig()
-
-  ~Line() {
-    std::error_code ignored;
-    if (!peerConfig.empty()) std::filesystem::remove(peerConfig, ignored);
-  }
-
-  void start(const std::string& camera) {
-    const auto station = writeStationFile(dir.path(), camera, plcPort);
-    peerConfig = writePeerConfig(station);
-    plc = std::make_unique<plc::test::PymodbusPlc>(peerConfig, plcPort);
-    plc->start();
-    // The PLC selects the recipe; facetd starts with the lowest id (1), so the switch is tested.
-    plc->command("set_register 0 " + std::to_string(kRecipe));
-    facetd = std::make_unique<ChildProcess>(
-        std::vector<std::string>{FACETD_PATH, "--config", station, "--http-port-file",
-                                 dir / "http.port", "--log-level", "warn"},
-        std::map<std::string, std::string>{}, dir / "facetd.log");
-  }
-
-  // SIGTERM: facetd finishes, flushes and exits 0.
-  void stop() {
-    facetd->signal(SIGTERM);
-    const auto code = facetd->wait(20s);
-    ASSERT_TRUE(code.has_value()) << "facetd did not exit within 20 s of SIGTERM";
-    EXPECT_EQ(*code, 0) << "see " << dir / "facetd.log";
-  }
-
-  std::vector<nlohmann::json> results() const { return plc->events("result"); }
-};
-
 TEST(DaemonLine, FakeGigECameraAndPymodbusPlc) {
   const auto expected = expectedParts(kDemo);
   ASSERT_EQ(expected.size(), 12u);
@@ -141,12 +84,13 @@ TEST(DaemonLine, FakeGigECameraAndPymodbusPlc) {
       camera.waitForLine([](const std::string& l) { return l.rfind("listening", 0) == 0; }, 10s))
       << "the fake GigE camera did not start";
 
-  Line line;
+  PlcLine line;
   line.start(
       "  backend: aravis\n  aravis:\n    address: 127.0.0.1\n    pixel_format: Mono8\n"
-      "    region: [0, 0, 640, 480]\n    trigger: software\n    colour: mono\n");
+      "    region: [0, 0, 640, 480]\n    trigger: software\n    colour: mono\n",
+      kRecipe);
   constexpr int kParts = 240;  // 20 rounds of the 12 demo images
-  ASSERT_NO_FATAL_FAILURE(runParts(*line.plc, kParts));
+  ASSERT_NO_FATAL_FAILURE(line.runParts(kParts, 5000ms));
   ASSERT_NO_FATAL_FAILURE(line.stop());
 
   // The frames the camera served, in order: "frame <k> <raw block id> <file>".
@@ -161,11 +105,11 @@ TEST(DaemonLine, FakeGigECameraAndPymodbusPlc) {
     ASSERT_EQ(k, served.size());
     served.emplace_back(raw, file);
   }
-  const auto parts = storedParts(line.dir / "results.db");
+  const auto parts = storedParts(line.database());
   const auto results = line.results();
   ASSERT_EQ(parts.size(), static_cast<std::size_t>(kParts)) << "one row per trigger";
   ASSERT_EQ(results.size(), static_cast<std::size_t>(kParts)) << "one PLC result per trigger";
-  EXPECT_EQ(integrityCheck(line.dir / "results.db"), "ok");
+  EXPECT_EQ(integrityCheck(line.database()), "ok");
 
   // The first part's frame id is the camera's raw block id (facetd unwraps later ones past the
   // 16-bit wrap); part i took the frame (frame_id_i - frame_id_0) after it.
@@ -201,13 +145,14 @@ TEST(DaemonLine, FakeGigECameraAndPymodbusPlc) {
 
 TEST(DaemonLine, ReplayCameraAndPymodbusPlc) {
   const auto expected = expectedParts(kDemo);
-  Line line;
+  PlcLine line;
   line.start("  backend: replay\n  replay:\n    folder: " + kDemo +
-             "\n    glob: \"*.png\"\n    loop: true\n    trigger: software\n    colour: mono\n");
+                 "\n    glob: \"*.png\"\n    loop: true\n    trigger: software\n    colour: mono\n",
+             kRecipe);
   constexpr int kParts = 36;
-  ASSERT_NO_FATAL_FAILURE(runParts(*line.plc, kParts));
+  ASSERT_NO_FATAL_FAILURE(line.runParts(kParts, 5000ms));
   ASSERT_NO_FATAL_FAILURE(line.stop());
-  const auto parts = storedParts(line.dir / "results.db");
+  const auto parts = storedParts(line.database());
   const auto results = line.results();
   ASSERT_EQ(parts.size(), static_cast<std::size_t>(kParts));
   ASSERT_EQ(results.size(), static_cast<std::size_t>(kParts));

@@ -102,7 +102,7 @@ TEST(DaemonSystemd, NotifyProtocolAndCleanStop) {
   NotifySocket notify(dir / "notify.sock");
   auto facetd =
       startFacetd(dir, station, {{"NOTIFY_SOCKET", notify.path()}, {"WATCHDOG_USEC", "1000000"}});
-  ASSERT_TRUE(notify.waitFor("READY=1", 30s)) << "no READY=1; see " << dir / "facetd.log";
+  ASSERT_TRUE(notify.waitFor("READY=1", 30s)) << "no READY=1\n" << facetd->outputTail();
   // WatchdogSec=1 s: pings at least every 0.5 s.
   const auto t0 = Clock::now();
   ASSERT_TRUE(notify.waitFor("WATCHDOG=1", 1500ms));

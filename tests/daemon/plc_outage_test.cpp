@@ -90,7 +90,7 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
                        dir / "http.port", "--log-level", "info"},
                       {}, dir / "facetd.log");
   const auto httpPort = waitForHttpPort(dir / "http.port", 30s);
-  ASSERT_TRUE(httpPort) << "facetd did not start; see " << dir / "facetd.log";
+  ASSERT_TRUE(httpPort) << "facetd did not start\n" << facetd.outputTail();
 
   // Holds once the PLC has seen an inspection counter of at least `counter`.
   auto seenUpTo = [&](int counter) {
@@ -144,7 +144,7 @@ TEST(PlcOutage, ThreeRestartsDuringAThousandPartRun) {
   }
   ASSERT_TRUE(settled) << "the run did not settle; last /metrics:\n" << metrics;
   facetd.signal(SIGTERM);
-  ASSERT_EQ(facetd.wait(20s), std::optional<int>(0)) << "see " << dir / "facetd.log";
+  ASSERT_EQ(facetd.wait(20s), std::optional<int>(0)) << facetd.outputTail();
 
   // The store: every part, once, ids 1..kParts.
   const auto stored = storedParts(dir / "results.db");

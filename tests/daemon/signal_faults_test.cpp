@@ -100,7 +100,7 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
                std::stoll(l.substr(at + 5)) >= 2;
       },
       120s);
-  ASSERT_TRUE(startedLine) << "no second part inspected; see " << dir / "facetd.log";
+  ASSERT_TRUE(startedLine) << "no second part inspected\n" << facetd->outputTail();
   facetd->signal(SIGTERM);
   const auto partId = std::stoll(startedLine->substr(startedLine->find("part=") + 5));
   const std::string part = "part " + std::to_string(partId);
@@ -163,7 +163,8 @@ TEST(SignalFaults, RepeatedSigkillKeepsTheStoreSoundInWalAndPartIdsContinue) {
   for (int round = 0; round < 3; ++round) {
     auto facetd = startFacetd(dir, station, "warn");
     ASSERT_TRUE(waitForCount(database, before.size() + 30, 60s))
-        << "round " << round << ": facetd stores no parts; see " << dir / "facetd.log";
+        << "round " << round << ": facetd stores no parts\n"
+        << facetd->outputTail();
     std::this_thread::sleep_for(std::chrono::milliseconds(random() % 200));
     facetd->signal(SIGKILL);
     ASSERT_EQ(facetd->wait(10s), std::optional<int>(128 + SIGKILL));
