@@ -128,12 +128,7 @@ void runReplay(const ReplayOptions& opt) {
       continue;
     }
     const auto outcome = inspection->inspect({.image = grab.frame.image, .scan = std::nullopt});
-    p.verdict = outcome.verdict;
-    p.measurements = outcome.measurements;
-    p.failedChecks = outcome.failedChecks;
-    p.error = outcome.error;
-    p.timings = outcome.timings;
-    p.inspectionMs = outcome.totalMs;
+    service::recordOutcome(p, outcome);
     if (p.verdict != service::Verdict::Pass) {
       std::string banner = std::string(service::verdictName(p.verdict)) + "  " + p.serial;
       if (!p.failedChecks.empty()) banner += "  " + p.failedChecks.front();

@@ -571,4 +571,13 @@ InspectionOutcome RecipeInspection::inspect(const InspectionInput& input) const 
   return out;
 }
 
+void recordOutcome(PartResult& part, const InspectionOutcome& outcome) {
+  part.verdict = outcome.verdict;
+  part.measurements = outcome.measurements;
+  part.failedChecks = outcome.failedChecks;
+  part.error = outcome.error;
+  part.timings = outcome.timings;
+  part.inspectionMs = outcome.totalMs;
+}
+
 }  // namespace facet::service

@@ -41,6 +41,10 @@ struct InspectionOutcome {
   Overlay overlay;
 };
 
+// Copies an inspection's verdict, measurements, failed checks, error and timings into the part
+// (facetd's store and the replay report keep the same record of a part).
+void recordOutcome(PartResult& part, const InspectionOutcome& outcome);
+
 // A recipe's resources could not be loaded (missing or corrupt image, model or scan).
 struct InspectionSetupError : std::runtime_error {
   using std::runtime_error::runtime_error;

@@ -433,12 +433,7 @@ void Station::inspectionLoop() {
     const InspectionOutcome outcome = j.inspection->inspect(input);
     j.inspectedAt = Clock::now();
     PartResult& p = j.result;
-    p.verdict = outcome.verdict;
-    p.measurements = outcome.measurements;
-    p.failedChecks = outcome.failedChecks;
-    p.error = outcome.error;
-    p.timings = outcome.timings;
-    p.inspectionMs = outcome.totalMs;
+    recordOutcome(p, outcome);
     j.overlay = outcome.overlay;
     metrics_
         .histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"inspect\"")

@@ -47,17 +47,6 @@ std::string stationFile(const SoakOptions& o, const std::string& dir) {
   f << "schema_version: 1\nname: soak-station\ncamera:\n  backend: replay\n  replay:\n"
     << "    folder: " << o.replayFolder << "\n    glob: \"*.png\"\n    loop: true\n    fps: 0\n"
     << "    trigger: free_run\n    colour: mono\n";
-  // facetd --no-plc ignores the section, but a station file needs one.
-  f << "plc:\n  role: client\n  mode: triggered\n  transport: tcp\n  host: 127.0.0.1\n"
-    << "  port: 502\n  unit_id: 1\n  word_order: ABCD\n  response_timeout_ms: 500\n"
-    << "  heartbeat_period_ms: 1000\n  register_map:\n    address_base: 0\n    control:\n"
-    << "      trigger: {coil: 0}\n      result_ack: {coil: 1}\n"
-    << "      recipe_select: {register: 0}\n    status:\n"
-    << "      ready: {coil: 16}\n      busy: {coil: 17}\n      result_valid: {coil: 18}\n"
-    << "      pass: {coil: 19}\n      completed_toggle: {coil: 20}\n"
-    << "      missed_trigger: {coil: 21}\n      error: {coil: 22}\n"
-    << "      error_code: {register: 10}\n      heartbeat: {register: 11}\n"
-    << "      inspection_counter: {register: 12}\n      active_recipe: {register: 13}\n";
   f << "recipes: " << o.recipesFolder << "\n";
   f << "results:\n  database: " << dir << "/results.db\n";
   f << "archive:\n  folder: " << dir << "/archive\n  quota_mb: " << o.archiveQuotaMb
