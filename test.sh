@@ -15,6 +15,9 @@ cd "$(dirname "$0")"
 bash deploy/install-deps.sh
 # ccache (when installed) reuses objects across clones at other paths: paths become relative.
 export CCACHE_BASEDIR=${CCACHE_BASEDIR:-$PWD}
+# The ASan build has debug info, whose hash would include the build folder's path: leave it out
+# so another clone hits the cache too (only the debugger's compilation folder differs).
+export CCACHE_NOHASHDIR=${CCACHE_NOHASHDIR:-true}
 
 run_release=${FACET_CI_RELEASE:-1}
 run_asan=${FACET_CI_ASAN:-1}
