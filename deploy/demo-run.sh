@@ -34,8 +34,11 @@ sleep 0.5
 for run in 1:bracket_registration 2:bracket_shape 3:fiducial_board 4:scan_offset; do
   id=${run%%:*}
   folder=recipes/demo/${run#*:}
-  echo "== recipe $id over $folder"
-  "$facetd" --config "$station" --recipe "$id" --replay "$folder" --print-parts \
+  # One part per recorded image or scan: facetd stops there instead of answering the
+  # simulator's next trigger with "replay finished" (which it does, as an error part, on a line).
+  parts=$(find "$folder" -maxdepth 1 \( -name '*.png' -o -name '*.csv' \) | wc -l)
+  echo "== recipe $id over $folder ($parts recorded parts)"
+  "$facetd" --config "$station" --recipe "$id" --replay "$folder" --max-parts "$parts" --print-parts \
     2> >(grep -v "has no value" >&2) | cut -c1-220
 done
 
