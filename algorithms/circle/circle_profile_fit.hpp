@@ -10,10 +10,14 @@
 // contrast (inside minus outside) and a(x, y) = a0 + g . (p - c0) the outside grey with an
 // illumination ramp g. In a thin band a ramp looks much like a shifted rim (it would cost half
 // the precision of a small circle), so g is kept only when it is significant (chi-square, 99.9%).
-// Levenberg-Marquardt; Tukey weights on the grey residuals (from the first step on) reject
-// clutter, and angular sectors whose residuals stay too large for the noise (the blurred tail of
-// a blob next to the rim, each pixel within the Tukey weight's reach) are dropped before a final
-// solve.
+// Levenberg-Marquardt. Before it, pixels whose grey-value gradient the rim cannot explain (a
+// tangential gradient, or any gradient away from the rim, beyond 4 standard deviations of its
+// noise) and their neighbours leave the band: faint clutter, clutter outside the edge points'
+// annulus and the blurred tails of both, which no edge point flags. Tukey weights on the grey
+// residuals (from the first step on, 8 robust sigmas once that screen has run) reject the gross
+// outliers left, and angular sectors whose residuals stay too large for the noise (the blurred
+// tail of a blob next to the rim, each pixel within the Tukey weight's reach) are dropped before
+// a final solve.
 //
 // The 50% level of a blurred disc lies s^2 / (2 R) inside its true rim (the disc is convex, so
 // it covers less than half of the PSF centred on its rim); the fitted s corrects that bias

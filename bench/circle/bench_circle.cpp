@@ -9,7 +9,8 @@
 // = 100. The CRLB columns give the Cramer-Rao bound of each case (cramerRaoBound).
 //
 // Usage: bench_circle [--smoke] [--scenes N] [--case clean|hard|low-contrast] [--radius R]
-//                     [--verbose] [--no-grey-refinement] [--no-bias-correction]
+//                     [--seed N] [--verbose] [--no-grey-refinement] [--no-bias-correction]
+// --seed N (default 0) draws other scenes: the accuracy must not depend on one set of scenes.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -213,8 +214,9 @@ double medianMs(std::vector<double> v) {
 int main(int argc, char** argv) {
   bool smoke = false;
   int scenes = 30;
-  std::string onlyCase;   // --case clean|hard|low-contrast: that case alone
-  double onlyRadius = 0;  // --radius R: that radius alone
+  std::string onlyCase;    // --case clean|hard|low-contrast: that case alone
+  double onlyRadius = 0;   // --radius R: that radius alone
+  std::uint64_t seed = 0;  // --seed N: another set of scenes (0: the original ones)
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke"))
       smoke = true;
@@ -230,6 +232,8 @@ int main(int argc, char** argv) {
       onlyCase = argv[++i];
     else if (!std::strcmp(argv[i], "--radius") && i + 1 < argc)
       onlyRadius = std::atof(argv[++i]);
+    else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc)
+      seed = std::strtoull(argv[++i], nullptr, 10);
   }
   if (smoke) scenes = 2;
   const int subrows = smoke ? 32 : 256;
@@ -237,8 +241,9 @@ int main(int argc, char** argv) {
 
   const double radii[] = {10, 20, 50, 100, 200};
   std::printf(
-      "bench_circle: %d scenes per radius and case (half discs, half holes), blur 1, noise 2%s\n",
-      scenes, smoke ? " [smoke]" : "");
+      "bench_circle: %d scenes per radius and case (half discs, half holes), blur 1, noise 2, "
+      "seed %llu%s\n",
+      scenes, static_cast<unsigned long long>(seed), smoke ? " [smoke]" : "");
   std::printf(
       "errors are RMS in px over measured scenes; fail = no result; ratio = hough / ours\n\n");
   std::printf(
@@ -257,7 +262,8 @@ int main(int argc, char** argv) {
     if (!onlyCase.empty() && onlyCase != caseName(kind)) continue;
     for (double radius : radii) {
       if (onlyRadius > 0 && radius != onlyRadius) continue;
-      std::mt19937_64 rng(static_cast<std::uint64_t>(radius * 1000) + static_cast<int>(kind));
+      std::mt19937_64 rng(static_cast<std::uint64_t>(radius * 1000) + static_cast<int>(kind) +
+                          seed * 1000003);
       Errors ours, hg, alt;
       for (int s = 0; s < scenes; ++s) {
         const Trial t = makeTrial(radius, kind, s % 2 == 1, subrows, rng);
