@@ -227,25 +227,32 @@ void ResultsStore::store(const PartResult& part) {
   }
 }
 
-std::int64_t ResultsStore::applyRetention(std::chrono::system_clock::time_point now) {
+std::int64_t ResultsStore::applyRetention(std::chrono::system_clock::time_point now,
+                                          std::int64_t limit) {
   std::int64_t deleted = 0;
+  // SQLite's LIMIT -1 is no limit.
+  auto remaining = [&] { return limit > 0 ? limit - deleted : std::int64_t{-1}; };
   // The newest part always stays: the next part id after a restart continues from it.
   if (retention_.maxAge) {
     Statement del(db_,
-                  "DELETE FROM parts WHERE time_us < ?1 "
-                  "AND part_id < (SELECT MAX(part_id) FROM parts)",
+                  "DELETE FROM parts WHERE part_id IN (SELECT part_id FROM parts "
+                  "WHERE time_us < ?1 AND part_id < (SELECT MAX(part_id) FROM parts) "
+                  "ORDER BY part_id LIMIT ?2)",
                   file_);
     del.bind(1, toMicros(now - *retention_.maxAge));
+    del.bind(2, remaining());
     del.step();
     deleted += sqlite3_changes64(db_);
   }
-  if (retention_.maxParts) {
+  if (retention_.maxParts && remaining() != 0) {
     // Walks the primary key from the newest part: no scan of the whole table.
     Statement del(db_,
-                  "DELETE FROM parts WHERE part_id <= "
-                  "(SELECT part_id FROM parts ORDER BY part_id DESC LIMIT 1 OFFSET ?1)",
+                  "DELETE FROM parts WHERE part_id IN (SELECT part_id FROM parts "
+                  "WHERE part_id <= (SELECT part_id FROM parts ORDER BY part_id DESC LIMIT 1 "
+                  "OFFSET ?1) ORDER BY part_id LIMIT ?2)",
                   file_);
     del.bind(1, std::max<std::int64_t>(*retention_.maxParts, 1));
+    del.bind(2, remaining());
     del.step();
     deleted += sqlite3_changes64(db_);
   }

@@ -87,7 +87,7 @@ Station::Station(config::StationConfig config, StationOptions options)
       publishQueue_(options_.publishQueue, OverflowPolicy::Block) {
   store_ =
       std::make_unique<ResultsStore>(config_.results.database, retentionPolicy(config_.results));
-  applyRetention();  // a large first clean-up happens here, before READY, not between parts
+  applyRetention(0);  // a large first clean-up happens here, before READY, not between parts
   nextPartId_ = store_->lastPartId() + 1;
   firstPartId_ = nextPartId_;
   if (!config_.archive.folder.empty())
@@ -467,8 +467,9 @@ void Station::publishingLoop() {
   auto nextRetention = Clock::now() + kRetentionPeriod;
   while (true) {
     if (Clock::now() >= nextRetention) {
-      applyRetention();
-      nextRetention = Clock::now() + kRetentionPeriod;
+      // A full slice means more is due: the next slice after the next part (or 100 ms).
+      const bool more = applyRetention(kRetentionSlice) >= kRetentionSlice;
+      nextRetention = more ? Clock::now() : Clock::now() + kRetentionPeriod;
     }
     auto job = publishQueue_.pop(100ms);
     if (!job) {
@@ -483,22 +484,25 @@ void Station::publishingLoop() {
   drained_ = true;
 }
 
-void Station::applyRetention() {
+std::int64_t Station::applyRetention(std::int64_t limit) {
+  std::int64_t deleted = 0;
   try {
-    std::int64_t deleted = 0;
     {
       std::lock_guard lock(storeMutex_);
-      deleted = store_->applyRetention(std::chrono::system_clock::now());
+      deleted = store_->applyRetention(std::chrono::system_clock::now(), limit);
     }
     if (deleted > 0) {
       metrics_.counter("facet_results_retention_deleted_total", "Parts deleted by retention")
           .increment(static_cast<double>(deleted));
-      spdlog::info("results store: retention deleted {} parts", deleted);
+      // Slices come every minute (or back to back while catching up): the metric counts them.
+      spdlog::log(limit == 0 ? spdlog::level::info : spdlog::level::debug,
+                  "results store: retention deleted {} parts", deleted);
     }
   } catch (const std::exception& e) {
     // Retention failing must not stop inspection; the database only keeps growing.
     spdlog::error("results store: retention failed: {}", e.what());
   }
+  return deleted;
 }
 
 void Station::publishPart(Job& j) {

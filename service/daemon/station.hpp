@@ -98,9 +98,12 @@ class Station : public StationView {
   void inspectionLoop();
   void publishingLoop();
   void publishPart(Job& job);
-  // Deletes parts the station file's retention no longer keeps (at start, then periodically).
-  void applyRetention();
+  // Deletes parts the station file's retention no longer keeps, at most `limit` (0 = all): all
+  // at start, then periodically between parts in slices of kRetentionSlice. Returns how many.
+  std::int64_t applyRetention(std::int64_t limit);
   static constexpr std::chrono::seconds kRetentionPeriod{60};
+  // About 10 ms of deleting here: a result waiting behind it is not held up longer than that.
+  static constexpr std::int64_t kRetentionSlice = 500;
   std::shared_ptr<const RecipeInspection> inspectionFor(int recipeId, std::string* error);
   std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
                                                         const plc::TriggerEvent* trigger);

@@ -110,6 +110,28 @@ TEST(ResultsStore, RetentionByAgeDeletesOldPartsAndTheirMeasurementsButKeepsTheN
   EXPECT_EQ(store.lastPartId(), 4u);
 }
 
+TEST(ResultsStore, RetentionInSlicesDeletesOldestFirstUpToTheLimit) {
+  const fs::path file = freshFile("slices.sqlite");
+  ResultsStore store(file, {.maxAge = std::chrono::hours(24), .maxParts = 10});
+  const auto now = std::chrono::system_clock::now();
+  for (std::uint64_t i = 1; i <= 30; ++i) {
+    PartResult p = part(i, Verdict::Pass, 10.0);
+    p.time = now - std::chrono::hours(i <= 6 ? 48 : 1);  // parts 1-6 are two days old
+    store.store(p);
+  }
+  // 6 too old, then 14 more beyond the newest 10: 20 in slices of 4, oldest first.
+  std::vector<std::int64_t> slices;
+  std::vector<std::uint64_t> oldestLeft;
+  for (int k = 0; k < 8; ++k) {
+    slices.push_back(store.applyRetention(now, 4));
+    oldestLeft.push_back(store.latest(100).front().partId);
+  }
+  EXPECT_EQ(slices, (std::vector<std::int64_t>{4, 4, 4, 4, 4, 0, 0, 0}));
+  EXPECT_EQ(oldestLeft, (std::vector<std::uint64_t>{5, 9, 13, 17, 21, 21, 21, 21}));
+  EXPECT_EQ(store.partCount(), 10);
+  EXPECT_EQ(measurementRows(file), 20);  // two per part, for the ten left
+}
+
 TEST(ResultsStore, ReopenContinuesAfterLastPart) {
   const fs::path file = freshFile("d.sqlite");
   { ResultsStore(file).store(part(41, Verdict::Pass, 10.0)); }
