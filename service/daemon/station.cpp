@@ -29,6 +29,7 @@ struct Station::Job {
   Clock::time_point acquiredAt;
   Clock::time_point inspectedAt;
   PartResult result;
+  PartError error = PartError::None;  // set for a part that was not inspected
   Overlay overlay;
 };
 
@@ -273,7 +274,8 @@ void Station::acquisitionLoop() {
             job->partId = nextPartId_++;
             ++partsTaken_;
             job->inspection = recipeForPart(nullptr, &*trigger);
-            publishNotInspected(std::move(*job), "no range scan left for the trigger");
+            publishNotInspected(std::move(*job), PartError::NoInput,
+                                "no range scan left for the trigger");
           }
           break;
         }
@@ -281,7 +283,7 @@ void Station::acquisitionLoop() {
           job->partId = nextPartId_++;
           ++partsTaken_;
           job->inspection = recipeForPart(nullptr, &*trigger);
-          publishNotInspected(std::move(*job), "no range scan for the trigger");
+          publishNotInspected(std::move(*job), PartError::NoInput, "no range scan for the trigger");
           continue;
         }
         if (options_.stopAtEndOfStream) break;
@@ -306,7 +308,8 @@ void Station::acquisitionLoop() {
         job->partId = nextPartId_++;
         ++partsTaken_;
         job->inspection = recipeForPart(nullptr, &*trigger);
-        publishNotInspected(std::move(*job), "no frame within 2 s of the trigger");
+        publishNotInspected(std::move(*job), PartError::NoFrame,
+                            "no frame within 2 s of the trigger");
         continue;
       case GrabStatus::Incomplete:
         metrics_.counter("facet_incomplete_frames_total", "Frames with missing pixel data")
@@ -315,7 +318,8 @@ void Station::acquisitionLoop() {
         ++partsTaken_;
         job->frame = std::move(grab.frame);
         job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
-        publishNotInspected(std::move(*job), "incomplete frame: " + grab.message);
+        publishNotInspected(std::move(*job), PartError::IncompleteFrame,
+                            "incomplete frame: " + grab.message);
         continue;
       case GrabStatus::EndOfStream:
         endOfStream = true;
@@ -330,7 +334,8 @@ void Station::acquisitionLoop() {
           ++partsTaken_;
           job->frame = std::move(grab.frame);
           job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
-          publishNotInspected(std::move(*job), "not inspected: " + grab.message);
+          publishNotInspected(std::move(*job), PartError::NoInput,
+                              "not inspected: " + grab.message);
           continue;
         }
         [[fallthrough]];
@@ -342,7 +347,7 @@ void Station::acquisitionLoop() {
           job->partId = nextPartId_++;
           ++partsTaken_;
           job->inspection = recipeForPart(nullptr, &*trigger);
-          publishNotInspected(std::move(*job),
+          publishNotInspected(std::move(*job), PartError::CameraUnavailable,
                               std::string("camera ") + toString(grab.status) + ": " + grab.message);
         }
         std::this_thread::sleep_for(100ms);
@@ -354,7 +359,8 @@ void Station::acquisitionLoop() {
         job->partId = nextPartId_++;
         ++partsTaken_;
         job->inspection = recipeForPart(nullptr, &*trigger);
-        publishNotInspected(std::move(*job), "replay finished: no image left for the trigger");
+        publishNotInspected(std::move(*job), PartError::NoInput,
+                            "replay finished: no image left for the trigger");
       }
       if (options_.stopAtEndOfStream) break;
       std::this_thread::sleep_for(50ms);
@@ -369,7 +375,8 @@ void Station::acquisitionLoop() {
     if (auto dropped = inspectQueue_.push(std::move(job)); dropped && *dropped) {
       metrics_.counter("facet_missed_parts_total", "Parts not inspected: inspection fell behind")
           .increment();
-      publishNotInspected(std::move(**dropped), "missed: inspection fell behind");
+      publishNotInspected(std::move(**dropped), PartError::Missed,
+                          "missed: inspection fell behind");
     }
     metrics_.gauge("facet_queue_depth", "Items waiting per queue", "queue=\"inspect\"")
         .set(static_cast<double>(inspectQueue_.size()));
@@ -443,7 +450,8 @@ void Station::inspectionLoop() {
   publishQueue_.close();
 }
 
-void Station::publishNotInspected(Job job, const std::string& cause) {
+void Station::publishNotInspected(Job job, PartError code, const std::string& cause) {
+  job.error = code;
   job.result.verdict = Verdict::Error;
   job.result.error = cause;
   job.inspectedAt = Clock::now();
@@ -524,7 +532,9 @@ void Station::publishPart(Job& j) {
       for (const auto& [check, step] : j.inspection->recipe().plcOutputs())
         r.values.try_emplace(check->plc->output.name, std::numeric_limits<double>::quiet_NaN());
     r.onlyGivenValues = true;  // other recipes' outputs keep their registers
-    r.errorCode = p.verdict == Verdict::Error ? 1 : 0;
+    if (p.verdict == Verdict::Error)
+      r.errorCode =
+          static_cast<int>(j.error == PartError::None ? PartError::InspectionFailed : j.error);
     r.triggerSequence = j.trigger ? j.trigger->sequence : 0;
     if (!plc_->publish(std::move(r)))
       spdlog::error("part {} recipe {}: result not delivered to the PLC (queue full)", p.partId,

@@ -33,6 +33,7 @@
 #include "service/daemon/image_archive.hpp"
 #include "service/daemon/inspection.hpp"
 #include "service/daemon/metrics.hpp"
+#include "service/daemon/part_error.hpp"
 #include "service/daemon/results_store.hpp"
 #include "service/daemon/station_view.hpp"
 
@@ -107,7 +108,7 @@ class Station : public StationView {
   std::shared_ptr<const RecipeInspection> inspectionFor(int recipeId, std::string* error);
   std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
                                                         const plc::TriggerEvent* trigger);
-  void publishNotInspected(Job job, const std::string& cause);
+  void publishNotInspected(Job job, PartError code, const std::string& cause);
   // A scan recipe's part: the next recorded scan instead of a camera frame. False at the end.
   bool acquireScan(Job& job);
   void publish(PartResult part, const cv::Mat& image, const Overlay& overlay);
