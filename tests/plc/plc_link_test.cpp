@@ -279,7 +279,7 @@ TEST(PlcLinkWithPymodbus, TriggerWhileBusyRaisesMissedTrigger) {
   ASSERT_TRUE(link.publish(sampleResult(map, 0, "late")));
   ASSERT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "result") == 1; }, 5s));
   ASSERT_TRUE(waitUntil([&] { return link.stats().acknowledged == 1; }, 5s));
-  // The peer holds a pulse raised while busy for 0.5 s.
+  // The peer drops a pulse raised while busy when the result arrives, at the latest after 0.5 s.
   ASSERT_TRUE(waitForTriggerLowSeenByLink(plc)) << "the missed trigger was never cleared";
   plc.command("trigger");  // no longer busy: accepted
   ASSERT_TRUE(link.waitTrigger(5s));
