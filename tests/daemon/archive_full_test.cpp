@@ -54,7 +54,8 @@ bool tmpfsNamespaceWorks(const TempDir& dir, std::string* why) {
 
 // Every file in the archive (seen from inside facetd's mount namespace) is a complete PNG, or
 // the filler: no ".partial" or truncated file survives a failed write. facetd goes on writing
-// meanwhile, so a ".partial" may be seen mid-write (it must be gone a second later), and the
+// meanwhile, so a ".partial" may be seen mid-write (it must be gone soon after: a PNG write
+// takes milliseconds, the 10 s allow for an instrumented facetd on a loaded machine), and the
 // quota may remove a file between listing and reading it.
 void expectOnlyWholeImages(const std::string& archive, int* images) {
   *images = 0;
@@ -70,8 +71,12 @@ void expectOnlyWholeImages(const std::string& archive, int* images) {
       ADD_FAILURE() << "not a whole PNG: " << name;
     ++*images;
   }
-  std::this_thread::sleep_for(1s);
-  for (const auto& file : others) EXPECT_FALSE(fs::exists(file)) << "left behind: " << file;
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  for (const auto& file : others) {
+    while (fs::exists(file) && std::chrono::steady_clock::now() < until)
+      std::this_thread::sleep_for(50ms);
+    EXPECT_FALSE(fs::exists(file)) << "left behind: " << file;
+  }
 }
 
 TEST(ArchiveFull, InspectionGoesOnArchiveDegradedThenRecovers) {

@@ -165,6 +165,38 @@ std::size_t countIn(const std::vector<nlohmann::json>& events, const char* kind)
                                                 [&](const auto& e) { return e["event"] == kind; }));
 }
 
+// A signal as the PLC sees it once it has carried out every command sent before this one (the
+// peer runs its commands in order); null when it does not answer within 5 s.
+nlohmann::json reportOf(PymodbusPlc& plc, const std::string& signal) {
+  const std::size_t before = plc.events("report").size();
+  plc.command("report " + signal);
+  if (!plc.waitFor([&](const auto& all) { return countIn(all, "report") > before; }, 5s))
+    return nullptr;
+  return plc.events("report").back()["value"];
+}
+
+// Waits until the PLC's trigger is low and the link has read it low: only then is the next
+// "trigger" a rising edge for the link. Neither a fixed sleep nor the peer's own state is
+// enough on a loaded machine: the peer may take the clearing and the next raise in one scan,
+// and the link may not poll in between. The link writes the heartbeat at the start of each
+// step and reads the trigger after it, so the second heartbeat written after the trigger was
+// seen low ends a step that read it low.
+bool waitForTriggerLowSeenByLink(PymodbusPlc& plc) {
+  const auto until = std::chrono::steady_clock::now() + 10s;
+  while (reportOf(plc, "trigger") != false) {
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(5ms);
+  }
+  const auto beat = reportOf(plc, "heartbeat");
+  if (!beat.is_number()) return false;
+  while (true) {
+    const auto now = reportOf(plc, "heartbeat");
+    if (now.is_number() && now.get<int>() >= beat.get<int>() + 2) return true;
+    if (std::chrono::steady_clock::now() > until) return false;
+    std::this_thread::sleep_for(5ms);
+  }
+}
+
 void triggeredRoundTrip(const RegisterMap& map) {
   const int port = test::freeTcpPort();
   PymodbusPlc plc(test::writePeerConfig(map, false), port);
@@ -236,8 +268,8 @@ TEST(PlcLinkWithPymodbus, TriggerWhileBusyRaisesMissedTrigger) {
   link.start();
   plc.command("trigger");
   ASSERT_TRUE(link.waitTrigger(5s));
-  // The peer clears the first trigger when busy rises; wait for that before the second pulse.
-  std::this_thread::sleep_for(50ms);
+  // The peer clears the first trigger when busy rises; the second pulse must be a new edge.
+  ASSERT_TRUE(waitForTriggerLowSeenByLink(plc)) << "the first trigger was never cleared";
   plc.command("trigger");  // still busy: no result published yet
   ASSERT_TRUE(
       plc.waitFor([&](const auto& all) { return countIn(all, "missed_trigger") == 1; }, 5s));
@@ -247,8 +279,9 @@ TEST(PlcLinkWithPymodbus, TriggerWhileBusyRaisesMissedTrigger) {
   ASSERT_TRUE(link.publish(sampleResult(map, 0, "late")));
   ASSERT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "result") == 1; }, 5s));
   ASSERT_TRUE(waitUntil([&] { return link.stats().acknowledged == 1; }, 5s));
-  std::this_thread::sleep_for(600ms);  // the peer holds a pulse raised while busy for 0.5 s
-  plc.command("trigger");              // no longer busy: accepted
+  // The peer drops a pulse raised while busy when the result arrives, at the latest after 0.5 s.
+  ASSERT_TRUE(waitForTriggerLowSeenByLink(plc)) << "the missed trigger was never cleared";
+  plc.command("trigger");  // no longer busy: accepted
   ASSERT_TRUE(link.waitTrigger(5s));
   EXPECT_EQ(link.stats().missedTriggers, 1u);
 }
@@ -356,7 +389,9 @@ TEST(PlcLinkWithPymodbus, FreeRunWritesEveryResultWithTheNextCounter) {
   RegisterMap map = fullMap();
   map.control = {};
   const int port = test::freeTcpPort();
-  PymodbusPlc plc(test::writePeerConfig(map, true), port);
+  // The peer reports each write of the counter as it lands: a scan for a changed counter would
+  // miss one when a link starved of CPU writes two results within one scan of the peer.
+  PymodbusPlc plc(test::writePeerConfig(map, true, 512, 128, {{"report_writes", true}}), port);
   plc.start();
   PlcSettings settings = fastSettings(port);
   settings.mode = HandshakeMode::FreeRun;
@@ -366,12 +401,14 @@ TEST(PlcLinkWithPymodbus, FreeRunWritesEveryResultWithTheNextCounter) {
   for (int i = 0; i < 6; ++i) {
     sent.push_back(sampleResult(map, i, "free-" + std::to_string(i)));
     ASSERT_TRUE(link.publish(sent.back()));
-    std::this_thread::sleep_for(30ms);  // the peer scans every 0.5 ms; give it each counter
   }
   ASSERT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "result") == 6; }, 10s));
   const auto results = plc.events("result");
   for (int i = 0; i < 6; ++i) expectDelivered(map, sent[i], results[i], i + 1);
-  EXPECT_EQ(link.stats().written, 6u);
+  // The peer saw the last counter as it landed; the link counts the result once its flags
+  // after the counter are written too.
+  EXPECT_TRUE(waitUntil([&] { return link.stats().written == 6u; }, 5s))
+      << "written " << link.stats().written;
   EXPECT_EQ(link.stats().queueDepth, 0u);
 }
 
@@ -509,7 +546,7 @@ TEST(PlcLinkWithPymodbus, TriggersAreIgnoredWhileNotEnabled) {
   EXPECT_EQ(link.stats().triggers, 0u);
   EXPECT_EQ(link.stats().missedTriggers, 0u);
   plc.command("untrigger");  // the unanswered trigger goes low before enable rises
-  std::this_thread::sleep_for(100ms);
+  ASSERT_TRUE(waitForTriggerLowSeenByLink(plc));
   plc.command("set_register 6 1");
   plc.command("trigger");
   EXPECT_TRUE(link.waitTrigger(5s));
@@ -531,23 +568,25 @@ TEST(PlcLinkWithPymodbus, ReadyActiveRecipeAndHeartbeatReachThePlc) {
   link.setActiveRecipe(12);
   link.start();
   ASSERT_TRUE(waitUntil([&] { return link.stats().connected; }, 5s));
-  auto report = [&](const std::string& signal) {
-    const std::size_t before = plc.events("report").size();
-    plc.command("report " + signal);
-    EXPECT_TRUE(plc.waitFor([&](const auto& all) { return countIn(all, "report") > before; }, 5s));
-    return plc.events("report").back()["value"];
+  // The link writes them after it connected, on its own thread: the PLC sees them within 5 s
+  // (a few ms on an idle machine).
+  auto reportBecomes = [&](const std::string& signal, const nlohmann::json& value) {
+    return waitUntil([&] { return reportOf(plc, signal) == value; }, 5s);
   };
-  std::this_thread::sleep_for(50ms);
-  EXPECT_EQ(report("ready"), true);
-  EXPECT_EQ(report("active_recipe"), 12);
-  const int beat = report("heartbeat");
-  std::this_thread::sleep_for(200ms);
-  EXPECT_GE(static_cast<int>(report("heartbeat")), beat + 3);
+  EXPECT_TRUE(reportBecomes("ready", true));
+  EXPECT_TRUE(reportBecomes("active_recipe", 12));
+  const int beat = reportOf(plc, "heartbeat");
+  EXPECT_TRUE(waitUntil(
+      [&] {
+        const auto now = reportOf(plc, "heartbeat");
+        return now.is_number() && now.get<int>() >= beat + 3;
+      },
+      5s))
+      << "the heartbeat stopped at " << reportOf(plc, "heartbeat");
   link.setReady(false);
   link.setActiveRecipe(4);
-  std::this_thread::sleep_for(50ms);
-  EXPECT_EQ(report("ready"), false);
-  EXPECT_EQ(report("active_recipe"), 4);
+  EXPECT_TRUE(reportBecomes("ready", false));
+  EXPECT_TRUE(reportBecomes("active_recipe", 4));
 }
 
 }  // namespace

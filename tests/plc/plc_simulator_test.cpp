@@ -111,7 +111,13 @@ TEST(PlcSimulator, FreeRunReportsEachCounter) {
                 {"angle_deg", 0.0},
                 {"score", 1.0}};
     ASSERT_TRUE(link.publish(r));
-    std::this_thread::sleep_for(20ms);
+    // The simulator scans for a changed counter: a result written before it saw the previous
+    // one would hide that one (a link thread starved on a loaded machine writes two in a row).
+    // Each result is published once the previous one was seen; the values are checked below.
+    const auto seen = std::chrono::steady_clock::now() + 5s;
+    while (received.size() < static_cast<std::size_t>(i + 1) &&
+           std::chrono::steady_clock::now() < seen)
+      std::this_thread::sleep_for(1ms);
   }
   const auto deadline = std::chrono::steady_clock::now() + 5s;
   while (received.size() < 5 && std::chrono::steady_clock::now() < deadline)

@@ -7,24 +7,54 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <random>
 #include <stdexcept>
 
 namespace facet::plc::test {
 
-int freeTcpPort() {
-  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+namespace {
+
+// Binds a TCP socket to 127.0.0.1:port (0: any) and closes it; the port bound, 0 on failure.
+int bindAndRelease(int port) {
+  const int s = ::socket(AF_INET, SOCK_STREAM | SOCK_CLOEXEC, 0);
+  if (s < 0) return 0;
   sockaddr_in address{};
   address.sin_family = AF_INET;
   address.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
-  address.sin_port = 0;
-  ::bind(s, reinterpret_cast<sockaddr*>(&address), sizeof(address));
+  address.sin_port = htons(static_cast<std::uint16_t>(port));
   socklen_t length = sizeof(address);
-  ::getsockname(s, reinterpret_cast<sockaddr*>(&address), &length);
+  const bool bound = ::bind(s, reinterpret_cast<sockaddr*>(&address), sizeof(address)) == 0 &&
+                     ::getsockname(s, reinterpret_cast<sockaddr*>(&address), &length) == 0;
   ::close(s);
-  return ntohs(address.sin_port);
+  return bound ? ntohs(address.sin_port) : 0;
+}
+
+// The first port the kernel hands out on its own (net.ipv4.ip_local_port_range).
+int ephemeralRangeStart() {
+  int low = 32768;
+  std::ifstream("/proc/sys/net/ipv4/ip_local_port_range") >> low;
+  return low;
+}
+
+}  // namespace
+
+// Below the ephemeral range: a port the kernel gives for bind(0) is one it may also give, as
+// the local port of any outgoing connection on the machine (the tests' HTTP and Modbus clients,
+// other tests), in the time between this check and the peer's bind, which then fails.
+int freeTcpPort() {
+  constexpr int kLowest = 10000;
+  const int end = ephemeralRangeStart();
+  if (end > kLowest + 1000) {
+    static std::mt19937 random(std::random_device{}());
+    std::uniform_int_distribution<int> pick(kLowest, end - 1);
+    for (int attempt = 0; attempt < 100; ++attempt)
+      if (const int port = bindAndRelease(pick(random)); port > 0) return port;
+  }
+  return bindAndRelease(0);
 }
 
 namespace {

@@ -7,15 +7,20 @@ facetd=$1
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # The example station, with the results and archive in a private folder and no fixed HTTP port.
+# Its copy goes to that folder too, never into recipes/: other tests read (and copy) that folder
+# meanwhile. Its relative paths (relative to the station file) become absolute.
+recipes=$PWD/recipes
+station=$work/station-under-test.yaml
 sed -e "s#/tmp/facet-demo-results.db#$work/results.db#" -e "s#/tmp/facet-demo-archive#$work/archive#" \
-    -e 's/port: 8080/port: 0/' recipes/station.yaml > recipes/.station-under-test.yaml
-trap 'rm -rf "$work" recipes/.station-under-test.yaml' EXIT
+    -e 's/port: 8080/port: 0/' -e "s#^recipes: \.\$#recipes: $recipes#" \
+    -e "s#folder: demo/#folder: $recipes/demo/#" -e "s#file: calibration.yaml#file: $recipes/calibration.yaml#" \
+    recipes/station.yaml > "$station"
 status=0
 for run in 1:bracket_registration 2:bracket_shape 3:fiducial_board 4:scan_offset; do
   id=${run%%:*}
   folder=recipes/demo/${run#*:}
   files=$(find "$folder" -maxdepth 1 \( -name '*.png' -o -name '*.csv' \) | wc -l)
-  summary=$("$facetd" --config recipes/.station-under-test.yaml --no-plc --recipe "$id" \
+  summary=$("$facetd" --config "$station" --no-plc --recipe "$id" \
               --replay "$folder" --print-parts | tee "$work/recipe-$id.log" | grep '^summary:')
   inspected=$(grep -c '^part .* \(pass\|fail\) ' "$work/recipe-$id.log" || true)
   echo "recipe $id ($folder, $files files): $summary; inspected $inspected"
