@@ -1,5 +1,7 @@
 #include "config/recipe_library.hpp"
 
+#include <sys/stat.h>
+
 #include <algorithm>
 #include <set>
 
@@ -11,13 +13,16 @@ RecipeLibrary::RecipeLibrary(RecipeLoadOptions options) : options_(std::move(opt
 }
 
 RecipeLibrary::FileStamp RecipeLibrary::stamp(const std::filesystem::path& file) {
-  std::error_code ec;
   FileStamp s;
-  const auto status = std::filesystem::status(file, ec);
-  if (ec || !std::filesystem::is_regular_file(status)) return s;
+  struct stat st {};
+  if (::stat(file.c_str(), &st) != 0 || !S_ISREG(st.st_mode)) return s;
+  auto ns = [](const timespec& t) { return std::int64_t{t.tv_sec} * 1'000'000'000 + t.tv_nsec; };
   s.exists = true;
-  s.modified = std::filesystem::last_write_time(file, ec);
-  s.size = std::filesystem::file_size(file, ec);
+  s.device = st.st_dev;
+  s.inode = st.st_ino;
+  s.size = static_cast<std::uint64_t>(st.st_size);
+  s.modifiedNs = ns(st.st_mtim);
+  s.changedNs = ns(st.st_ctim);
   return s;
 }
 

@@ -8,6 +8,7 @@
 //
 // Recipe files are the `*.recipe.yaml` files anywhere below the root. Thread-safe.
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -42,7 +43,7 @@ class RecipeLibrary {
   ReloadReport reload();
 
   // Whether a recipe file was added, removed or changed, or a file one names changed, since the
-  // last reload(). Cheap: compares sizes and modification times.
+  // last reload(). Cheap: compares inodes, sizes and modification and status-change times.
   [[nodiscard]] bool changedOnDisk() const;
 
   [[nodiscard]] std::shared_ptr<const Recipe> find(int id) const;
@@ -53,10 +54,14 @@ class RecipeLibrary {
   [[nodiscard]] const std::filesystem::path& root() const { return root_; }
 
  private:
+  // What tells a changed file from the one read: the modification time alone misses a file
+  // replaced by one of the same size and time (cp -p, rsync -t, an editor keeping the time);
+  // the status-change time cannot be set back and moves with every write, and a file renamed
+  // into place has another inode.
   struct FileStamp {
     bool exists = false;
-    std::filesystem::file_time_type modified{};
-    std::uintmax_t size = 0;
+    std::uint64_t device = 0, inode = 0, size = 0;
+    std::int64_t modifiedNs = 0, changedNs = 0;
     bool operator==(const FileStamp&) const = default;
   };
   using Stamps = std::map<std::filesystem::path, FileStamp>;

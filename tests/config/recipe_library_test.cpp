@@ -116,6 +116,31 @@ TEST_F(Library, DuplicateIdsAcrossTheFolderAreRefused) {
   EXPECT_EQ(library.find(1)->name, "B");
 }
 
+TEST_F(Library, AFileReplacedWithTheSameSizeAndModificationTimeIsReloaded) {
+  // What `cp -p` or `rsync -t` of an edited recipe does: 1.1 -> 1.3 keeps the size, and the
+  // modification time is set back to the old file's.
+  scratch.write("a.recipe.yaml", recipeText(1, "A", 1.1));
+  const auto file = scratch.path() / "a.recipe.yaml";
+  const auto size = std::filesystem::file_size(file);
+  const auto modified = std::filesystem::last_write_time(file);
+  auto library = make();
+  library.reload();
+  ASSERT_NE(library.find(1), nullptr);
+  const double before = library.find(1)->steps.at(1).as<CircleStep>().nominalDiameter;
+
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a later status-change time
+  scratch.write("a.recipe.yaml", recipeText(1, "A", 1.3));
+  std::filesystem::last_write_time(file, modified);
+  ASSERT_EQ(std::filesystem::file_size(file), size);
+  ASSERT_EQ(std::filesystem::last_write_time(file), modified);
+
+  EXPECT_TRUE(library.changedOnDisk());
+  const auto report = library.reload();
+  EXPECT_EQ(report.loaded, (std::vector<int>{1}));
+  EXPECT_DOUBLE_EQ(before, 1.1);
+  EXPECT_DOUBLE_EQ(library.find(1)->steps.at(1).as<CircleStep>().nominalDiameter, 1.3);
+}
+
 TEST_F(Library, AChangedImageReloadsTheRecipe) {
   scratch.write("a.recipe.yaml", recipeText(1, "A"));
   auto library = make();
