@@ -162,8 +162,7 @@ GrabResult ReplayCamera::readNext(std::unique_lock<std::mutex>& lock) {
       reported_[read.index] = true;
       Frame refused;  // no image and no frame number: only where it came from
       refused.source = files_[read.index].string();
-      std::string sidecar_error;
-      refused.metadata = sidecar_.forImage(files_[read.index], &sidecar_error);
+      refused.metadata = sidecar_.forImage(files_[read.index]);  // a bad sidecar is logged there
       return {GrabStatus::Error, std::move(refused), read.content.error};
     }
     if (!read.sidecar_error.empty()) health_.last_error = read.sidecar_error;

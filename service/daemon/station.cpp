@@ -271,18 +271,14 @@ void Station::acquisitionLoop() {
           // The recorded scans are all used: a trigger now gets a not-inspected answer, and the
           // replay ends.
           if (trigger) {
-            job->partId = nextPartId_++;
-            ++partsTaken_;
-            job->inspection = recipeForPart(nullptr, &*trigger);
+            takePart(*job);
             publishNotInspected(std::move(*job), PartError::NoInput,
                                 "no range scan left for the trigger");
           }
           break;
         }
         if (trigger) {
-          job->partId = nextPartId_++;
-          ++partsTaken_;
-          job->inspection = recipeForPart(nullptr, &*trigger);
+          takePart(*job);
           publishNotInspected(std::move(*job), PartError::NoInput, "no range scan for the trigger");
           continue;
         }
@@ -290,9 +286,7 @@ void Station::acquisitionLoop() {
         std::this_thread::sleep_for(50ms);
         continue;
       }
-      job->partId = nextPartId_++;
-      ++partsTaken_;
-      job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
+      takePart(*job);
       inspectQueue_.push(std::move(job));
       continue;
     }
@@ -305,19 +299,15 @@ void Station::acquisitionLoop() {
         break;
       case GrabStatus::Timeout:
         if (!trigger) continue;
-        job->partId = nextPartId_++;
-        ++partsTaken_;
-        job->inspection = recipeForPart(nullptr, &*trigger);
+        takePart(*job);
         publishNotInspected(std::move(*job), PartError::NoFrame,
                             "no frame within 2 s of the trigger");
         continue;
       case GrabStatus::Incomplete:
         metrics_.counter("facet_incomplete_frames_total", "Frames with missing pixel data")
             .increment();
-        job->partId = nextPartId_++;
-        ++partsTaken_;
         job->frame = std::move(grab.frame);
-        job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
+        takePart(*job);
         publishNotInspected(std::move(*job), PartError::IncompleteFrame,
                             "incomplete frame: " + grab.message);
         continue;
@@ -330,10 +320,8 @@ void Station::acquisitionLoop() {
           // part that was not inspected, stored under its file name, never skipped silently.
           metrics_.counter("facet_refused_files_total", "Replay files refused as not inspected")
               .increment();
-          job->partId = nextPartId_++;
-          ++partsTaken_;
           job->frame = std::move(grab.frame);
-          job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
+          takePart(*job);
           publishNotInspected(std::move(*job), PartError::NoInput,
                               "not inspected: " + grab.message);
           continue;
@@ -344,9 +332,7 @@ void Station::acquisitionLoop() {
         metrics_.counter("facet_camera_errors_total", "Grabs that failed").increment();
         spdlog::warn("camera: {}: {}", toString(grab.status), grab.message);
         if (trigger) {
-          job->partId = nextPartId_++;
-          ++partsTaken_;
-          job->inspection = recipeForPart(nullptr, &*trigger);
+          takePart(*job);
           publishNotInspected(std::move(*job), PartError::CameraUnavailable,
                               std::string("camera ") + toString(grab.status) + ": " + grab.message);
         }
@@ -356,9 +342,7 @@ void Station::acquisitionLoop() {
     if (endOfStream) {
       if (trigger) {
         // Every accepted trigger gets an answer, even when the replay has nothing left.
-        job->partId = nextPartId_++;
-        ++partsTaken_;
-        job->inspection = recipeForPart(nullptr, &*trigger);
+        takePart(*job);
         publishNotInspected(std::move(*job), PartError::NoInput,
                             "replay finished: no image left for the trigger");
       }
@@ -368,10 +352,8 @@ void Station::acquisitionLoop() {
     }
     metrics_.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(), "stage=\"grab\"")
         .observe(msSince(t0));
-    job->partId = nextPartId_++;
-    ++partsTaken_;
     job->frame = std::move(grab.frame);
-    job->inspection = recipeForPart(&job->frame, trigger ? &*trigger : nullptr);
+    takePart(*job);
     if (auto dropped = inspectQueue_.push(std::move(job)); dropped && *dropped) {
       metrics_.counter("facet_missed_parts_total", "Parts not inspected: inspection fell behind")
           .increment();
@@ -448,6 +430,12 @@ void Station::inspectionLoop() {
     publishQueue_.push(std::move(*job));
   }
   publishQueue_.close();
+}
+
+void Station::takePart(Job& job) {
+  job.partId = nextPartId_++;
+  ++partsTaken_;
+  job.inspection = recipeForPart(&job.frame, job.trigger ? &*job.trigger : nullptr);
 }
 
 void Station::publishNotInspected(Job job, PartError code, const std::string& cause) {

@@ -108,6 +108,9 @@ class Station : public StationView {
   std::shared_ptr<const RecipeInspection> inspectionFor(int recipeId, std::string* error);
   std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
                                                         const plc::TriggerEvent* trigger);
+  // Numbers a part the acquisition took and picks its recipe (from its frame's sidecar, once the
+  // frame is in the job, or the trigger): every trigger answered, every frame taken, once.
+  void takePart(Job& job);
   void publishNotInspected(Job job, PartError code, const std::string& cause);
   // A scan recipe's part: the next recorded scan instead of a camera frame. False at the end.
   bool acquireScan(Job& job);

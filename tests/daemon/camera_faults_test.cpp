@@ -19,6 +19,7 @@
 #include <thread>
 
 #include "tests/daemon/child_process.hpp"
+#include "tests/daemon/facetd_http.hpp"
 #include "tests/daemon/line_run.hpp"
 #include "tests/daemon/plc_line.hpp"
 #include "tests/plc/pymodbus_peer.hpp"
@@ -98,11 +99,7 @@ struct Line : PlcLine {
   // An unlabelled metric's value from /metrics; -1 when absent.
   double metric(const std::string& name) {
     auto r = get("/metrics");
-    if (!r) return -1;
-    std::istringstream in(r->body);
-    for (std::string l; std::getline(in, l);)
-      if (l.rfind(name + " ", 0) == 0) return std::stod(l.substr(name.size() + 1));
-    return -1;
+    return r ? metricValue(r->body, name).value_or(-1) : -1;
   }
 
   // Polls /healthz until `done` holds; returns how long that took, or nullopt.
