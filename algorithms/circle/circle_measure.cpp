@@ -196,6 +196,63 @@ std::optional<Circle> fitRim(const std::vector<Eigen::Vector2d>& pts, Circle cir
   return circle;
 }
 
+// Angular runs of inliers (split where neighbours are more than maxGap apart), as index lists
+// into `in`, around the circle's centre.
+std::vector<std::vector<std::size_t>> inlierArcs(const std::vector<Eigen::Vector2d>& in,
+                                                 const Circle& c, double maxGap) {
+  std::vector<std::pair<double, std::size_t>> a;
+  a.reserve(in.size());
+  for (std::size_t i = 0; i < in.size(); ++i)
+    a.emplace_back(std::atan2(in[i].y() - c.centre.y(), in[i].x() - c.centre.x()), i);
+  std::sort(a.begin(), a.end());
+  std::vector<std::vector<std::size_t>> arcs;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (k == 0 || a[k].first - a[k - 1].first > maxGap) arcs.emplace_back();
+    arcs.back().push_back(a[k].second);
+  }
+  // The run through +-180 degrees is one arc.
+  if (arcs.size() > 1 && a.front().first + 2.0 * kPi - a.back().first <= maxGap) {
+    arcs.front().insert(arcs.front().end(), arcs.back().begin(), arcs.back().end());
+    arcs.pop_back();
+  }
+  return arcs;
+}
+
+// A short run of inliers that the rest of the rim does not predict: the straight border of an
+// occluder or a clutter edge that happens to lie within the RANSAC threshold of a circle pulled
+// towards it (at r = 10 px, a light occluder's far side 2 px outside the rim lent a circle 1 px
+// off five of its points). Each run holding under a third of the inliers is judged against a
+// plain fit of the others, when those cover at least the minimum coverage: a real piece of the
+// rim lies on that circle within its noise, a foreign one off it by more than the RANSAC
+// threshold. Returns the points to drop (empty when every run belongs).
+std::vector<Eigen::Vector2d> strayArc(const std::vector<Eigen::Vector2d>& in, const Circle& c,
+                                      const CircleMeasureParams& params) {
+  const double maxGap = std::max(3.0 / std::max(c.radius, 1e-6), 2.0 * kPi / 180.0);
+  const auto arcs = inlierArcs(in, c, maxGap);
+  if (arcs.size() < 2) return {};
+  double worst = 0.0;
+  std::vector<Eigen::Vector2d> stray;
+  for (const auto& arc : arcs) {
+    if (3 * arc.size() >= in.size()) continue;
+    std::vector<Eigen::Vector2d> rest, own;
+    std::vector<std::uint8_t> mine(in.size(), 0);
+    for (std::size_t i : arc) mine[i] = 1;
+    for (std::size_t i = 0; i < in.size(); ++i) (mine[i] ? own : rest).push_back(in[i]);
+    if (static_cast<int>(rest.size()) < params.minInliers) continue;
+    const auto others = fitGeometric(rest, std::vector<double>(rest.size(), 1.0), c);
+    if (!others || coverageDeg(rest, *others) < params.minCoverageDeg) continue;
+    std::vector<double> r;
+    for (const auto& p : own) r.push_back(residual(*others, p));
+    std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+    const double off = std::abs(r[r.size() / 2]);
+    if (off > params.ransacThreshold && off > worst) {
+      worst = off;
+      stray = std::move(own);
+    }
+  }
+  return stray;
+}
+
 // Strong edge points that are not the rim: off the circle or not radial with the rim's polarity
 // (rimSign +1: gradient outwards). Weak ones (below the high threshold) are mostly noise and must
 // not punch holes into the grey-value fit.
@@ -346,7 +403,16 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   // Geometric fit on the RANSAC inliers, then re-collect the inliers around the refined circle
   // and refit with the robust weight.
   std::vector<Eigen::Vector2d> in;
-  const std::optional<Circle> fitted = fitRim(bestPts, *best, params, in);
+  std::optional<Circle> fitted = fitRim(bestPts, *best, params, in);
+  // Drop runs of inliers the rest of the rim disagrees with, worst first, and refit.
+  for (int round = 0; round < 3 && fitted; ++round) {
+    const std::vector<Eigen::Vector2d> stray = strayArc(in, *fitted, params);
+    if (stray.empty()) break;
+    std::erase_if(bestPts, [&](const Eigen::Vector2d& p) {
+      return std::find(stray.begin(), stray.end(), p) != stray.end();
+    });
+    fitted = fitRim(bestPts, *fitted, params, in);
+  }
   if (!fitted)
     return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
   const Circle circle = *fitted;

@@ -10,9 +10,11 @@
 //   4. outliers removed by gradient direction: near-radial within a tolerance, expected polarity;
 //   5. RANSAC circle (an inlier lies near the hypothesis AND its gradient is radial to it within
 //      12 degrees, so a straight edge next to an occluded sector cannot lend a wrong circle its
-//      points), then a geometric (orthogonal distance) least-squares fit on the inliers by
-//      Levenberg-Marquardt, optionally with a robust Huber/Tukey weight (IRLS); the curvature
-//      bias of second-derivative edges (-k / r) is corrected with a measured k;
+//      points; a short run of inliers that a fit of the others puts more than the RANSAC
+//      threshold off is dropped too), then a geometric (orthogonal distance) least-squares fit
+//      on the inliers by Levenberg-Marquardt, optionally with a robust Huber/Tukey weight
+//      (IRLS); the curvature bias of second-derivative edges (-k / r) is corrected with a
+//      measured k;
 //   6. (default) a grey-value refinement on the rim the inliers cover (circle_profile_fit.hpp):
 //      a blurred-disc model fitted to every pixel of a band around the rim. It reaches the
 //      Cramer-Rao bound where edge points stay about 2x above it (small circles) and corrects the
