@@ -3,10 +3,15 @@
 // Scenes: discs (light on dark) and holes (dark in a light plate) of radius 10..200 px at random
 // subpixel centres, blur sigma 1, noise sigma 2, contrast 100; the coarse position handed to
 // both methods is off by up to 2 px. Cases: clean; hard (30% of the rim occluded, clutter on the
-// annulus off the rim, illumination gradient); low contrast (15 grey levels). Errors are RMS over
-// the scenes a method measured; failures are counted separately. Targets (issue 4): clean centre
-// and radius RMS <= 0.01 px, hard <= 0.02 px without failure, low contrast <= 0.03 px, <= 1 ms at r
-// = 100. The CRLB columns give the Cramer-Rao bound of each case (cramerRaoBound).
+// annulus off the rim, illumination gradient); low contrast (15 grey levels). Targets (issue 4),
+// "median over >= 30 scenes per radius": centre and radius error <= 0.01 px clean, <= 0.02 px
+// hard without failure, <= 0.03 px at low contrast; <= 1 ms at r = 100. The target column judges
+// the median error over the scenes a row measured, as the issue words it; the RMS is printed
+// beside it and judged too, since a median can hide a few gross errors.
+//
+// The bound columns are the Cramer-Rao bound (RMS) of each row for any unbiased estimator,
+// computed per scene from the Fisher information of its own pixels (cramerRaoBound). A target
+// below the bound is marked: no estimator meets it other than by chance.
 //
 // Usage: bench_circle [--smoke] [--scenes N] [--case clean|hard|low-contrast] [--radius R]
 //                     [--seed N] [--verbose] [--no-grey-refinement] [--no-bias-correction]
@@ -52,7 +57,28 @@ struct Trial {
   cv::Point2d coarse;  // what the measurement is given
   double nominal = 0;
   bool hole = false;
+  double contrast = 0;
+  bool ramp = false;  // the scene has an illumination gradient
+  cv::Mat foreign;    // CV_8U, 1 where clutter or an occluder changes the noise-free grey
 };
+
+// Pixels whose noise-free grey the clutter and the occluder change by a quarter grey level or
+// more: the scene rendered without noise with and without them.
+cv::Mat foreignPixels(const facet::scene::Scene& scene) {
+  facet::scene::SceneSpec spec = scene.spec();
+  spec.noiseSigma = 0.0;
+  spec.depth = CV_16U;
+  facet::scene::Scene all(spec), rimOnly(spec);
+  for (const auto& p : scene.primitives()) {
+    all.add(p);
+    if (p.role == "object" || p.role == "hole") rimOnly.add(p);
+  }
+  cv::Mat a, b, diff;
+  all.render().convertTo(a, CV_64F, 1.0 / 256.0);
+  rimOnly.render().convertTo(b, CV_64F, 1.0 / 256.0);
+  cv::absdiff(a, b, diff);
+  return diff >= 0.25;
+}
 
 Trial makeTrial(double radius, Case kind, bool hole, int subrows, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
@@ -94,6 +120,9 @@ Trial makeTrial(double radius, Case kind, bool hole, int subrows, std::mt19937_6
     scene.addOccluder(box, 0.206, 100.0 + 60.0 * u(rng));
   }
   t.image = scene.render();
+  t.contrast = contrast;
+  t.ramp = kind == Case::Hard;
+  t.foreign = kind == Case::Hard ? foreignPixels(scene) : cv::Mat::zeros(t.image.size(), CV_8U);
   const double ea = 2 * std::numbers::pi * u(rng), er = 2.0 * std::sqrt(u(rng));
   t.coarse = {t.centre.x + er * std::cos(ea), t.centre.y + er * std::sin(ea)};
   t.nominal = radius;
@@ -101,17 +130,32 @@ Trial makeTrial(double radius, Case kind, bool hole, int subrows, std::mt19937_6
 }
 
 struct Errors {
-  double sumC2 = 0, sumR2 = 0, sumKr = 0;
-  int measured = 0, failed = 0;
+  std::vector<double> centre, radius;  // per measured scene: |centre error|, |radius error|
+  double sumKr = 0;
+  int failed = 0;
   void add(cv::Point2d c, double r, const Trial& t) {
-    sumC2 += std::pow(c.x - t.centre.x, 2) + std::pow(c.y - t.centre.y, 2);
-    sumR2 += std::pow(r - t.radius, 2);
+    centre.push_back(std::hypot(c.x - t.centre.x, c.y - t.centre.y));
+    radius.push_back(std::abs(r - t.radius));
     sumKr += (t.radius - r) * t.radius;  // curvature-bias constant k if the error were -k/r
-    ++measured;
   }
-  double centreRms() const { return measured ? std::sqrt(sumC2 / measured) : NAN; }
-  double radiusRms() const { return measured ? std::sqrt(sumR2 / measured) : NAN; }
-  double biasK() const { return measured ? sumKr / measured : NAN; }
+  int measured() const { return static_cast<int>(centre.size()); }
+  static double rms(const std::vector<double>& v) {
+    if (v.empty()) return NAN;
+    double s = 0;
+    for (double e : v) s += e * e;
+    return std::sqrt(s / static_cast<double>(v.size()));
+  }
+  static double median(std::vector<double> v) {
+    if (v.empty()) return NAN;
+    std::sort(v.begin(), v.end());
+    const std::size_t n = v.size();
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+  }
+  double centreRms() const { return rms(centre); }
+  double radiusRms() const { return rms(radius); }
+  double centreMedian() const { return median(centre); }
+  double radiusMedian() const { return median(radius); }
+  double biasK() const { return centre.empty() ? NAN : sumKr / measured(); }
 };
 
 constexpr double kWidth = 5.0;
@@ -159,41 +203,41 @@ bool hough(const Trial& t, int method, cv::Point2d* c, double* r) {
 }
 
 // Cramer-Rao bound of the centre error (RMS of the 2D distance) and of the radius error of one
-// scene of the case, for any unbiased estimator, from the Fisher information of the pixels.
-// Model of a pixel at p: I = a + g . p + b Phi(-(|p - c| - R) / s), with s^2 = blur^2 + 1/12
-// (PSF and pixel width) and white noise of variance noise^2 + 1/12 (quantisation). Unknown: c, R,
-// s, a, b and, in the hard case (which has an illumination gradient), g. Pixels: every one within
-// 8 px of the rim (farther ones only pin down a and g, which are pinned already); in the hard
-// case minus the strip of the occluder over 30% of the rim. The clutter is left out, which can
-// only lower the bound. Centre (0.3, 0.2) px off the pixel grid.
+// scene, for any unbiased estimator, from the Fisher information of its pixels. Model of a pixel
+// at p: I = a + g . p + b Phi(-(|p - c| - R) / s), with s^2 = blur^2 + 1/12 (PSF and pixel width)
+// and white noise of variance noise^2 + 1/12 (quantisation). Unknown: c, R, s, a, b and, where
+// the scene has an illumination gradient, g. Pixels: every one within 8 px of the rim (farther
+// ones only pin down a and g, which are pinned already) that the clutter and the occluder leave
+// unchanged. Pixels they change are left out rather than modelled, which is what an estimator
+// without a model of the clutter can use.
 struct Bound {
   double centre = 0, radius = 0;
 };
-Bound cramerRaoBound(double radius, Case kind) {
-  const double contrast = kind == Case::LowContrast ? 15.0 : 100.0;
+Bound cramerRaoBound(const Trial& t) {
   const double noiseVar = 2.0 * 2.0 + 1.0 / 12.0, s = std::sqrt(1.0 + 1.0 / 12.0);
-  const bool hard = kind == Case::Hard;
-  const int params = hard ? 8 : 6;
+  const int params = t.ramp ? 8 : 6;
   Eigen::MatrixXd fisher = Eigen::MatrixXd::Zero(params, params);
-  const double cx = 0.3, cy = 0.2, band = 8.0;
-  const int n = static_cast<int>(radius + band) + 2;
-  for (int y = -n; y <= n; ++y) {
-    for (int x = -n; x <= n; ++x) {
-      const double dx = x - cx, dy = y - cy, rho = std::hypot(dx, dy), d = rho - radius;
-      if (std::abs(d) > band || rho == 0.0) continue;
-      // The occluder strip of the bench: x from 0.588 R to R + 2, |y| up to R + 2.
-      if (hard && dx >= 0.588 * radius && dx <= radius + 2.0 && std::abs(dy) <= radius + 2.0)
-        continue;
+  const double band = 8.0;
+  const int x0 = std::max(0, static_cast<int>(t.centre.x - t.radius - band));
+  const int x1 = std::min(t.image.cols - 1, static_cast<int>(t.centre.x + t.radius + band) + 1);
+  const int y0 = std::max(0, static_cast<int>(t.centre.y - t.radius - band));
+  const int y1 = std::min(t.image.rows - 1, static_cast<int>(t.centre.y + t.radius + band) + 1);
+  Eigen::VectorXd j(params);
+  for (int y = y0; y <= y1; ++y) {
+    for (int x = x0; x <= x1; ++x) {
+      const double dx = x - t.centre.x, dy = y - t.centre.y, rho = std::hypot(dx, dy);
+      const double d = rho - t.radius;
+      if (std::abs(d) > band || rho == 0.0 || t.foreign.at<std::uint8_t>(y, x)) continue;
       const double z = d / s;
-      const double g = contrast * std::exp(-0.5 * z * z) / (std::sqrt(2.0 * std::numbers::pi) * s);
-      Eigen::VectorXd j(params);
+      const double g =
+          t.contrast * std::exp(-0.5 * z * z) / (std::sqrt(2.0 * std::numbers::pi) * s);
       j(0) = g * dx / rho;                              // d I / d cx
       j(1) = g * dy / rho;                              // d I / d cy
       j(2) = g;                                         // d I / d R (up to sign)
       j(3) = g * z;                                     // d I / d s
       j(4) = 1.0;                                       // d I / d a
       j(5) = 0.5 * std::erfc(z / std::numbers::sqrt2);  // d I / d b
-      if (hard) {
+      if (t.ramp) {
         j(6) = dx;
         j(7) = dy;
       }
@@ -213,7 +257,7 @@ double medianMs(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   bool smoke = false;
-  int scenes = 30;
+  int scenes = 100;
   std::string onlyCase;    // --case clean|hard|low-contrast: that case alone
   double onlyRadius = 0;   // --radius R: that radius alone
   std::uint64_t seed = 0;  // --seed N: another set of scenes (0: the original ones)
@@ -245,70 +289,108 @@ int main(int argc, char** argv) {
       "seed %llu%s\n",
       scenes, static_cast<unsigned long long>(seed), smoke ? " [smoke]" : "");
   std::printf(
-      "errors are RMS in px over measured scenes; fail = no result; ratio = hough / ours\n\n");
-  std::printf(
-      "CRLB c / r = Cramer-Rao bound of the centre / radius error of any unbiased estimator: all\n"
-      "pixels within 8 px of the visible rim, blur 1, noise 2, quantisation, levels, blur (and "
-      "the\n"
-      "illumination ramp in the hard case) unknown; clutter left out. MISSED* = the target lies\n"
-      "below the bound (no unbiased estimator meets it)\n\n");
-  std::printf(
-      "%-12s %5s | %8s %8s %4s | %7s %7s | %8s %8s %4s | %8s %8s %4s | %6s %6s %6s %6s | %-17s | "
-      "%s\n",
-      "case", "r", "ours c", "ours r", "fail", "CRLB c", "CRLB r", "HG c", "HG r", "miss", "ALT c",
-      "ALT r", "miss", "HG/c", "HG/r", "ALT/c", "ALT/r", "target", "k");
-  bool allMet = true;
+      "errors in px over the scenes measured: |centre error| (2D) and |radius error|; fail = no "
+      "result\n"
+      "bound = Cramer-Rao bound (RMS) from each scene's pixels within 8 px of the rim that "
+      "clutter and\n"
+      "occluder leave unchanged; levels, blur (and the illumination ramp in the hard case) "
+      "unknown.\n"
+      "At the bound, an unbiased estimator's median error is about 0.83 x bound (centre, 2D) and "
+      "0.67 x bound\n"
+      "(radius). MISSED* = the target lies below that: no estimator meets it but by chance\n\n");
+
+  struct Row {
+    Case kind;
+    double radius;
+    Errors ours, hg, alt;
+    Bound bound;
+  };
+  std::vector<Row> rows;
   for (Case kind : {Case::Clean, Case::Hard, Case::LowContrast}) {
     if (!onlyCase.empty() && onlyCase != caseName(kind)) continue;
     for (double radius : radii) {
       if (onlyRadius > 0 && radius != onlyRadius) continue;
       std::mt19937_64 rng(static_cast<std::uint64_t>(radius * 1000) + static_cast<int>(kind) +
                           seed * 1000003);
-      Errors ours, hg, alt;
+      Row row{kind, radius, {}, {}, {}, {}};
+      double boundC2 = 0, boundR2 = 0;
       for (int s = 0; s < scenes; ++s) {
         const Trial t = makeTrial(radius, kind, s % 2 == 1, subrows, rng);
         const facet::CircleMeasurement m = facet::measureCircle(t.image, paramsFor(t));
         if (m.ok())
-          ours.add(m.centre, m.radius, t);
+          row.ours.add(m.centre, m.radius, t);
         else
-          ++ours.failed;
+          ++row.ours.failed;
+        const Bound b = cramerRaoBound(t);
+        boundC2 += b.centre * b.centre;
+        boundR2 += b.radius * b.radius;
         if (gVerbose)
           std::printf(
               "  %s r=%.0f scene %d %s: %s c err (%.4f, %.4f) r err %.4f inliers %d/%d "
-              "cov %.0f rms %.3f refined %d %s\n",
+              "cov %.0f rms %.3f refined %d bound c %.4f %s\n",
               caseName(kind), radius, s, t.hole ? "hole" : "disc",
               m.ok() ? "ok" : facet::circleFailureCause(m.failures).c_str(),
               m.centre.x - t.centre.x, m.centre.y - t.centre.y, m.radius - t.radius, m.inliers,
-              m.candidates, m.coverageDeg, m.rms, m.greyRefined, m.message.c_str());
+              m.candidates, m.coverageDeg, m.rms, m.greyRefined, b.centre, m.message.c_str());
         cv::Point2d c;
         double r = 0;
         if (hough(t, cv::HOUGH_GRADIENT, &c, &r))
-          hg.add(c, r, t);
+          row.hg.add(c, r, t);
         else
-          ++hg.failed;
+          ++row.hg.failed;
         if (hough(t, cv::HOUGH_GRADIENT_ALT, &c, &r))
-          alt.add(c, r, t);
+          row.alt.add(c, r, t);
         else
-          ++alt.failed;
+          ++row.alt.failed;
       }
-      const double bound = 0.01 * caseFactor(kind);
-      const bool met = ours.failed == 0 && ours.centreRms() <= bound && ours.radiusRms() <= bound;
-      allMet = allMet && met;
-      const Bound crlb = cramerRaoBound(radius, kind);
-      const bool belowBound = crlb.centre > bound || crlb.radius > bound;
-      std::printf(
-          "%-12s %5.0f | %8.4f %8.4f %4d | %7.4f %7.4f | %8.4f %8.4f %4d | %8.4f %8.4f %4d | %6.1f "
-          "%6.1f %6.1f %6.1f | %7s (<= %.2f) | %.3f\n",
-          caseName(kind), radius, ours.centreRms(), ours.radiusRms(), ours.failed, crlb.centre,
-          crlb.radius, hg.centreRms(), hg.radiusRms(), hg.failed, alt.centreRms(), alt.radiusRms(),
-          alt.failed, hg.centreRms() / ours.centreRms(), hg.radiusRms() / ours.radiusRms(),
-          alt.centreRms() / ours.centreRms(), alt.radiusRms() / ours.radiusRms(),
-          met          ? "met"
-          : belowBound ? "MISSED*"
-                       : "MISSED",
-          bound, ours.biasK());
+      row.bound = {std::sqrt(boundC2 / scenes), std::sqrt(boundR2 / scenes)};
+      rows.push_back(std::move(row));
     }
   }
+
+  // Accuracy against the targets.
+  std::printf("%-12s %5s | %8s %8s | %8s %8s | %4s | %7s %7s | %-10s | %-8s | %-8s | %s\n",
+              "case", "r", "median c", "median r", "RMS c", "RMS r", "fail", "bound c", "bound r",
+              "target", "median", "RMS", "k");
+  bool allMedian = true, allRms = true;
+  for (const Row& row : rows) {
+    const Errors& o = row.ours;
+    const double target = 0.01 * caseFactor(row.kind);
+    const bool none = o.failed == 0;
+    const bool medianMet = none && o.centreMedian() <= target && o.radiusMedian() <= target;
+    const bool rmsMet = none && o.centreRms() <= target && o.radiusRms() <= target;
+    const bool medianBelow = 0.833 * row.bound.centre > target || 0.674 * row.bound.radius > target;
+    const bool rmsBelow = row.bound.centre > target || row.bound.radius > target;
+    allMedian = allMedian && medianMet;
+    allRms = allRms && rmsMet;
+    auto verdict = [](bool met, bool below) {
+      return met ? "met" : below ? "MISSED*" : "MISSED";
+    };
+    char targetText[16];
+    std::snprintf(targetText, sizeof targetText, "<= %.2f", target);
+    std::printf(
+        "%-12s %5.0f | %8.4f %8.4f | %8.4f %8.4f | %4d | %7.4f %7.4f | %-10s | %-8s | %-8s | "
+        "%.3f\n",
+        caseName(row.kind), row.radius, o.centreMedian(), o.radiusMedian(), o.centreRms(),
+        o.radiusRms(), o.failed, row.bound.centre, row.bound.radius, targetText,
+        verdict(medianMet, medianBelow), verdict(rmsMet, rmsBelow), o.biasK());
+  }
+
+  // The same scenes through HoughCircles: RMS errors and the ratio to ours.
+  std::printf("\n%-12s %5s | %8s %8s %4s | %8s %8s %4s | %6s %6s %6s %6s\n", "case", "r",
+              "HG c", "HG r", "miss", "ALT c", "ALT r", "miss", "HG/c", "HG/r", "ALT/c", "ALT/r");
+  for (const Row& row : rows) {
+    const Errors &o = row.ours, &hg = row.hg, &alt = row.alt;
+    std::printf(
+        "%-12s %5.0f | %8.4f %8.4f %4d | %8.4f %8.4f %4d | %6.1f %6.1f %6.1f %6.1f\n",
+        caseName(row.kind), row.radius, hg.centreRms(), hg.radiusRms(), hg.failed, alt.centreRms(),
+        alt.radiusRms(), alt.failed, hg.centreRms() / o.centreRms(),
+        hg.radiusRms() / o.radiusRms(), alt.centreRms() / o.centreRms(),
+        alt.radiusRms() / o.radiusRms());
+  }
+  std::printf(
+      "(HG = HOUGH_GRADIENT, ALT = HOUGH_GRADIENT_ALT: RMS errors over the scenes each detected "
+      "a circle within the search width; miss = none; ratio = hough RMS / ours)\n");
 
   // Time per circle at r = 100 after the coarse location, one core.
   std::mt19937_64 rng(7);
@@ -336,6 +418,7 @@ int main(int argc, char** argv) {
       "HOUGH_GRADIENT %.3f ms | HOUGH_GRADIENT_ALT %.3f ms | target <= 1 ms: %s\n",
       t.image.cols, t.image.rows, reps, ms, medianMs(hgT), medianMs(altT),
       ms <= 1.0 ? "met" : "MISSED");
-  std::printf("all accuracy targets %s\n", allMet ? "met" : "NOT met");
+  std::printf("accuracy targets by the median (the issue's statistic): %s; by the RMS: %s\n",
+              allMedian ? "all met" : "NOT all met", allRms ? "all met" : "NOT all met");
   return 0;
 }
