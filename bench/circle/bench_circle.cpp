@@ -349,9 +349,9 @@ int main(int argc, char** argv) {
   }
 
   // Accuracy against the targets.
-  std::printf("%-12s %5s | %8s %8s | %8s %8s | %4s | %7s %7s | %-10s | %-8s | %-8s | %s\n",
-              "case", "r", "median c", "median r", "RMS c", "RMS r", "fail", "bound c", "bound r",
-              "target", "median", "RMS", "k");
+  std::printf("%-12s %5s | %8s %8s | %8s %8s | %4s | %7s %7s | %-10s | %-8s | %-8s | %s\n", "case",
+              "r", "median c", "median r", "RMS c", "RMS r", "fail", "bound c", "bound r", "target",
+              "median", "RMS", "k");
   bool allMedian = true, allRms = true;
   for (const Row& row : rows) {
     const Errors& o = row.ours;
@@ -363,9 +363,7 @@ int main(int argc, char** argv) {
     const bool rmsBelow = row.bound.centre > target || row.bound.radius > target;
     allMedian = allMedian && medianMet;
     allRms = allRms && rmsMet;
-    auto verdict = [](bool met, bool below) {
-      return met ? "met" : below ? "MISSED*" : "MISSED";
-    };
+    auto verdict = [](bool met, bool below) { return met ? "met" : below ? "MISSED*" : "MISSED"; };
     char targetText[16];
     std::snprintf(targetText, sizeof targetText, "<= %.2f", target);
     std::printf(
@@ -377,16 +375,15 @@ int main(int argc, char** argv) {
   }
 
   // The same scenes through HoughCircles: RMS errors and the ratio to ours.
-  std::printf("\n%-12s %5s | %8s %8s %4s | %8s %8s %4s | %6s %6s %6s %6s\n", "case", "r",
-              "HG c", "HG r", "miss", "ALT c", "ALT r", "miss", "HG/c", "HG/r", "ALT/c", "ALT/r");
+  std::printf("\n%-12s %5s | %8s %8s %4s | %8s %8s %4s | %6s %6s %6s %6s\n", "case", "r", "HG c",
+              "HG r", "miss", "ALT c", "ALT r", "miss", "HG/c", "HG/r", "ALT/c", "ALT/r");
   for (const Row& row : rows) {
     const Errors &o = row.ours, &hg = row.hg, &alt = row.alt;
-    std::printf(
-        "%-12s %5.0f | %8.4f %8.4f %4d | %8.4f %8.4f %4d | %6.1f %6.1f %6.1f %6.1f\n",
-        caseName(row.kind), row.radius, hg.centreRms(), hg.radiusRms(), hg.failed, alt.centreRms(),
-        alt.radiusRms(), alt.failed, hg.centreRms() / o.centreRms(),
-        hg.radiusRms() / o.radiusRms(), alt.centreRms() / o.centreRms(),
-        alt.radiusRms() / o.radiusRms());
+    std::printf("%-12s %5.0f | %8.4f %8.4f %4d | %8.4f %8.4f %4d | %6.1f %6.1f %6.1f %6.1f\n",
+                caseName(row.kind), row.radius, hg.centreRms(), hg.radiusRms(), hg.failed,
+                alt.centreRms(), alt.radiusRms(), alt.failed, hg.centreRms() / o.centreRms(),
+                hg.radiusRms() / o.radiusRms(), alt.centreRms() / o.centreRms(),
+                alt.radiusRms() / o.radiusRms());
   }
   std::printf(
       "(HG = HOUGH_GRADIENT, ALT = HOUGH_GRADIENT_ALT: RMS errors over the scenes each detected "
