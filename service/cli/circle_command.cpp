@@ -70,12 +70,22 @@ void run(const CircleOptions& o) {
                {"rms", m.rms},
                {"inliers", m.inliers},
                {"coverage_deg", m.coverageDeg},
+               // Whether centre and radius come from the grey-value fit (and its blur) or, when
+               // that fit did not converge, from the edge points alone: an engineer judging a
+               // result needs to know which.
+               {"grey_refined", m.greyRefined},
+               {"blur", m.blur},
                {"time_ms", ms}});
   } else {
     std::cout << "centre (" << m.centre.x << ", " << m.centre.y << ") px, radius " << m.radius
               << " px, diameter " << m.diameter << " px\nroundness " << m.roundness << " px, rms "
               << m.rms << " px, " << m.inliers << " inliers covering " << m.coverageDeg << " deg, "
-              << ms << " ms\n";
+              << ms << " ms\n"
+              << (m.greyRefined
+                      ? "refined on the grey values, blur " + std::to_string(m.blur) + " px"
+                      : std::string("from the edge points only (grey-value fit did not "
+                                    "converge)"))
+              << "\n";
   }
 }
 

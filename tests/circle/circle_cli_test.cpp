@@ -58,6 +58,8 @@ TEST_F(CircleCli, PrintsOneJsonObjectWithTheCircle) {
   EXPECT_LT(j.at("rms").get<double>(), 0.2);
   EXPECT_GE(j.at("roundness").get<double>(), 0.0);
   EXPECT_GE(j.at("time_ms").get<double>(), 0.0);
+  EXPECT_TRUE(j.at("grey_refined").get<bool>());
+  EXPECT_NEAR(j.at("blur").get<double>(), 1.0, 0.3);  // the scene's PSF sigma, plus pixel size
 }
 
 TEST_F(CircleCli, MeasurementFailureIsAJsonErrorWithItsCause) {
