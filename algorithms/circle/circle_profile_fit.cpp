@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <utility>
 
 #include <Eigen/Dense>
 
@@ -53,6 +54,19 @@ double medianOf(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
+// Robust sigma (1.4826 x median absolute value) of residuals around zero, from an evenly strided
+// subset of at most kScaleSamples: it only scales the Tukey weight and the sector test, where a
+// few percent do not matter, and the median of all of a big rim's residuals cost a tenth of the
+// measurement.
+double robustSigma(const std::vector<double>& residuals) {
+  constexpr std::size_t kScaleSamples = 512;
+  const std::size_t stride = std::max<std::size_t>(1, residuals.size() / kScaleSamples);
+  std::vector<double> a;
+  a.reserve(residuals.size() / stride + 1);
+  for (std::size_t i = 0; i < residuals.size(); i += stride) a.push_back(std::abs(residuals[i]));
+  return 1.4826 * medianOf(std::move(a));
+}
+
 // Angular bins whose grey residuals are too large for the noise. Per bin, the mean of the squared
 // residuals (each capped at 3 sigma, so one stray pixel does not condemn its bin) is compared
 // with the median over all bins, the noise level of a clean rim including the model's own misfit;
@@ -61,9 +75,7 @@ std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
                                            const std::vector<double>& residuals, int bins) {
   constexpr double kSectorZ = 4.0;
   std::vector<double> sum(bins, 0.0), count(bins, 0.0);
-  std::vector<double> absR(residuals.size());
-  for (std::size_t i = 0; i < residuals.size(); ++i) absR[i] = std::abs(residuals[i]);
-  const double cap = 6.0 * 1.4826 * medianOf(absR);
+  const double cap = 6.0 * robustSigma(residuals);
   for (std::size_t i = 0; i < samples.size(); ++i) {
     const double a = std::min(std::abs(residuals[i]), cap);
     sum[samples[i].bin] += a * a;
@@ -314,12 +326,10 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     }
   };
   auto tukeyWeights = [&] {
-    std::vector<double> absR(m);
-    for (std::size_t i = 0; i < m; ++i) absR[i] = std::abs(r[i]);
-    const double sigma = std::max(1.4826 * medianOf(absR), 0.25);
+    const double sigma = std::max(robustSigma(r), 0.25);
     const double c = tukeyC * sigma;
     for (std::size_t i = 0; i < m; ++i) {
-      const double u = absR[i] / c;
+      const double u = std::abs(r[i]) / c;
       weight[i] = u >= 1.0 ? 0.0 : (1 - u * u) * (1 - u * u);
     }
     return sigma;
