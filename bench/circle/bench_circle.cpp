@@ -176,20 +176,24 @@ facet::CircleMeasureParams paramsFor(const Trial& t) {
 
 // HoughCircles with the documented settings, restricted to the same radius range; the detection
 // strongest within the search width of the coarse position counts (the caller knows where to look).
+// The documented Canny thresholds assume about 100 grey levels of contrast; they are scaled with
+// the scene's contrast, or no rim of the low-contrast case would be an edge at all.
 bool hough(const Trial& t, int method, cv::Point2d* c, double* r) {
   cv::Mat img;
   std::vector<cv::Vec3f> found;
   const int minR = static_cast<int>(std::floor(t.nominal - kWidth));
   const int maxR = static_cast<int>(std::ceil(t.nominal + kWidth));
+  const double contrastScale = t.contrast / 100.0;
   if (method == cv::HOUGH_GRADIENT) {
     // OpenCV tutorial: smooth first, dp 1, Canny high threshold 100, accumulator threshold low
     // enough for small circles.
     cv::GaussianBlur(t.image, img, {5, 5}, 1.5);
-    cv::HoughCircles(img, found, cv::HOUGH_GRADIENT, 1, 1, 100, 15, std::max(minR, 1), maxR);
+    cv::HoughCircles(img, found, cv::HOUGH_GRADIENT, 1, 1, 100 * contrastScale, 15,
+                     std::max(minR, 1), maxR);
   } else {
     // Documentation of HOUGH_GRADIENT_ALT: dp 1.5, param1 300, param2 0.9 (circle "perfectness").
-    cv::HoughCircles(t.image, found, cv::HOUGH_GRADIENT_ALT, 1.5, 1, 300, 0.9, std::max(minR, 1),
-                     maxR);
+    cv::HoughCircles(t.image, found, cv::HOUGH_GRADIENT_ALT, 1.5, 1, 300 * contrastScale, 0.9,
+                     std::max(minR, 1), maxR);
   }
   // Detections come strongest first: take the strongest one within the search width.
   for (const auto& f : found) {
