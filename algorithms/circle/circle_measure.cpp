@@ -256,16 +256,16 @@ std::vector<Eigen::Vector2d> strayArc(const std::vector<Eigen::Vector2d>& in, co
 // Strong edge points that are not the rim: off the circle or not radial with the rim's polarity
 // (rimSign +1: gradient outwards). Weak ones (below the high threshold) are mostly noise and must
 // not punch holes into the grey-value fit.
-std::vector<cv::Point2d> foreignEdges(const AnnulusEdges& edges, const Circle& circle, int rimSign,
-                                      double cosTol) {
-  std::vector<cv::Point2d> foreign;
+std::vector<EdgePoint> foreignEdges(const AnnulusEdges& edges, const Circle& circle, int rimSign,
+                                    double cosTol) {
+  std::vector<EdgePoint> foreign;
   for (const EdgePoint& e : edges.points) {
     const Eigen::Vector2d radial = Eigen::Vector2d{e.position.x, e.position.y} - circle.centre;
     const double d = radial.norm();
     if (d == 0.0) continue;
     const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
     if (e.magnitude >= edges.highThreshold && (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
-      foreign.push_back(e.position);
+      foreign.push_back(e);
   }
   return foreign;
 }
@@ -403,6 +403,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   // Geometric fit on the RANSAC inliers, then re-collect the inliers around the refined circle
   // and refit with the robust weight.
   std::vector<Eigen::Vector2d> in;
+  const std::vector<Eigen::Vector2d> rimCandidates = bestPts;  // before stray arcs leave
   std::optional<Circle> fitted = fitRim(bestPts, *best, params, in);
   // Drop runs of inliers the rest of the rim disagrees with, worst first, and refit.
   for (int round = 0; round < 3 && fitted; ++round) {
@@ -447,9 +448,26 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
         "the fit's rms " + std::to_string(m.rms) + " px exceeds " + std::to_string(params.maxRms));
 
   if (params.refineWithGreyValues) {
-    if (auto fine =
-            fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints,
-                             foreignEdges(edges, circle, rimSign, cosTol), edges.noiseSigma)) {
+    auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints,
+                                 foreignEdges(edges, circle, rimSign, cosTol), edges.noiseSigma);
+    // The grey fit only uses the sectors the inliers cover, and clutter that pulls the edge
+    // points' circle can push a clean arc of the rim out of the inliers (or out as a stray arc):
+    // at r = 10 px a lost third of the rim cost 0.1 px. The grey fit is several times more
+    // precise, so rim points within the RANSAC threshold of it are re-collected, and the grey
+    // fit is repeated when they are more than the inliers.
+    if (fine) {
+      const Circle refined{Eigen::Vector2d{fine->centre.x, fine->centre.y}, fine->radius};
+      std::vector<cv::Point2d> rim;
+      for (const auto& p : rimCandidates)
+        if (std::abs(residual(refined, p)) <= params.ransacThreshold)
+          rim.emplace_back(p.x(), p.y());
+      if (rim.size() > m.inlierPoints.size())
+        if (auto again =
+                fitCircleProfile(image, fine->centre, fine->radius, rim,
+                                 foreignEdges(edges, refined, rimSign, cosTol), edges.noiseSigma))
+          fine = again;
+    }
+    if (fine) {
       m.centre = fine->centre;
       m.radius = fine->radius;
       m.diameter = 2.0 * m.radius;

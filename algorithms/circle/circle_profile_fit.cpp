@@ -147,7 +147,7 @@ void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, do
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
-                                                 const std::vector<cv::Point2d>& foreignPoints,
+                                                 const std::vector<EdgePoint>& foreignPoints,
                                                  double noiseSigma, double maxShift) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
@@ -197,15 +197,31 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
   const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - rOut)));
   const int y1 = std::min(image.rows - 1, static_cast<int>(std::ceil(centre.y + rOut)));
-  // Pixels within 2 px of a foreign edge (clutter, an occluder's border) stay out of the fit.
+  // Pixels near a foreign edge (clutter, an occluder's border) stay out of the fit: within 2 px,
+  // and farther for a strong edge, as far as its blurred step still changes the grey by more than
+  // a quarter of the noise. The step's height follows from the edge's gradient magnitude (a step
+  // b blurred by s peaks at b / (sqrt(2 pi) s)); a fixed 2 px let the halo of a high-contrast blob
+  // next to the rim (several grey levels there, radial like the rim's own gradient) into the fit.
   cv::Mat tainted;
   if (!foreignPoints.empty() && x1 >= x0 && y1 >= y0) {
+    constexpr double kEdgeBlur = 1.0;  // pixels; a sharp edge seen through the pixel grid
+    constexpr double kMinTaint = 2.0, kMaxTaint = 4.0;                    // pixels
+    const double tolerance = noiseSigma > 0.0 ? 0.25 * noiseSigma : 0.5;  // grey levels
     tainted = cv::Mat::zeros(y1 - y0 + 1, x1 - x0 + 1, CV_8U);
-    for (const auto& q : foreignPoints) {
+    for (const EdgePoint& e : foreignPoints) {
+      const double step = e.magnitude * std::sqrt(2.0 * kPi) * kEdgeBlur;
+      auto halo = [&](double d) {  // grey change d px from the edge
+        const double z = d / kEdgeBlur;
+        return step * upperTail(z, std::exp(-0.5 * z * z));
+      };
+      double reach = kMinTaint;
+      while (reach < kMaxTaint && halo(reach) > tolerance) reach += 0.25;
+      const cv::Point2d q = e.position;
       const int qx = static_cast<int>(std::lround(q.x)), qy = static_cast<int>(std::lround(q.y));
-      for (int v = std::max(y0, qy - 2); v <= std::min(y1, qy + 2); ++v)
-        for (int u = std::max(x0, qx - 2); u <= std::min(x1, qx + 2); ++u)
-          if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= 4.0)
+      const int span = static_cast<int>(std::ceil(reach));
+      for (int v = std::max(y0, qy - span); v <= std::min(y1, qy + span); ++v)
+        for (int u = std::max(x0, qx - span); u <= std::min(x1, qx + span); ++u)
+          if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= reach * reach)
             tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
     }
   }

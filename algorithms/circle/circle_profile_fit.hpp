@@ -28,6 +28,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/edges/subpixel_edges.hpp"
+
 namespace facet {
 
 struct CircleProfileFit {
@@ -41,14 +43,15 @@ struct CircleProfileFit {
 // `image`: CV_8UC1 or CV_16UC1. `centre`, `radius`: the geometric fit of the edge points.
 // `rimPoints`: its inlier edge points; only the parts of the rim they cover are used (occluded or
 // cluttered sectors stay out). `foreignPoints`: edge points that are not the rim (clutter, an
-// occluder's border); pixels within 2 px of them stay out. `noiseSigma` (grey levels, 8-bit scale;
+// occluder's border); pixels within 2 px of them stay out, and up to 4 px where a strong edge's
+// blurred step still reaches a quarter of the noise. `noiseSigma` (grey levels, 8-bit scale;
 // 0 = unknown) lets a clean, large rim use only the share of its pixels the precision needs.
 // Returns nothing when the fit does not converge to a plausible circle (moves farther than
 // `maxShift` pixels, blur outside (0.2, 5) px).
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
-                                                 const std::vector<cv::Point2d>& foreignPoints = {},
+                                                 const std::vector<EdgePoint>& foreignPoints = {},
                                                  double noiseSigma = 0.0, double maxShift = 1.0);
 
 }  // namespace facet
