@@ -263,7 +263,10 @@ double medianMs(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   bool smoke = false;
-  int scenes = 100;
+  // The issue asks for 30 or more. A median over 100 scenes still wanders by about +-15% between
+  // seeds (hard r = 10: 0.0144 to 0.0202 px over ten seeds, 0.0170 over 8,000 scenes); over 400
+  // it settles to a few percent, for about 30 s of running time.
+  int scenes = 400;
   std::string onlyCase;    // --case clean|hard|low-contrast: that case alone
   double onlyRadius = 0;   // --radius R: that radius alone
   std::uint64_t seed = 0;  // --seed N: another set of scenes (0: the original ones)
