@@ -322,6 +322,16 @@ TEST(CircleMeasure, StraightBorderBesideAnOccludedSectorDoesNotMakeACircle) {
   EXPECT_LT(worst, 0.1);
 }
 
+// The spec of one scene of bench_circle's hard case at r = 10, from its noise seed and ramp: the
+// tests below rebuild scenes that the bench found measured wrong.
+SceneSpec hardSceneSpec(std::uint64_t seed, cv::Point2d ramp) {
+  SceneSpec sp = spec(80, 70);
+  sp.subrows = 256;
+  sp.seed = seed;
+  sp.illuminationGradient = ramp;
+  return sp;
+}
+
 // An occluder about as light as the disc hides the bottom of a small rim; its far side, a
 // straight edge 2 px outside the rim, has the rim's polarity and a radial gradient near the
 // bottom. Five of its points lie within the RANSAC threshold of a circle 1 px too low and too
@@ -330,11 +340,7 @@ TEST(CircleMeasure, StraightBorderBesideAnOccludedSectorDoesNotMakeACircle) {
 // bench's hard case at r = 10; this is that scene). Judged against the rest of the rim, the
 // run of five points lies 2 px off it and is dropped.
 TEST(CircleMeasure, StraightEdgeRunThatTheRestOfTheRimDisagreesWithIsDropped) {
-  SceneSpec sp = spec(80, 70);
-  sp.subrows = 256;
-  sp.seed = 3345750974238663308ull;
-  sp.illuminationGradient = {-0.657490, 0.360842};
-  Scene s(sp);
+  Scene s(hardSceneSpec(3345750974238663308ull, {-0.657490, 0.360842}));
   const cv::Point2d c{39.1317, 39.8413};
   const double radius = 9.7527;
   s.addDisc(c, radius, 170);
@@ -360,11 +366,7 @@ TEST(CircleMeasure, StraightEdgeRunThatTheRestOfTheRimDisagreesWithIsDropped) {
 // inliers cover, then had 140 of the rim's 250 unoccluded degrees and missed the centre by
 // 0.12 px and the radius by 0.09 px. Its result re-collects that arc, and the fit is repeated.
 TEST(CircleMeasure, CleanArcThatClutterPushedOutOfTheInliersReturnsToTheGreyValueFit) {
-  SceneSpec sp = spec(80, 70);
-  sp.subrows = 256;
-  sp.seed = 3314388346836275554ull;
-  sp.illuminationGradient = {-0.544751, 0.515506};
-  Scene s(sp);
+  Scene s(hardSceneSpec(3314388346836275554ull, {-0.544751, 0.515506}));
   const cv::Point2d c{39.5244, 39.1372};
   const double radius = 9.7945;
   s.addDisc(c, radius, 170);
