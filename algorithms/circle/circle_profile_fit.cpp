@@ -48,6 +48,13 @@ double upperTail(double z, double gauss) {
   return z >= 0.0 ? tail : 1.0 - tail;
 }
 
+// Grey value of pixel (x, y) on the 8-bit scale (16-bit images divided by 256), the scale of the
+// noise level and of the model.
+double greyAt(const cv::Mat& image, int x, int y) {
+  return image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) / 256.0
+                                 : static_cast<double>(image.at<std::uint8_t>(y, x));
+}
+
 double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
@@ -104,16 +111,13 @@ std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
 // test on the residuals, this one does not depend on the fit being right (a circle pulled by
 // clutter leaves coherent residuals along its own rim). The neighbours go too: a blurred blob's
 // tail is still a few grey levels high where its gradient has sunk into the noise.
-void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, double scale,
-                          cv::Point2d centre, double radius, double noiseSigma, cv::Rect box) {
+void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d centre,
+                          double radius, double noiseSigma, cv::Rect box) {
   constexpr double kGradientZ = 4.0;
   constexpr double kFlatZone = 3.0;  // pixels from the rim: the blurred edge's slope is < 1% there
   // The 3x3 Sobel divided by 8 is a unit-gain derivative; its noise is sqrt(12) / 8 of the pixels'.
   const double limit = kGradientZ * noiseSigma * std::sqrt(12.0) / 8.0;
-  auto at = [&](int x, int y) {
-    return image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
-                                   : static_cast<double>(image.at<std::uint8_t>(y, x));
-  };
+  auto at = [&](int x, int y) { return greyAt(image, x, y); };
   cv::Mat flagged = cv::Mat::zeros(box.height + 2, box.width + 2, CV_8U);  // 1 px margin
   bool any = false;
   for (const Sample& e : samples) {
@@ -150,7 +154,6 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
                                                  const std::vector<EdgePoint>& foreignPoints,
                                                  double noiseSigma, double maxShift) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
-  const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
 
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
   const int bins = std::max(16, static_cast<int>(2.0 * kPi * radius / 2.0));
@@ -241,9 +244,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       }
       const int bin = binOf(dx, dy);
       if (!covered[bin] || (!tainted.empty() && tainted.at<std::uint8_t>(y - y0, x - x0))) continue;
-      const double grey = image.depth() == CV_16U ? image.at<std::uint16_t>(y, x) * scale
-                                                  : image.at<std::uint8_t>(y, x);
-      samples.push_back({dx, dy, grey, bin, x, y});
+      samples.push_back({dx, dy, greyAt(image, x, y), bin, x, y});
     }
   }
   if (samples.size() < 30) return std::nullopt;
@@ -285,7 +286,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
         });
     }
     // After the thinning, so that a big rim pays only for the pixels it keeps.
-    dropForeignGradients(samples, image, scale, centre, radius, noiseSigma,
+    dropForeignGradients(samples, image, centre, radius, noiseSigma,
                          cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
     if (samples.size() < 30) return std::nullopt;
   }

@@ -129,6 +129,13 @@ Trial makeTrial(double radius, Case kind, bool hole, int subrows, std::mt19937_6
   return t;
 }
 
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 struct Errors {
   std::vector<double> centre, radius;  // per measured scene: |centre error|, |radius error|
   double sumKr = 0;
@@ -144,12 +151,6 @@ struct Errors {
     double s = 0;
     for (double e : v) s += e * e;
     return std::sqrt(s / static_cast<double>(v.size()));
-  }
-  static double median(std::vector<double> v) {
-    if (v.empty()) return NAN;
-    std::sort(v.begin(), v.end());
-    const std::size_t n = v.size();
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
   }
   double centreRms() const { return rms(centre); }
   double radiusRms() const { return rms(radius); }
@@ -252,11 +253,6 @@ Bound cramerRaoBound(const Trial& t) {
   }
   const Eigen::MatrixXd cov = fisher.inverse();
   return {std::sqrt(cov(0, 0) + cov(1, 1)), std::sqrt(cov(2, 2))};
-}
-
-double medianMs(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace
@@ -418,11 +414,11 @@ int main(int argc, char** argv) {
     hgT.push_back(t2 - t1);
     altT.push_back(t3 - t2);
   }
-  const double ms = medianMs(ours);
+  const double ms = median(ours);
   std::printf(
       "\ntime per circle r=100 (%dx%d image, median of %d, thread CPU time): ours %.3f ms | "
       "HOUGH_GRADIENT %.3f ms | HOUGH_GRADIENT_ALT %.3f ms | target <= 1 ms: %s\n",
-      t.image.cols, t.image.rows, reps, ms, medianMs(hgT), medianMs(altT),
+      t.image.cols, t.image.rows, reps, ms, median(hgT), median(altT),
       ms <= 1.0 ? "met" : "MISSED");
   std::printf("accuracy targets by the median (the issue's statistic): %s; by the RMS: %s\n",
               allMedian ? "all met" : "NOT all met", allRms ? "all met" : "NOT all met");
