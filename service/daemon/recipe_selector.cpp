@@ -134,7 +134,8 @@ config::ReloadReport RecipeSelector::reload() {
 
 nlohmann::json RecipeSelector::problems() const {
   nlohmann::json problems = nlohmann::json::array();
-  for (const auto& d : library_.problems().items()) problems.push_back(config::format(d));
+  const config::Diagnostics rejected = library_.problems();
+  for (const auto& d : rejected.items()) problems.push_back(config::format(d));
   std::lock_guard lock(mutex_);
   for (const auto& [id, e] : errors_) problems.push_back("recipe " + std::to_string(id) + ": " + e);
   return problems;

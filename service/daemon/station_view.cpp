@@ -1,4 +1,5 @@
 #include <opencv2/imgcodecs.hpp>
+#include <spdlog/spdlog.h>
 
 #include "service/daemon/station.hpp"
 
