@@ -1,12 +1,12 @@
 #include "config/recipe_loader.hpp"
 
 #include <algorithm>
-#include <fstream>
 #include <map>
 #include <set>
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "algorithms/scan/scan_file.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
 #include "config/closest_name.hpp"
 #include "config/confined_path.hpp"
@@ -250,30 +250,18 @@ class RecipeReader {
     return path;
   }
 
+  // Read by the parser the inspection uses (algorithms/scan/scan_csv), so that a file the check
+  // accepts is one the inspection can read.
   void checkScanFile(const YAML::Node& n, const std::filesystem::path& path) {
-    std::ifstream in(path);
-    std::string line;
-    int lineNo = 0, points = 0;
-    while (std::getline(in, line)) {
-      ++lineNo;
-      if (line.empty() || line[0] == '#') continue;
-      std::vector<double> values;
-      std::size_t start = 0;
-      bool numeric = true;
-      while (start <= line.size()) {
-        const std::size_t comma = std::min(line.find(',', start), line.size());
-        YAML::Node cell(line.substr(start, comma - start));
-        const auto v = readNumber(cell);
-        numeric = numeric && v.has_value();
-        values.push_back(v.value_or(0));
-        start = comma + 1;
-      }
-      if (!numeric && lineNo == 1) continue;  // a header
-      if (!numeric || (values.size() != 2 && values.size() != 3)) {
-        out_.error({path, lineNo, 1}, "expected a point \"x,y\" in metres (or \"scan,x,y\")");
-        return;
-      }
-      ++points;
+    std::size_t points = 0;
+    try {
+      points = scan::readScanCsvFile(path.string()).size();
+    } catch (const scan::ScanFormatError& e) {
+      out_.error({path, e.line, 1}, e.message);
+      return;
+    } catch (const std::exception& e) {
+      error(n, e.what());
+      return;
     }
     if (points < 3)
       error(n, "reference scan " + inQuotes(n.Scalar()) + " has " + std::to_string(points) +

@@ -1,9 +1,9 @@
 #include "config/recipe_training.hpp"
 
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/image/grey_image.hpp"
 #include "algorithms/shape/shape_model.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
 #include "config/training_record.hpp"
@@ -17,8 +17,7 @@ TrainedModel train(const Step& step, const std::filesystem::path& templateFile,
   const std::string what = "step '" + step.id + "': ";
   cv::Mat image = cv::imread(templateFile.string(), cv::IMREAD_UNCHANGED);
   if (image.empty()) throw TrainingError(what + templateFile.string() + ": cannot read the image");
-  if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_BGR2GRAY);
-  if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2GRAY);
+  image = toGrey(image);
 
   ShapeModelParams params;
   if (region)

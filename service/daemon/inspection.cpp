@@ -10,6 +10,8 @@
 #include "algorithms/circle/circle_measure.hpp"
 #include "algorithms/circle/disc_locator.hpp"
 #include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/geometry/similarity_fit.hpp"
+#include "algorithms/image/grey_image.hpp"
 #include "algorithms/registration/register_images.hpp"
 #include "algorithms/scan/scan_file.hpp"
 #include "algorithms/scan/scan_match.hpp"
@@ -51,13 +53,6 @@ StepResult failed(std::string cause) {
   return r;
 }
 
-cv::Mat toGrey(const cv::Mat& image) {
-  if (image.channels() == 1) return image;
-  cv::Mat grey;
-  cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
-  return grey;
-}
-
 cv::Mat readGrey(const std::filesystem::path& file) {
   cv::Mat image = cv::imread(file.string(), cv::IMREAD_UNCHANGED);
   if (image.empty()) throw InspectionSetupError(file.string() + ": cannot read image");
@@ -75,13 +70,9 @@ cv::Matx33d poseMap(const Pose2D& pose, cv::Point2d home) {
   return m * translation(-home);
 }
 
-cv::Point2d apply(const cv::Matx33d& H, cv::Point2d p) {
-  return mapPoint(H, p);
-}
-
 // Rotation (degrees, counter-clockwise on screen) of a near-similarity map at point p.
 double rotationDeg(const cv::Matx33d& H, cv::Point2d p) {
-  const cv::Point2d q0 = apply(H, p), q1 = apply(H, p + cv::Point2d(10, 0));
+  const cv::Point2d q0 = mapPoint(H, p), q1 = mapPoint(H, p + cv::Point2d(10, 0));
   return degrees(std::atan2(-(q1.y - q0.y), q1.x - q0.x));
 }
 
@@ -108,27 +99,6 @@ cv::Matx33d relativeMap(const std::optional<std::string>& relativeTo,
                         const std::map<std::string, StepResult>& done) {
   if (!relativeTo) return cv::Matx33d::eye();
   return *done.at(*relativeTo).refToImage;
-}
-
-// Least-squares similarity (Umeyama in 2D) taking `from` onto `to`.
-cv::Matx33d fitSimilarity(const std::vector<cv::Point2d>& from,
-                          const std::vector<cv::Point2d>& to) {
-  cv::Point2d mf, mt;
-  for (std::size_t i = 0; i < from.size(); ++i) mf += from[i], mt += to[i];
-  mf *= 1.0 / from.size();
-  mt *= 1.0 / to.size();
-  double sxx = 0, sxy = 0, var = 0;
-  for (std::size_t i = 0; i < from.size(); ++i) {
-    const cv::Point2d a = from[i] - mf, b = to[i] - mt;
-    sxx += a.x * b.x + a.y * b.y;
-    sxy += a.x * b.y - a.y * b.x;
-    var += a.dot(a);
-  }
-  const double c = sxx / var, s = sxy / var;  // scale * cos, scale * sin (maths orientation)
-  const cv::Matx22d M{c, -s, s, c};
-  const cv::Point2d t =
-      mt - cv::Point2d(M(0, 0) * mf.x + M(0, 1) * mf.y, M(1, 0) * mf.x + M(1, 1) * mf.y);
-  return {M(0, 0), M(0, 1), t.x, M(1, 0), M(1, 1), t.y, 0, 0, 1};
 }
 
 class StepRunner {
@@ -195,7 +165,7 @@ class StepRunner {
     r.values["score"] =
         reg.matches.empty() ? 0.0 : static_cast<double>(reg.inliers.size()) / reg.matches.size();
     std::vector<cv::Point2d> outline;
-    for (const auto& c : corners(region)) outline.push_back(apply(*r.refToImage, c));
+    for (const auto& c : corners(region)) outline.push_back(mapPoint(*r.refToImage, c));
     overlay_.polygon(outline, r.values["score"] >= a.minScore);
     if (r.values["score"] < a.minScore)
       return failed("alignment score " + std::to_string(r.values["score"]) + " below " +
@@ -207,7 +177,7 @@ class StepRunner {
 
   // x, y: offset of the reference point `home` from its nominal place; angle: rotation.
   static StepResult withPoseValues(StepResult r, cv::Point2d home) {
-    const cv::Point2d found = apply(*r.refToImage, home);
+    const cv::Point2d found = mapPoint(*r.refToImage, home);
     r.values["x"] = found.x - home.x;
     r.values["y"] = found.y - home.y;
     r.angleDeg = rotationDeg(*r.refToImage, home);
@@ -221,7 +191,7 @@ class StepRunner {
     const cv::Matx33d H = relativeMap(f.relativeTo, done);
     std::vector<cv::Point2d> nominal, found;
     for (const auto& mark : f.marks) {
-      const cv::Point2d expected = apply(H, mark);
+      const cv::Point2d expected = mapPoint(H, mark);
       const double radius = f.markDiameter / 2.0 / mmPerPixel_;
       const double searchRadius = f.searchRadius / mmPerPixel_;
       overlay_.circle(expected, searchRadius + radius, true, true);
@@ -244,7 +214,9 @@ class StepRunner {
       nominal.push_back(expected);
       found.push_back(m.centre);
     }
-    const cv::Matx33d S = fitSimilarity(nominal, found);
+    const auto similarity = fitSimilarity(nominal, found);
+    if (!similarity) return failed("the nominal fiducial positions coincide");
+    const cv::Matx33d S = similarity->H;
     StepResult r;
     r.refToImage = S * H;
     cv::Point2d cn, cf;
@@ -271,7 +243,7 @@ class StepRunner {
       if (base.referenceView) {
         std::vector<cv::Point2f> mapped;
         for (const auto& c : corners(cv::Rect(*base.referenceView)))
-          mapped.emplace_back(apply(*base.refToImage, c));
+          mapped.emplace_back(mapPoint(*base.refToImage, c));
         const int margin = 8;
         search &=
             cv::boundingRect(mapped) + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin);
@@ -293,7 +265,7 @@ class StepRunner {
     }
     cv::Point2d home = res_.modelHomes.at(step.id);
     // Relative to an earlier pose, the nominal position moves with the part.
-    const cv::Point2d nominal = apply(relativeMap(s.relativeTo, done), home);
+    const cv::Point2d nominal = mapPoint(relativeMap(s.relativeTo, done), home);
     const ShapeMatch& best = matches[0];
     const cv::Point2d at(best.x + search.x, best.y + search.y);
     r.values["x"] = at.x - nominal.x;
@@ -310,7 +282,7 @@ class StepRunner {
 
   StepResult circle(const Step& step, const std::map<std::string, StepResult>& done) {
     const auto& c = step.as<config::CircleStep>();
-    const cv::Point2d expected = apply(relativeMap(c.relativeTo, done), c.centre);
+    const cv::Point2d expected = mapPoint(relativeMap(c.relativeTo, done), c.centre);
     CircleMeasureParams p;
     p.centre = expected;
     p.radius = c.nominalDiameter / 2.0 / mmPerPixel_;
