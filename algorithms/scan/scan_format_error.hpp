@@ -10,11 +10,9 @@ struct ScanFormatError : std::runtime_error {
   ScanFormatError(const std::string& source, int line, const std::string& message)
       : std::runtime_error(source + ":" + std::to_string(line) + ": " + message),
         source(source),
-        line(line),
-        message(message) {}
-  std::string source;   // file name (or whatever the caller named the stream)
-  int line = 0;         // 1-based
-  std::string message;  // what is wrong, without the source and line
+        line(line) {}
+  std::string source;  // file name (or whatever the caller named the stream)
+  int line = 0;        // 1-based
 };
 
 }  // namespace facet::scan
