@@ -10,6 +10,7 @@
 
 #include "algorithms/circle/annulus_edges.hpp"
 #include "algorithms/circle/circle_profile_fit.hpp"
+#include "algorithms/geometry/levenberg_marquardt.hpp"
 #include "algorithms/geometry/ransac.hpp"
 
 namespace facet {
@@ -63,52 +64,52 @@ double robustWeight(CircleRobustWeight kind, double r, double sigma) {
 }
 
 // Weighted geometric (orthogonal distance) fit by Levenberg-Marquardt: minimises
-// sum w_i (|p_i - c| - R)^2. Returns nothing when it does not converge to a finite circle.
-std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
-                                   const std::vector<double>& w, Circle c) {
-  double lambda = 1e-6;
-  auto cost = [&](const Circle& k) {
+// sum w_i (|p_i - c| - R)^2 over (cx, cy, R).
+class GeometricCircleFit {
+ public:
+  GeometricCircleFit(const std::vector<Eigen::Vector2d>& pts, const std::vector<double>& w)
+      : pts_(pts), w_(w) {}
+
+  double cost(const Eigen::Vector3d& x) const {
     double s = 0;
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const double r = residual(k, pts[i]);
-      s += w[i] * r * r;
+    for (std::size_t i = 0; i < pts_.size(); ++i) {
+      const double r = (pts_[i] - x.head<2>()).norm() - x.z();
+      s += w_[i] * r * r;
     }
     return s;
-  };
-  double current = cost(c);
-  for (int it = 0; it < 20; ++it) {
-    Eigen::Matrix3d jtj = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d jtr = Eigen::Vector3d::Zero();
-    for (std::size_t i = 0; i < pts.size(); ++i) {
-      const Eigen::Vector2d d = pts[i] - c.centre;
-      const double n = d.norm();
-      if (n < 1e-12 || w[i] == 0.0) continue;
-      const Eigen::Vector3d j{-d.x() / n, -d.y() / n, -1.0};
-      const double r = n - c.radius;
-      jtj.noalias() += w[i] * j * j.transpose();
-      jtr.noalias() += w[i] * j * r;
-    }
-    bool improved = false;
-    for (int tries = 0; tries < 10 && !improved; ++tries) {
-      Eigen::Matrix3d a = jtj;
-      a.diagonal() *= 1.0 + lambda;
-      const Eigen::Vector3d step = a.ldlt().solve(-jtr);
-      if (!step.allFinite()) return std::nullopt;
-      const Circle next{c.centre + step.head<2>(), c.radius + step.z()};
-      const double nextCost = cost(next);
-      if (nextCost <= current) {
-        improved = true;
-        const bool converged = step.norm() < 1e-5;  // pixels: far below the accuracy sought
-        c = next;
-        current = nextCost;
-        lambda = std::max(lambda * 0.1, 1e-12);
-        if (converged) return c;
-      } else {
-        lambda *= 10.0;
-      }
-    }
-    if (!improved) break;  // at the minimum up to rounding
   }
+  void normalEquations(int, const Eigen::Vector3d& x, Eigen::Matrix3d& jtj, Eigen::Vector3d& jtr,
+                       double&) const {
+    jtj.setZero();
+    jtr.setZero();
+    for (std::size_t i = 0; i < pts_.size(); ++i) {
+      const Eigen::Vector2d d = pts_[i] - x.head<2>();
+      const double n = d.norm();
+      if (n < 1e-12 || w_[i] == 0.0) continue;
+      const Eigen::Vector3d j{-d.x() / n, -d.y() / n, -1.0};
+      const double r = n - x.z();
+      jtj.noalias() += w_[i] * j * j.transpose();
+      jtr.noalias() += w_[i] * j * r;
+    }
+  }
+  std::optional<double> trialCost(const Eigen::Vector3d& x) const { return cost(x); }
+  void accept() {}
+  bool converged(int, const Eigen::Vector3d& step) const {
+    return step.norm() < 1e-5;  // pixels: far below the accuracy sought
+  }
+
+ private:
+  const std::vector<Eigen::Vector2d>& pts_;
+  const std::vector<double>& w_;
+};
+
+// Returns nothing when the fit does not converge to a finite circle.
+std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
+                                   const std::vector<double>& w, Circle c) {
+  GeometricCircleFit problem(pts, w);
+  Eigen::Vector3d x{c.centre.x(), c.centre.y(), c.radius};
+  if (levenbergMarquardt(problem, x) == LevenbergMarquardtStop::NonFiniteStep) return std::nullopt;
+  c = {x.head<2>(), x.z()};
   if (!c.centre.allFinite() || !std::isfinite(c.radius) || c.radius <= 0.0) return std::nullopt;
   return c;
 }

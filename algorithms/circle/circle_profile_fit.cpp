@@ -5,9 +5,12 @@
 #include <cmath>
 #include <cstdint>
 #include <numbers>
+#include <optional>
 #include <utility>
 
 #include <Eigen/Dense>
+
+#include "algorithms/geometry/levenberg_marquardt.hpp"
 
 namespace facet {
 namespace {
@@ -355,52 +358,46 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // Levenberg-Marquardt over the parameters marked free (a fixed one keeps its value).
   double sigma = 0.0;
   auto solve = [&](const std::array<bool, 8>& free, int maxIterations, bool reweight) {
-    evaluate(p, r, jac);
-    double current = cost(r);
-    double lambda = 1e-4;
-    for (int it = 0; it < maxIterations; ++it) {
-      // Robust weights from the start (the starting levels are medians, so clutter already stands
-      // out; an unweighted first step lets large dark blobs drag the contrast down), and again
-      // once the grey levels have settled after the first, nearly linear step.
-      if (reweight && it <= 1) {
-        sigma = tukeyWeights();
-        current = cost(r);
-      }
-      normalEquations();
-      for (int k = 0; k < 8; ++k)
-        if (!free[k]) {
-          jtj.row(k).setZero();
-          jtj.col(k).setZero();
-          jtj(k, k) = 1.0;
-          jtr(k) = 0.0;
-        }
-      bool accepted = false;
-      Vector8 step;
-      for (int tries = 0; tries < 6 && !accepted; ++tries) {
-        Matrix8 a = jtj;
-        a.diagonal() += lambda * jtj.diagonal().cwiseMax(1e-9);
-        step = a.ldlt().solve(jtr);
-        if (!step.allFinite()) return false;
-        const Vector8 next = p + step;
-        if (next(3) > 0.05) {
-          evaluate(next, rTry, jacTry);
-          const double c = cost(rTry);
-          if (c <= current) {
-            accepted = true;
-            p = next;
-            current = c;
-            std::swap(r, rTry);
-            std::swap(jac, jacTry);
-            lambda = std::max(lambda * 0.3, 1e-9);
-            break;
+    LevenbergMarquardtCallbacks problem{
+        [&](const Vector8& q) {
+          evaluate(q, r, jac);
+          return cost(r);
+        },
+        [&](int it, const Vector8&, Matrix8& h, Vector8& g, double& current) {
+          // Robust weights from the start (the starting levels are medians, so clutter already
+          // stands out; an unweighted first step lets large dark blobs drag the contrast down),
+          // and again once the grey levels have settled after the first, nearly linear step.
+          if (reweight && it <= 1) {
+            sigma = tukeyWeights();
+            current = cost(r);
           }
-        }
-        lambda *= 10;
-      }
-      if (!accepted) break;
-      if (it >= 2 && step.head<4>().norm() < 1e-3) break;
-    }
-    return true;
+          normalEquations();
+          for (int k = 0; k < 8; ++k)
+            if (!free[k]) {
+              jtj.row(k).setZero();
+              jtj.col(k).setZero();
+              jtj(k, k) = 1.0;
+              jtr(k) = 0.0;
+            }
+          h = jtj;
+          g = -jtr;  // the residuals here are grey - model
+        },
+        [&](const Vector8& q) -> std::optional<double> {
+          if (!(q(3) > 0.05)) return std::nullopt;
+          evaluate(q, rTry, jacTry);
+          return cost(rTry);
+        },
+        [&] {
+          std::swap(r, rTry);
+          std::swap(jac, jacTry);
+        },
+        [](int it, const Vector8& step) { return it >= 2 && step.head<4>().norm() < 1e-3; }};
+    const LevenbergMarquardtSettings settings{.maxIterations = maxIterations,
+                                              .maxTries = 6,
+                                              .initialDamping = 1e-4,
+                                              .dampingDecrease = 0.3,
+                                              .minDamping = 1e-9};
+    return levenbergMarquardt(problem, p, settings) != LevenbergMarquardtStop::NonFiniteStep;
   };
 
   // Without the illumination ramp first: in a thin band a ramp resembles a shifted rim, and

@@ -1,7 +1,6 @@
 #include "algorithms/registration/fiducials.hpp"
 
-#include <cmath>
-#include <numbers>
+#include "algorithms/geometry/similarity_fit.hpp"
 
 namespace facet {
 
@@ -22,28 +21,15 @@ FiducialResult locateFiducials(const cv::Mat& ref, const std::vector<cv::Point2d
   out.H = r.H;
   for (const auto& m : refMarks) out.marks.push_back(mapPoint(r.H, m));
   // Similarity that carries the reference marks onto the found ones (least squares): its angle
-  // is the part's rotation. With centred points p, q: q = s R(a) p, R(a) = [[c, s], [-s, c]].
-  cv::Point2d cp(0, 0), cq(0, 0);
-  for (std::size_t i = 0; i < refMarks.size(); ++i) {
-    cp += refMarks[i];
-    cq += out.marks[i];
-  }
-  cp *= 1.0 / refMarks.size();
-  cq *= 1.0 / refMarks.size();
-  double sc = 0, ss = 0, pp = 0;
-  for (std::size_t i = 0; i < refMarks.size(); ++i) {
-    const cv::Point2d p = refMarks[i] - cp, q = out.marks[i] - cq;
-    sc += p.x * q.x + p.y * q.y;
-    ss += p.y * q.x - p.x * q.y;
-    pp += p.x * p.x + p.y * p.y;
-  }
-  if (!(pp > 0)) {
+  // is the part's rotation.
+  const auto similarity = fitSimilarity(refMarks, out.marks);
+  if (!similarity) {
     out.failureCause = "too_few_fiducials";
     out.message = "the reference marks coincide";
     return out;
   }
-  out.rotationDeg = std::atan2(ss, sc) * 180.0 / std::numbers::pi;
-  out.scale = std::hypot(sc, ss) / pp;
+  out.rotationDeg = similarity->rotationDeg;
+  out.scale = similarity->scale;
   out.ok = true;
   return out;
 }

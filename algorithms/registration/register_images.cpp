@@ -6,17 +6,15 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "algorithms/image/grey_image.hpp"
 #include "algorithms/registration/harris_affine.hpp"
 
 namespace facet {
 namespace {
 
-cv::Mat toGrey(const cv::Mat& image) {
-  cv::Mat grey = image;
-  if (image.channels() == 3)
-    cv::cvtColor(image, grey, cv::COLOR_BGR2GRAY);
-  else if (image.channels() == 4)
-    cv::cvtColor(image, grey, cv::COLOR_BGRA2GRAY);
+// Grey on [0, 1] as float, whatever the input's depth.
+cv::Mat unitGrey(const cv::Mat& image) {
+  const cv::Mat grey = toGrey(image);
   double scale = 1.0, offset = 0.0;
   if (grey.depth() == CV_8U) {
     scale = 1.0 / 255.0;
@@ -138,8 +136,8 @@ std::vector<int> pruneByRotationScale(const std::vector<FeatureMatch>& m,
 
 cv::Matx22d jacobianAt(const cv::Matx33d& H, cv::Point2d p) {
   const double w = H(2, 0) * p.x + H(2, 1) * p.y + H(2, 2);
-  const double u = (H(0, 0) * p.x + H(0, 1) * p.y + H(0, 2)) / w;
-  const double v = (H(1, 0) * p.x + H(1, 1) * p.y + H(1, 2)) / w;
+  const cv::Point2d q = mapPoint(H, p);
+  const double u = q.x, v = q.y;
   return {(H(0, 0) - u * H(2, 0)) / w, (H(0, 1) - u * H(2, 1)) / w, (H(1, 0) - v * H(2, 0)) / w,
           (H(1, 1) - v * H(2, 1)) / w};
 }
@@ -298,12 +296,6 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
 
 }  // namespace
 
-cv::Point2d mapPoint(const cv::Matx33d& H, cv::Point2d p) {
-  const double w = H(2, 0) * p.x + H(2, 1) * p.y + H(2, 2);
-  return {(H(0, 0) * p.x + H(0, 1) * p.y + H(0, 2)) / w,
-          (H(1, 0) * p.x + H(1, 1) * p.y + H(1, 2)) / w};
-}
-
 std::vector<cv::Vec4d> RegistrationResult::pairs() const {
   std::vector<cv::Vec4d> out;
   for (int i : inliers)
@@ -317,7 +309,7 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
   if (refImage.empty() || image.empty())
     return failure(result, "empty_image",
                    refImage.empty() ? "the reference image is empty" : "the image is empty");
-  const cv::Mat ref = toGrey(refImage), img = toGrey(image);
+  const cv::Mat ref = unitGrey(refImage), img = unitGrey(image);
   if (isBlank(ref))
     return failure(result, "blank_image", "the reference image is uniform: no corners to register");
   if (isBlank(img))

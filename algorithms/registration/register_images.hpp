@@ -12,6 +12,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/geometry/projective_map.hpp"  // mapPoint: a reference point through H
 #include "algorithms/registration/harris_corners.hpp"
 #include "algorithms/registration/log_polar_window.hpp"
 #include "algorithms/registration/ncc_matcher.hpp"
@@ -82,8 +83,5 @@ struct RegistrationResult {
 // Registers `image` to `ref` (8-bit or 16-bit, 1 or 3 channels; converted to grey).
 RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
                                   const RegistrationParams& params = {});
-
-// Maps a reference point through H.
-cv::Point2d mapPoint(const cv::Matx33d& H, cv::Point2d p);
 
 }  // namespace facet

@@ -7,7 +7,9 @@
 
 #include <Eigen/Dense>
 
+#include "algorithms/geometry/projective_map.hpp"
 #include "algorithms/geometry/ransac.hpp"
+#include "algorithms/geometry/similarity_fit.hpp"
 
 namespace facet {
 namespace {
@@ -36,12 +38,6 @@ cv::Matx33d normaliser(const std::vector<cv::Point2d>& pts) {
   return {s, 0, -s * c.x, 0, s, -s * c.y, 0, 0, 1};
 }
 
-cv::Point2d apply(const cv::Matx33d& T, cv::Point2d p) {
-  const double w = T(2, 0) * p.x + T(2, 1) * p.y + T(2, 2);
-  return {(T(0, 0) * p.x + T(0, 1) * p.y + T(0, 2)) / w,
-          (T(1, 0) * p.x + T(1, 1) * p.y + T(1, 2)) / w};
-}
-
 std::optional<cv::Matx33d> fitNormalised(const std::vector<cv::Point2d>& src,
                                          const std::vector<cv::Point2d>& dst,
                                          TransformModel model) {
@@ -49,8 +45,8 @@ std::optional<cv::Matx33d> fitNormalised(const std::vector<cv::Point2d>& src,
   const cv::Matx33d Ts = normaliser(src), Td = normaliser(dst);
   std::vector<cv::Point2d> a(n), b(n);
   for (int i = 0; i < n; ++i) {
-    a[i] = apply(Ts, src[i]);
-    b[i] = apply(Td, dst[i]);
+    a[i] = mapPoint(Ts, src[i]);
+    b[i] = mapPoint(Td, dst[i]);
   }
   cv::Matx33d Hn = cv::Matx33d::eye();
   if (model == TransformModel::Homography && n == 4) {
@@ -91,19 +87,9 @@ std::optional<cv::Matx33d> fitNormalised(const std::vector<cv::Point2d>& src,
     const Eigen::Vector3d pu = qr.solve(u), pv = qr.solve(v);
     Hn = {pu(0), pu(1), pu(2), pv(0), pv(1), pv(2), 0, 0, 1};
   } else {
-    // u = c x + s y + tx, v = -s x + c y + ty
-    Eigen::MatrixXd M(2 * n, 4);
-    Eigen::VectorXd r(2 * n);
-    for (int i = 0; i < n; ++i) {
-      M.row(2 * i) << a[i].x, a[i].y, 1, 0;
-      M.row(2 * i + 1) << a[i].y, -a[i].x, 0, 1;
-      r(2 * i) = b[i].x;
-      r(2 * i + 1) = b[i].y;
-    }
-    const auto qr = M.colPivHouseholderQr();
-    if (qr.rank() < 4) return std::nullopt;
-    const Eigen::Vector4d p = qr.solve(r);
-    Hn = {p(0), p(1), p(2), -p(1), p(0), p(3), 0, 0, 1};
+    const auto similarity = fitSimilarity(a, b);
+    if (!similarity) return std::nullopt;
+    Hn = similarity->H;
   }
   cv::Matx33d H = Td.inv() * Hn * Ts;
   if (std::abs(H(2, 2)) < 1e-12) return std::nullopt;
@@ -161,9 +147,8 @@ bool parseTransformModel(const std::string& name, TransformModel& model) {
 double transferError(const cv::Matx33d& H, cv::Point2d src, cv::Point2d dst) {
   const double w = H(2, 0) * src.x + H(2, 1) * src.y + H(2, 2);
   if (!(std::abs(w) > 1e-12)) return std::numeric_limits<double>::infinity();
-  const double u = (H(0, 0) * src.x + H(0, 1) * src.y + H(0, 2)) / w;
-  const double v = (H(1, 0) * src.x + H(1, 1) * src.y + H(1, 2)) / w;
-  return std::hypot(u - dst.x, v - dst.y);
+  const cv::Point2d q = mapPoint(H, src);
+  return std::hypot(q.x - dst.x, q.y - dst.y);
 }
 
 std::optional<cv::Matx33d> fitTransformLeastSquares(const std::vector<cv::Point2d>& src,

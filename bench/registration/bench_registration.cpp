@@ -298,15 +298,9 @@ void nccTable(const std::string& dir, bool smoke) {
   }
 }
 
-// The shared data folder sits beside the checkout (FACET_SHARED_DIR); worktrees one level deeper
-// find it one folder further up.
+// The Oxford graf sequence in the repository (tests/data/oxford-graf, with its README).
 std::string defaultDataDir() {
-  for (const std::string& base :
-       {std::string(FACET_SHARED_DIR), std::string(FACET_SOURCE_DIR) + "/../../shared"}) {
-    const std::string dir = base + "/data/oxford-graf";
-    if (std::ifstream(dir + "/H1to2p").good()) return dir;
-  }
-  return std::string(FACET_SHARED_DIR) + "/data/oxford-graf";
+  return std::string(FACET_TEST_DATA_DIR) + "/oxford-graf";
 }
 
 }  // namespace

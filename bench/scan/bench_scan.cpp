@@ -14,7 +14,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <filesystem>
 #include <functional>
 #include <numbers>
 #include <random>
@@ -208,16 +207,9 @@ void benchSimulation(int cases, int people, const std::vector<Method>& ms) {
               icpFails, icpFailsSolvedByIdcp);
 }
 
-// The shared data folder: $FACET_SHARED_DIR, else the build's FACET_SHARED_DIR, else (for git
-// worktrees one level deeper) the shared folder beside the worktrees' parent.
+// The CARMEN logs in the repository (tests/data/carmen-scans, with their README).
 std::string scanDataDir() {
-  std::vector<std::string> candidates;
-  if (const char* env = std::getenv("FACET_SHARED_DIR")) candidates.emplace_back(env);
-  candidates.emplace_back(FACET_SHARED_DIR);
-  candidates.emplace_back(std::string(FACET_SOURCE_DIR) + "/../../shared");
-  for (const auto& c : candidates)
-    if (std::filesystem::exists(c + "/data/scans")) return c + "/data/scans/";
-  return candidates.front() + "/data/scans/";
+  return std::string(FACET_TEST_DATA_DIR) + "/carmen-scans/";
 }
 
 }  // namespace

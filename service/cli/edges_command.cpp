@@ -5,9 +5,9 @@
 #include <sstream>
 
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "algorithms/edges/subpixel_edges.hpp"
+#include "algorithms/image/grey_image.hpp"
 #include "service/cli/command_line.hpp"
 
 namespace facet::cli {
@@ -35,8 +35,7 @@ cv::Rect parseRoi(const std::string& text) {
 cv::Mat readGrey(const std::string& path) {
   cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (image.empty()) throw InputError(path + ": cannot read the image");
-  if (image.channels() == 3) cv::cvtColor(image, image, cv::COLOR_BGR2GRAY);
-  if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2GRAY);
+  image = toGrey(image);
   if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
     throw InputError(path + ": expected an 8-bit or 16-bit grey or colour image, got " +
                      cv::typeToString(image.type()));

@@ -324,6 +324,11 @@ std::vector<PartResult> ResultsStore::query(std::chrono::system_clock::time_poin
   return select("WHERE time_us >= ?1", "ASC", toMicros(since), limit);
 }
 
+std::vector<PartResult> ResultsStore::partsAfter(std::uint64_t afterPartId,
+                                                 std::size_t limit) const {
+  return select("WHERE part_id > ?1", "ASC", static_cast<std::int64_t>(afterPartId), limit);
+}
+
 std::vector<PartResult> ResultsStore::latest(std::size_t count) const {
   auto parts = select("", "DESC", 0, count);
   std::reverse(parts.begin(), parts.end());

@@ -45,6 +45,10 @@ class ResultsStore {
   // Parts at or after `since` (oldest first), at most `limit` (0 = all).
   [[nodiscard]] std::vector<PartResult> query(std::chrono::system_clock::time_point since,
                                               std::size_t limit = 0) const;
+  // Parts with id > afterPartId, oldest first, at most `limit` (0 = all): a client pages through
+  // the store by passing the last id it got, and misses nothing however many parts arrived.
+  [[nodiscard]] std::vector<PartResult> partsAfter(std::uint64_t afterPartId,
+                                                   std::size_t limit) const;
   // The `count` newest parts, newest last.
   [[nodiscard]] std::vector<PartResult> latest(std::size_t count) const;
 

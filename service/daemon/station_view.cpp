@@ -100,9 +100,7 @@ std::vector<PartResult> Station::recentParts(std::size_t count) const {
 
 std::vector<PartResult> Station::storedParts(std::uint64_t afterPartId, std::size_t limit) const {
   std::lock_guard lock(storeMutex_);
-  auto parts = store_->latest(limit == 0 ? 100 : limit);
-  std::erase_if(parts, [&](const PartResult& p) { return p.partId <= afterPartId; });
-  return parts;
+  return store_->partsAfter(afterPartId, limit == 0 ? 100 : limit);
 }
 
 std::vector<unsigned char> Station::lastOverlayPng() const {

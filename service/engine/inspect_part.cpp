@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <map>
 
-#include "service/engine/grey_image.hpp"
+#include "algorithms/image/grey_image.hpp"
 
 namespace facet::service {
 namespace {

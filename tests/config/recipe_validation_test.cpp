@@ -159,6 +159,33 @@ TEST_F(RecipeValidation, MissingFileIsReportedWithWhereItWasLookedFor) {
   EXPECT_TRUE(hasDiagnostic(r.diagnostics, 8, 16, "'reference' file 'nope.png' does not exist"));
 }
 
+// The reference scan of a scan_align step is read by the inspection's own scan parser: a row it
+// would refuse is reported (with the scan file's line) at the recipe's 'reference', and a file it
+// reads is accepted.
+TEST_F(RecipeValidation, ReferenceScanIsCheckedByTheInspectionsParser) {
+  const std::string recipe = R"(schema_version: 1
+id: 4
+name: Scan
+steps:
+  - id: fixture
+    kind: scan_align
+    reference: corner.csv
+)";
+  scratch.write("corner.csv", "x,y\n1.0,0.0\n1.0,0.5\n0.5,1.0\n");
+  const auto good = load(recipe);
+  EXPECT_TRUE(good.recipe.has_value()) << good.diagnostics.text();
+
+  scratch.write("corner.csv", "x,y\n1.0,0.0\n1.0,0.5,7\n0.5,1.0\n");
+  const auto bad = load(recipe);
+  EXPECT_FALSE(bad.recipe.has_value());
+  EXPECT_TRUE(hasDiagnostic(bad.diagnostics, 7, 16,
+                            "corner.csv:3: expected 2 comma-separated values, got 3"))
+      << bad.diagnostics.text();
+
+  scratch.write("corner.csv", "x,y\n1.0,0.0\n1.0,0.5\n");
+  EXPECT_TRUE(hasDiagnostic(load(recipe).diagnostics, 7, 16, "has 2 points; at least 3"));
+}
+
 TEST_F(RecipeValidation, PathWithDotDotLeavingTheFolderIsRefused) {
   const ScratchFolder outside;
   outside.writeImage("secret.png");

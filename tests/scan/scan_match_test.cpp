@@ -206,10 +206,7 @@ TEST(ScanMatch, TooFewCorrespondencesWhenScansAreFarApart) {
 // from the corrected relative pose plus up to 0.5 m and 30 deg, IDCP BoC lands within 0.1 m and
 // 2 deg on most pairs, and more often than point-to-point ICP.
 TEST(ScanMatchIntelLog, IdcpBocRecoversPerturbedStarts) {
-  const std::filesystem::path shared = std::filesystem::exists(FACET_SHARED_DIR "/data/scans")
-                                           ? FACET_SHARED_DIR
-                                           : FACET_SOURCE_DIR "/../../shared";
-  const auto log = readCarmenLogFile((shared / "data/scans/intel-corrected.log.gz").string());
+  const auto log = readCarmenLogFile(FACET_TEST_DATA_DIR "/carmen-scans/intel-corrected.log.gz");
   ASSERT_GT(log.size(), 300u);
   std::mt19937_64 rng(6);
   std::uniform_real_distribution<double> unit(0.0, 1.0);

@@ -95,11 +95,8 @@ TEST(CarmenLog, BadLinesNameSourceAndLine) {
 }
 
 TEST(CarmenLog, ReadsTheGzippedIntelLog) {
-  const std::filesystem::path path =
-      std::filesystem::path(FACET_SOURCE_DIR) / "../../shared/data/scans/intel-corrected.log.gz";
-  const std::filesystem::path alt =
-      std::filesystem::path(FACET_SHARED_DIR) / "data/scans/intel-corrected.log.gz";
-  const auto file = std::filesystem::exists(alt) ? alt : path;
+  const std::filesystem::path file =
+      std::filesystem::path(FACET_TEST_DATA_DIR) / "carmen-scans/intel-corrected.log.gz";
   ASSERT_TRUE(std::filesystem::exists(file)) << file;
   const auto scans = readCarmenLogFile(file.string());
   ASSERT_EQ(scans.size(), 910u);  // the README: 910 scans x 180 beams

@@ -139,6 +139,31 @@ TEST(ResultsStore, ReopenContinuesAfterLastPart) {
   EXPECT_EQ(again.lastPartId(), 41u);
 }
 
+// A page is the `limit` parts right after the given id, oldest first, with their measurements,
+// not the newest ones: paging with the last id received visits every part once.
+TEST(ResultsStore, PartsAfterIsTheNextPageOldestFirst) {
+  const fs::path file = freshFile("paging.sqlite");
+  ResultsStore store(file);
+  for (std::uint64_t id = 1; id <= 30; ++id) store.store(part(id, Verdict::Pass, 10.0));
+  const auto page = store.partsAfter(4, 5);
+  ASSERT_EQ(page.size(), 5u);
+  for (std::size_t i = 0; i < page.size(); ++i) {
+    EXPECT_EQ(page[i].partId, 5 + i);
+    EXPECT_EQ(page[i].measurements.size(), 2u);
+  }
+  std::vector<std::uint64_t> seen;
+  for (std::uint64_t after = 0;;) {
+    const auto next = store.partsAfter(after, 7);
+    if (next.empty()) break;
+    for (const auto& p : next) seen.push_back(p.partId);
+    after = next.back().partId;
+    if (after == 14) store.store(part(31, Verdict::Fail, 11.0));  // arrives while paging
+  }
+  ASSERT_EQ(seen.size(), 31u);
+  for (std::size_t i = 0; i < seen.size(); ++i) EXPECT_EQ(seen[i], i + 1);
+  EXPECT_TRUE(store.partsAfter(31, 7).empty());
+}
+
 TEST(ResultsStore, UnwritableLocationNamesTheFile) {
   try {
     ResultsStore store("/proc/facet-no-such/results.sqlite");

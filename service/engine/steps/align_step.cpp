@@ -2,11 +2,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include "algorithms/image/grey_image.hpp"
 #include "algorithms/registration/register_images.hpp"
 #include "algorithms/shape/find_shape_model.hpp"
 #include "config/recipe_format.hpp"
 #include "service/engine/frame_maps.hpp"
-#include "service/engine/grey_image.hpp"
 #include "service/engine/steps/pose_fields.hpp"
 #include "service/engine/steps/shape_model_resource.hpp"
 

@@ -4,6 +4,7 @@
 
 #include "algorithms/circle/disc_locator.hpp"
 #include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/geometry/similarity_fit.hpp"
 #include "algorithms/registration/register_images.hpp"
 #include "config/recipe_format.hpp"
 #include "service/engine/steps/polarity_names.hpp"
@@ -13,27 +14,6 @@ namespace facet::service {
 namespace {
 
 using config::Quantity;
-
-// Least-squares similarity (Umeyama in 2D) taking `from` onto `to`.
-cv::Matx33d fitSimilarity(const std::vector<cv::Point2d>& from,
-                          const std::vector<cv::Point2d>& to) {
-  cv::Point2d mf, mt;
-  for (std::size_t i = 0; i < from.size(); ++i) mf += from[i], mt += to[i];
-  mf *= 1.0 / from.size();
-  mt *= 1.0 / to.size();
-  double sxx = 0, sxy = 0, var = 0;
-  for (std::size_t i = 0; i < from.size(); ++i) {
-    const cv::Point2d a = from[i] - mf, b = to[i] - mt;
-    sxx += a.x * b.x + a.y * b.y;
-    sxy += a.x * b.y - a.y * b.x;
-    var += a.dot(a);
-  }
-  const double c = sxx / var, s = sxy / var;  // scale * cos, scale * sin (maths orientation)
-  const cv::Matx22d M{c, -s, s, c};
-  const cv::Point2d t =
-      mt - cv::Point2d(M(0, 0) * mf.x + M(0, 1) * mf.y, M(1, 0) * mf.x + M(1, 1) * mf.y);
-  return {M(0, 0), M(0, 1), t.x, M(1, 0), M(1, 1), t.y, 0, 0, 1};
-}
 
 }  // namespace
 
@@ -99,7 +79,9 @@ StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const
     nominal.push_back(expected);
     found.push_back(m.centre);
   }
-  const cv::Matx33d S = fitSimilarity(nominal, found);
+  const auto similarity = fitSimilarity(nominal, found);
+  if (!similarity) return StepResult::failed("the nominal fiducial positions coincide");
+  const cv::Matx33d S = similarity->H;
   StepResult r;
   r.refToImage = S * H;
   cv::Point2d cn, cf;

@@ -3,12 +3,12 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/image/grey_image.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
 #include "config/recipe_loader.hpp"
 #include "config/recipe_training.hpp"
 #include "config/training_record.hpp"
 #include "config/yaml_validation.hpp"
-#include "service/engine/grey_image.hpp"
 
 namespace facet::service {
 namespace {

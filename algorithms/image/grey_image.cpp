@@ -1,14 +1,14 @@
-#include "service/engine/grey_image.hpp"
+#include "algorithms/image/grey_image.hpp"
 
 #include <opencv2/imgproc.hpp>
 
-namespace facet::service {
+namespace facet {
 
 cv::Mat toGrey(const cv::Mat& image) {
-  if (image.channels() == 1) return image;
+  if (image.channels() != 3 && image.channels() != 4) return image;
   cv::Mat grey;
   cv::cvtColor(image, grey, image.channels() == 4 ? cv::COLOR_BGRA2GRAY : cv::COLOR_BGR2GRAY);
   return grey;
 }
 
-}  // namespace facet::service
+}  // namespace facet
