@@ -272,6 +272,8 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   thin(model.finePoints, params.maxPoints > 0 ? 2 * params.maxPoints : 0);
   if (static_cast<int>(model.finePoints.size()) < kMinModelPoints)
     throw ShapeModelError("shape model: the template has too few subpixel edge points");
+  model.symmetries =
+      findModelSymmetries(model.levels.front().points, model.levels.front().angleStep);
   return model;
 }
 

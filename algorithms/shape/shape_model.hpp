@@ -14,6 +14,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/shape/model_symmetry.hpp"
+
 namespace facet {
 
 struct ShapeModelParams {
@@ -85,6 +87,9 @@ struct ShapeModel {
   double minContrast = 5.0;  // grey levels per pixel
   double contrastLow = 0.0;  // thresholds actually used for the template, grey levels per pixel
   double contrastHigh = 0.0;
+  // Rotations that map the model almost onto itself (derived from the level-0 points when the
+  // model is created or loaded; not stored in model files).
+  std::vector<ModelSymmetry> symmetries;
 
   [[nodiscard]] bool empty() const { return levels.empty(); }
   [[nodiscard]] int numLevels() const { return static_cast<int>(levels.size()); }
