@@ -112,6 +112,7 @@ double overlap(const cv::RotatedRect& a, const cv::RotatedRect& b) {
 
 constexpr std::size_t kClusterRefined = 2;  // other candidates on the same part refined as well
 constexpr double kClusterMargin = 0.1;      // ... if their level-0 score is at most this lower
+constexpr double kSkipRefinement = 0.15;    // below minScore by more: not worth refining
 
 struct Finished {
   Pose2D pose;
@@ -145,7 +146,11 @@ struct Finisher {
     c = shape_detail::interpolate(search, c);
     const Pose2D start{c.x, c.y, c.angle, c.scale};
     const Finished interpolated{start, scoreAt(start)};
-    if (params.subpixel != SubpixelMode::LeastSquares) return interpolated;
+    // The least-squares refinement costs a subpixel edge detection: it is spent only on poses
+    // that can become matches (it moves a score by a few hundredths, not by kSkipRefinement).
+    if (params.subpixel != SubpixelMode::LeastSquares ||
+        interpolated.score < params.minScore - kSkipRefinement)
+      return interpolated;
     // A fixed-scale model may still meet a part a percent larger or smaller (lens, distance):
     // the refinement follows it within the tolerance, or keeps the scale when it would go
     // farther.
