@@ -4,11 +4,13 @@
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/least_squares_refinement.hpp"
+#include "algorithms/shape/level_search.hpp"
 #include "algorithms/shape/response_map_search.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
 
@@ -17,9 +19,9 @@ namespace {
 
 using shape_detail::Candidate;
 using shape_detail::DirectionField;
-using shape_detail::PosedPoints;
-using shape_detail::posePoints;
-using shape_detail::scorePose;
+using shape_detail::Interval;
+using shape_detail::LevelSearch;
+using shape_detail::refineOnLevel;
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr double kTopFactor = 0.7;     // top-level threshold, relative to minScore
@@ -28,12 +30,6 @@ constexpr double kFinalFactor = 0.8;   // level 0 before refinement (the refined
 
 // ---------------------------------------------------------------------------------------------
 // Search space
-
-struct Interval {
-  double start = 0.0;
-  double extent = 0.0;
-  bool full = false;  // angle: the whole circle
-};
 
 std::vector<double> angleSamples(const Interval& range, double step) {
   std::vector<double> out;
@@ -77,84 +73,6 @@ std::optional<Interval> angleRange(const ShapeModel& model, const FindParams& pa
 }
 
 // ---------------------------------------------------------------------------------------------
-// Tracking one candidate down one level: a local search around the parent's pose.
-
-struct LevelSearch {
-  const cv::Mat* field = nullptr;
-  const ShapeLevel* level = nullptr;
-  Interval angles;
-  double scaleMin = 1.0, scaleMax = 1.0;
-  Polarity polarity = Polarity::Use;
-  double minScore = 0.0;
-  double greediness = 0.0;
-};
-
-double clampAngle(const Interval& range, double a) {
-  if (range.full) return wrapAngle(a);
-  return std::clamp(a, range.start, range.start + range.extent);
-}
-
-// Best pose in a neighbourhood of `c`: (2 radius + 1)^2 positions x (2 angleSteps + 1) angles x 3
-// scales, climbing while the best lies on the border.
-Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angleSteps = 1) {
-  const double aStep = s.level->angleStep;
-  const double sStep = s.scaleMax > s.scaleMin ? s.level->scaleStep : 0.0;
-  Candidate best = c;
-  best.score = -1.0;
-  for (int climb = 0; climb < 6; ++climb) {
-    Candidate centre = climb == 0 ? c : best;
-    bool onBorder = false;
-    const int ns = sStep > 0.0 ? 1 : 0;
-    for (int k = -angleSteps; k <= angleSteps; ++k) {
-      const double a = clampAngle(s.angles, centre.angle + k * aStep);
-      for (int m = -ns; m <= ns; ++m) {
-        const double sc = std::clamp(centre.scale + m * sStep, s.scaleMin, s.scaleMax);
-        const PosedPoints posed = posePoints(s.level->points, a, sc);
-        for (int dy = -radius; dy <= radius; ++dy)
-          for (int dx = -radius; dx <= radius; ++dx) {
-            const cv::Point at(cvRound(centre.x) + dx, cvRound(centre.y) + dy);
-            const double score = scorePose(*s.field, posed, at, s.polarity,
-                                           std::max(s.minScore, best.score), s.greediness);
-            if (score > best.score) {
-              best = {double(at.x), double(at.y), a, sc, score};
-              onBorder = std::abs(dx) == radius || std::abs(dy) == radius ||
-                         (std::abs(k) == angleSteps && aStep > 0.0) || m != 0;
-            }
-          }
-      }
-    }
-    if (!onBorder || best.score < s.minScore) break;
-    radius = 1;
-    angleSteps = 1;
-  }
-  return best;
-}
-
-// Score-parabola interpolation around the level-0 maximum in x, y, angle and scale.
-Candidate interpolate(const LevelSearch& s, Candidate c) {
-  auto at = [&](double dx, double dy, double da, double ds) {
-    const PosedPoints posed = posePoints(s.level->points, c.angle + da, c.scale + ds);
-    return scorePose(*s.field, posed, cv::Point(cvRound(c.x + dx), cvRound(c.y + dy)), s.polarity,
-                     0.0, 0.0);
-  };
-  auto vertex = [](double m, double z, double p) {
-    const double d = m - 2.0 * z + p;
-    return d < 0.0 ? std::clamp(0.5 * (m - p) / d, -0.5, 0.5) : 0.0;
-  };
-  const double z = at(0, 0, 0, 0);
-  const double aStep = s.level->angleStep;
-  Candidate out = c;
-  out.x += vertex(at(-1, 0, 0, 0), z, at(1, 0, 0, 0));
-  out.y += vertex(at(0, -1, 0, 0), z, at(0, 1, 0, 0));
-  out.angle += aStep * vertex(at(0, 0, -aStep, 0), z, at(0, 0, aStep, 0));
-  if (s.scaleMax > s.scaleMin) {
-    const double sStep = s.level->scaleStep;
-    out.scale += sStep * vertex(at(0, 0, 0, -sStep), z, at(0, 0, 0, sStep));
-  }
-  return out;
-}
-
-// ---------------------------------------------------------------------------------------------
 // Matches in the image: oriented boxes for the overlap test and the refinement's region.
 
 struct Box {
@@ -188,6 +106,67 @@ double overlap(const cv::RotatedRect& a, const cv::RotatedRect& b) {
   const double smaller = std::min(a.size.area(), b.size.area());
   return smaller > 0.0 ? cv::contourArea(hull) / smaller : 0.0;
 }
+
+// ---------------------------------------------------------------------------------------------
+// Finishing a level-0 candidate: a wider look, subpixel refinement, the refined score.
+
+constexpr std::size_t kClusterRefined = 2;  // other candidates on the same part refined as well
+constexpr double kClusterMargin = 0.1;      // ... if their level-0 score is at most this lower
+constexpr double kSkipRefinement = 0.15;    // below minScore by more: not worth refining
+
+struct Finished {
+  Pose2D pose;
+  double score = 0.0;
+  double residual = 0.0;
+};
+
+struct Finisher {
+  const cv::Mat& image;
+  const ShapeModel& model;
+  const Box& box;
+  const LevelSearch& search;  // level 0
+  DirectionField& field;
+  const FindParams& params;
+  bool scaleRange;
+
+  double scoreAt(const Pose2D& pose) const {
+    field.ensure(placedBox(box, pose).boundingRect() + cv::Size(4, 4) - cv::Point(2, 2));
+    return shape_detail::refinedScore(field.directions(), model, pose, params.polarity);
+  }
+
+  std::optional<Finished> finish(Candidate c) const {
+    field.ensure(placedBox(box, {c.x, c.y, c.angle, c.scale}).boundingRect() + cv::Size(8, 8) -
+                 cv::Point(4, 4));
+    // Occluders and clutter can bend the score surface so that tracking stops on a secondary
+    // peak next to the true one; a wider look around each match about to be returned finds it.
+    if (const Candidate wide = refineOnLevel(search, c, 2, 3); wide.score > c.score) c = wide;
+    if (c.score < 0.0) return std::nullopt;
+    if (params.subpixel == SubpixelMode::None)
+      return Finished{{c.x, c.y, c.angle, c.scale}, c.score};
+    c = shape_detail::interpolate(search, c);
+    const Pose2D start{c.x, c.y, c.angle, c.scale};
+    const Finished interpolated{start, scoreAt(start)};
+    // The least-squares refinement costs a subpixel edge detection: it is spent only on poses
+    // that can become matches (it moves a score by a few hundredths, not by kSkipRefinement).
+    if (params.subpixel != SubpixelMode::LeastSquares ||
+        interpolated.score < params.minScore - kSkipRefinement)
+      return interpolated;
+    // A fixed-scale model may still meet a part a percent larger or smaller (lens, distance):
+    // the refinement follows it within the tolerance, or keeps the scale when it would go
+    // farther.
+    const double tolerance = params.refineScaleTolerance;
+    const cv::Rect roi = placedBox(box, start).boundingRect() + cv::Size(8, 8) - cv::Point(4, 4);
+    shape_detail::Refined r = shape_detail::refineLeastSquares(
+        image, model, roi, start, params.polarity, scaleRange || tolerance > 0.0);
+    if (!scaleRange && r.ok && std::abs(r.pose.scale / start.scale - 1.0) > tolerance)
+      r = shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, false);
+    // A refinement that wanders off by more than the search's own uncertainty has locked onto
+    // something else; one that scores lower than its start made the pose worse.
+    if (!r.ok || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0) return interpolated;
+    const Finished refined{r.pose, scoreAt(r.pose), r.residual};
+    return refined.score >= interpolated.score ? refined : interpolated;
+  }
+};
 
 void checkParams(const ShapeModel& model, const FindParams& p) {
   if (model.empty()) throw std::invalid_argument("findShapeModel: the model is empty");
@@ -291,10 +270,15 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
 
-  // Best first: refine, check the refined score, suppress overlaps with the matches kept.
+  // Best first: refine, check the refined score, suppress overlaps with the matches kept. Each
+  // match is chosen among its alternatives (the model's near-symmetric turns and other candidates
+  // on the same part), all refined, so that the coarse levels' pick does not decide.
   const Box box = modelBox(model);
   search.field = &fields[0].directions();
   search.level = &model.levels[0];
+  search.minScore = params.minScore * kFinalFactor;
+  const bool fixedScale = scaleMax <= scaleMin;
+  const Finisher finisher{image, model, box, search, fields[0], params, !fixedScale};
   std::vector<ShapeMatch> matches;
   std::vector<cv::RotatedRect> keptBoxes;
   auto clashes = [&](const Pose2D& pose) {
@@ -303,39 +287,46 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
       if (overlap(r, k) > params.maxOverlap) return true;
     return false;
   };
-  for (Candidate c : candidates) {
+  std::vector<bool> used(candidates.size(), false);
+  for (std::size_t i = 0; i < candidates.size(); ++i) {
     if (params.numMatches > 0 && static_cast<int>(matches.size()) >= params.numMatches) break;
+    if (used[i]) continue;
+    used[i] = true;
+    const Candidate& c = candidates[i];
     if (clashes({c.x, c.y, c.angle, c.scale})) continue;
+    std::vector<Candidate> alternatives{c};
+    for (const ModelSymmetry& sym : model.symmetries) {
+      const Pose2D turned = turnedBy({c.x, c.y, c.angle, c.scale}, sym);
+      alternatives.push_back({std::round(turned.x), std::round(turned.y),
+                              shape_detail::clampAngle(*angles, turned.angle), c.scale, -1.0});
+    }
+    const cv::RotatedRect here = placedBox(box, {c.x, c.y, c.angle, c.scale});
+    for (std::size_t j = i + 1, taken = 0; j < candidates.size() && taken < kClusterRefined; ++j) {
+      const Candidate& o = candidates[j];
+      if (used[j] ||
+          overlap(here, placedBox(box, {o.x, o.y, o.angle, o.scale})) <= params.maxOverlap)
+        continue;
+      used[j] = true;
+      const bool same = std::hypot(o.x - c.x, o.y - c.y) < 1.5 &&
+                        std::abs(wrapAngle(o.angle - c.angle)) < 1.5 * search.level->angleStep;
+      if (!same && o.score >= c.score - kClusterMargin) alternatives.push_back(o), ++taken;
+    }
+    std::optional<Finished> best;
+    for (const Candidate& alt : alternatives) {
+      const std::optional<Finished> f = finisher.finish(alt);
+      if (f && (!best || f->score > best->score)) best = f;
+    }
+    if (!best || best->score < params.minScore || clashes(best->pose)) continue;
     ShapeMatch m;
-    // Occluders and clutter can bend the score surface so that tracking stops on a secondary
-    // peak next to the true one; a wider look around each match about to be returned finds it.
-    if (const Candidate wide = refineOnLevel(search, c, 2, 3); wide.score > c.score) c = wide;
-    if (params.subpixel != SubpixelMode::None) c = interpolate(search, c);
-    Pose2D pose{c.x, c.y, c.angle, c.scale};
-    if (params.subpixel == SubpixelMode::LeastSquares) {
-      const cv::Rect roi = placedBox(box, pose).boundingRect() + cv::Size(8, 8) - cv::Point(4, 4);
-      const shape_detail::Refined r = shape_detail::refineLeastSquares(
-          image, model, roi, pose, params.polarity, scaleMax > scaleMin);
-      // A refinement that wanders off by more than the search's own uncertainty has locked onto
-      // something else.
-      if (r.ok && std::hypot(r.pose.x - pose.x, r.pose.y - pose.y) < 3.0) {
-        pose = r.pose;
-        m.residual = r.residual;
-      }
-    }
-    if (params.subpixel != SubpixelMode::None) {
-      fields[0].ensure(placedBox(box, pose).boundingRect() + cv::Size(4, 4) - cv::Point(2, 2));
-      c.score = shape_detail::refinedScore(fields[0].directions(), model, pose, params.polarity);
-      if (c.score < params.minScore || clashes(pose)) continue;
-    }
-    m.x = pose.x;
-    m.y = pose.y;
-    m.angle = wrapAngle(pose.angle);
-    m.scale = pose.scale;
-    m.score = c.score;
+    m.x = best->pose.x;
+    m.y = best->pose.y;
+    m.angle = wrapAngle(best->pose.angle);
+    m.scale = best->pose.scale;
+    m.score = best->score;
+    m.residual = best->residual;
     m.contour.reserve(model.finePoints.size());
-    for (const auto& p : model.finePoints) m.contour.push_back(pose.apply(p.position));
-    keptBoxes.push_back(placedBox(box, pose));
+    for (const auto& p : model.finePoints) m.contour.push_back(best->pose.apply(p.position));
+    keptBoxes.push_back(placedBox(box, best->pose));
     matches.push_back(std::move(m));
   }
   std::sort(matches.begin(), matches.end(),

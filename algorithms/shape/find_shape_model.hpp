@@ -40,9 +40,10 @@ struct FindParams {
   double maxOverlap = 0.5;
   // Early termination when scoring a pose on the levels below the top, 0..1: 0 = safe (abandon a
   // pose only when it cannot reach minScore even if every remaining point matched perfectly),
-  // 1 = fastest (abandon it as soon as the points so far match at less than minScore). Higher
-  // values can miss heavily occluded parts. Default 0.9.
-  double greediness = 0.9;
+  // 1 = fastest (abandon it as soon as the points so far match at less than minScore). Values
+  // above 0 can miss clear parts on real photographs, where a part's points match unevenly (a
+  // part scoring 0.9 was lost at 0.9). Default 0 (safe).
+  double greediness = 0.0;
   // Angle range searched, radians: [angleStart, angleStart + angleExtent], intersected with the
   // model's trained range. Default: full circle.
   double angleStart = -std::numbers::pi;
@@ -55,6 +56,11 @@ struct FindParams {
   Polarity polarity = Polarity::Use;
   // Subpixel refinement of each match. Default LeastSquares.
   SubpixelMode subpixel = SubpixelMode::LeastSquares;
+  // Least squares with a model of fixed scale: the refinement may also adjust the scale by up to
+  // this relative amount (real parts and lenses differ from the template by a percent or so; a
+  // fixed scale would pull the position towards one side). The match reports the scale it found.
+  // 0 = keep the scale fixed. Default 0.02.
+  double refineScaleTolerance = 0.02;
   // Number of pyramid levels used, 0 = all of the model's. Fewer levels = slower, more robust.
   int numLevels = 0;
   // Parallelism on OpenCV's worker pool: stripes of the top-level search (1..8), and, when > 1,

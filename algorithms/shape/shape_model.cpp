@@ -19,6 +19,9 @@ using shape_detail::toGreyFloat;
 constexpr int kMaxAutoLevels = 6;
 constexpr int kMaxUpperLevelPoints = 250;  // top-level sums are 16-bit: 250 * 127 < 32767
 constexpr int kMinModelPoints = 8;
+// Automatic pyramid levels (ShapeModelParams::numLevels = 0).
+constexpr int kMinTopEdgePoints = 24;  // fewer cannot tell the part from clutter
+constexpr double kMinTopRadius = 5.0;  // pixels; the angle step atan(1 / R) stays below 12 deg
 
 // The q-quantile of the gradient magnitude over the masked pixels.
 double magnitudeQuantile(const cv::Mat& magnitude, const cv::Mat& mask, double q) {
@@ -229,8 +232,11 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     cv::Size2d box;
     const double radius = extentOf(r.points, box);
     if (level == 0) radius0 = radius;
+    const int edgeCount = cv::countNonZero(r.edgeMask);
+    // Automatic levels: a level is used while it keeps the part's features, judged by the edge
+    // points it keeps rather than by its size (see ShapeModelParams::numLevels).
     if (level > 0 && params.numLevels == 0 &&
-        (std::min(box.width, box.height) < 12.0 || r.points.size() < 16))
+        (edgeCount < kMinTopEdgePoints || radius < kMinTopRadius))
       break;
     if (level > 0 && r.points.size() < 4)
       throw ShapeModelError("shape model: level " + std::to_string(level) +
@@ -272,6 +278,8 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   thin(model.finePoints, params.maxPoints > 0 ? 2 * params.maxPoints : 0);
   if (static_cast<int>(model.finePoints.size()) < kMinModelPoints)
     throw ShapeModelError("shape model: the template has too few subpixel edge points");
+  model.symmetries =
+      findModelSymmetries(model.levels.front().points, model.levels.front().angleStep);
   return model;
 }
 

@@ -14,6 +14,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/shape/model_symmetry.hpp"
+
 namespace facet {
 
 struct ShapeModelParams {
@@ -26,8 +28,11 @@ struct ShapeModelParams {
   // Default: the centre of the region, ((w-1)/2, (h-1)/2) of the roi or the whole template.
   std::optional<cv::Point2d> referencePoint;
 
-  // Number of pyramid levels, >= 1. 0 = automatic: as many as keep the model at least about
-  // 12 pixels wide and 16 edge points on the top level (at most 6).
+  // Number of pyramid levels, >= 1. 0 = automatic: each level halves the image, and the search
+  // on the top level costs about 1/16 of the one below it (a quarter of the positions, half the
+  // angles, half the points), so the model takes every level that still holds the part: at
+  // least 24 edge pixels and a radius of at least 5 pixels (angle step below 12 degrees) on the
+  // top level, whatever the template's width. At most 6 levels.
   int numLevels = 0;
 
   // Angle range searched, radians: [angleStart, angleStart + angleExtent]. Default: full circle.
@@ -85,6 +90,9 @@ struct ShapeModel {
   double minContrast = 5.0;  // grey levels per pixel
   double contrastLow = 0.0;  // thresholds actually used for the template, grey levels per pixel
   double contrastHigh = 0.0;
+  // Rotations that map the model almost onto itself (derived from the level-0 points when the
+  // model is created or loaded; not stored in model files).
+  std::vector<ModelSymmetry> symmetries;
 
   [[nodiscard]] bool empty() const { return levels.empty(); }
   [[nodiscard]] int numLevels() const { return static_cast<int>(levels.size()); }

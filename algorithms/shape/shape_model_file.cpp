@@ -217,6 +217,8 @@ ShapeModel loadShapeModel(const std::filesystem::path& path) {
     r.fail("corrupt shape model file (invalid values)");
   if (const std::string why = implausibility(model); !why.empty())
     r.fail("corrupt shape model file (invalid values: " + why + ")");
+  model.symmetries =
+      findModelSymmetries(model.levels.front().points, model.levels.front().angleStep);
   return model;
 }
 

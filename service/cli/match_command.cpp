@@ -111,7 +111,7 @@ void addMatchCommand(CLI::App& app) {
   cmd->add_option("--num-matches", o->find.numMatches, "Matches to return, 0 = all (default 1)");
   cmd->add_option("--max-overlap", o->find.maxOverlap,
                   "Largest overlap of two matches, 0..1 (default 0.5)");
-  cmd->add_option("--greediness", o->find.greediness, "0 = safe .. 1 = fast (default 0.9)");
+  cmd->add_option("--greediness", o->find.greediness, "0 = safe .. 1 = fast (default 0: safe)");
   cmd->add_option("--angle-range", o->angleRange,
                   "Angles to search: a0,a1 in degrees (default: the model's)");
   cmd->add_option("--scale-range", o->scaleRange, "Scales to search: s0,s1 (default: the model's)");

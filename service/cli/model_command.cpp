@@ -80,12 +80,25 @@ void run(const ModelOptions& o) {
     throw InputError(e.what());
   }
   if (o.json) {
+    // What the automatic parameters chose, so that a user can see (and fix) them.
+    nlohmann::json levels = nlohmann::json::array();
+    for (const auto& l : model.levels)
+      levels.push_back({{"points", l.points.size()}, {"angle_step", degrees(l.angleStep)}});
+    nlohmann::json symmetries = nlohmann::json::array();
+    for (const auto& s : model.symmetries)
+      symmetries.push_back({{"angle", degrees(s.angle)}, {"score", s.score}});
     printJson({{"model", o.out},
                {"levels", model.numLevels()},
+               {"levels_chosen", o.levels == 0 ? "automatic" : "--levels"},
+               {"pyramid", levels},
                {"points", model.levels.front().points.size()},
                {"subpixel_points", model.finePoints.size()},
                {"reference", {model.referencePoint.x, model.referencePoint.y}},
-               {"angle_step", degrees(model.levels.front().angleStep)}});
+               {"angle_step", degrees(model.levels.front().angleStep)},
+               {"contrast_low", model.contrastLow},
+               {"contrast_high", model.contrastHigh},
+               {"min_contrast", model.minContrast},
+               {"near_symmetries", symmetries}});
   } else {
     std::cout << "wrote " << o.out << ": " << model.numLevels() << " levels, "
               << model.levels.front().points.size() << " points on level 0, "

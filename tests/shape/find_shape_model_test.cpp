@@ -44,7 +44,8 @@ TEST(FindShapeModel, LeastSquaresIsSubpixelAccurateAtAnyAngle) {
     ASSERT_EQ(matches.size(), 1u) << "pose " << i;
     EXPECT_LT(positionError(matches[0], poses[i]), 0.05) << "pose " << i;
     EXPECT_LT(std::abs(angleErrorDeg(matches[0], poses[i])), 0.03) << "pose " << i;
-    EXPECT_DOUBLE_EQ(matches[0].scale, 1.0);
+    // The default refinement may adjust a fixed scale by up to 2%; on an exact part it stays put.
+    EXPECT_NEAR(matches[0].scale, 1.0, 1e-3);
     EXPECT_GT(matches[0].score, 0.9);
     EXPECT_LT(matches[0].residual, 0.2);
     // The contour is the model's subpixel points at the pose.

@@ -1,0 +1,72 @@
+#include "algorithms/shape/level_search.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "algorithms/shape/shape_similarity.hpp"
+
+namespace facet::shape_detail {
+
+double clampAngle(const Interval& range, double a) {
+  if (range.full) return wrapAngle(a);
+  return std::clamp(a, range.start, range.start + range.extent);
+}
+
+Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angleSteps) {
+  const double aStep = s.level->angleStep;
+  const double sStep = s.scaleMax > s.scaleMin ? s.level->scaleStep : 0.0;
+  Candidate best = c;
+  best.score = -1.0;
+  for (int climb = 0; climb < 6; ++climb) {
+    Candidate centre = climb == 0 ? c : best;
+    bool onBorder = false;
+    const int ns = sStep > 0.0 ? 1 : 0;
+    for (int k = -angleSteps; k <= angleSteps; ++k) {
+      const double a = clampAngle(s.angles, centre.angle + k * aStep);
+      for (int m = -ns; m <= ns; ++m) {
+        const double sc = std::clamp(centre.scale + m * sStep, s.scaleMin, s.scaleMax);
+        const PosedPoints posed = posePoints(s.level->points, a, sc);
+        for (int dy = -radius; dy <= radius; ++dy)
+          for (int dx = -radius; dx <= radius; ++dx) {
+            const cv::Point at(cvRound(centre.x) + dx, cvRound(centre.y) + dy);
+            const double score = scorePose(*s.field, posed, at, s.polarity,
+                                           std::max(s.minScore, best.score), s.greediness);
+            if (score > best.score) {
+              best = {double(at.x), double(at.y), a, sc, score};
+              onBorder = std::abs(dx) == radius || std::abs(dy) == radius ||
+                         (std::abs(k) == angleSteps && aStep > 0.0) || m != 0;
+            }
+          }
+      }
+    }
+    if (!onBorder || best.score < s.minScore) break;
+    radius = 1;
+    angleSteps = 1;
+  }
+  return best;
+}
+
+Candidate interpolate(const LevelSearch& s, Candidate c) {
+  auto at = [&](double dx, double dy, double da, double ds) {
+    const PosedPoints posed = posePoints(s.level->points, c.angle + da, c.scale + ds);
+    return scorePose(*s.field, posed, cv::Point(cvRound(c.x + dx), cvRound(c.y + dy)), s.polarity,
+                     0.0, 0.0);
+  };
+  auto vertex = [](double m, double z, double p) {
+    const double d = m - 2.0 * z + p;
+    return d < 0.0 ? std::clamp(0.5 * (m - p) / d, -0.5, 0.5) : 0.0;
+  };
+  const double z = at(0, 0, 0, 0);
+  const double aStep = s.level->angleStep;
+  Candidate out = c;
+  out.x += vertex(at(-1, 0, 0, 0), z, at(1, 0, 0, 0));
+  out.y += vertex(at(0, -1, 0, 0), z, at(0, 1, 0, 0));
+  out.angle += aStep * vertex(at(0, 0, -aStep, 0), z, at(0, 0, aStep, 0));
+  if (s.scaleMax > s.scaleMin) {
+    const double sStep = s.level->scaleStep;
+    out.scale += sStep * vertex(at(0, 0, 0, -sStep), z, at(0, 0, 0, sStep));
+  }
+  return out;
+}
+
+}  // namespace facet::shape_detail

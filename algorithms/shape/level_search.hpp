@@ -1,0 +1,41 @@
+#pragma once
+// Searching one pyramid level around a known pose (internal to facet_shape): the local search
+// that tracks a candidate down the pyramid and the score-parabola interpolation on level 0.
+
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/response_map_search.hpp"
+#include "algorithms/shape/shape_model.hpp"
+
+namespace facet::shape_detail {
+
+struct Interval {
+  double start = 0.0;
+  double extent = 0.0;
+  bool full = false;  // angle: the whole circle
+};
+
+// An angle moved into the interval (wrapped for the full circle, clamped otherwise).
+double clampAngle(const Interval& range, double a);
+
+struct LevelSearch {
+  const cv::Mat* field = nullptr;  // the level's DirectionField directions
+  const ShapeLevel* level = nullptr;
+  Interval angles;
+  double scaleMin = 1.0, scaleMax = 1.0;
+  Polarity polarity = Polarity::Use;
+  double minScore = 0.0;
+  double greediness = 0.0;
+};
+
+// Best pose in a neighbourhood of `c`: (2 radius + 1)^2 positions x (2 angleSteps + 1) angles x 3
+// scales, climbing while the best lies on the border. Score -1 when nothing reaches minScore.
+Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angleSteps = 1);
+
+// Score-parabola interpolation around a level-0 maximum in x, y, angle and scale.
+Candidate interpolate(const LevelSearch& s, Candidate c);
+
+}  // namespace facet::shape_detail

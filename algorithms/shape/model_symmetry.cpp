@@ -1,0 +1,96 @@
+#include "algorithms/shape/model_symmetry.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "algorithms/shape/shape_model.hpp"
+
+namespace facet {
+namespace {
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// The model's points rasterised around their centre: the unit direction at every point's pixel,
+// zero elsewhere, so that a turned point's neighbourhood can be looked up directly.
+struct PointRaster {
+  cv::Mat directions;  // CV_32FC2
+  cv::Point2d origin;  // model coordinates of pixel (0, 0)
+};
+
+PointRaster rasterise(const std::vector<ShapePoint>& points, cv::Point2d centre, double reach) {
+  const int side = 2 * static_cast<int>(std::ceil(reach)) + 5;
+  PointRaster r{cv::Mat(side, side, CV_32FC2, cv::Scalar(0, 0)),
+                centre - cv::Point2d((side - 1) / 2.0, (side - 1) / 2.0)};
+  for (const auto& p : points) {
+    const cv::Point at(cvRound(p.position.x - r.origin.x), cvRound(p.position.y - r.origin.y));
+    if (cv::Rect(0, 0, side, side).contains(at))
+      r.directions.at<cv::Vec2f>(at) = {p.direction.x, p.direction.y};
+  }
+  return r;
+}
+
+// Mean over the points of the best direction agreement within one pixel of the turned point.
+double selfSimilarity(const std::vector<ShapePoint>& points, const PointRaster& raster,
+                      cv::Point2d centre, double angle) {
+  const double c = std::cos(angle), s = std::sin(angle);
+  const cv::Rect inside(1, 1, raster.directions.cols - 2, raster.directions.rows - 2);
+  double sum = 0.0;
+  for (const auto& p : points) {
+    const double x = p.position.x - centre.x, y = p.position.y - centre.y;
+    const cv::Point2d q = centre + cv::Point2d(c * x + s * y, -s * x + c * y);
+    const cv::Point at(cvRound(q.x - raster.origin.x), cvRound(q.y - raster.origin.y));
+    if (!inside.contains(at)) continue;
+    const double dx = c * p.direction.x + s * p.direction.y;
+    const double dy = -s * p.direction.x + c * p.direction.y;
+    double best = 0.0;
+    for (int v = -1; v <= 1; ++v)
+      for (int u = -1; u <= 1; ++u) {
+        const cv::Vec2f d = raster.directions.at<cv::Vec2f>(at + cv::Point(u, v));
+        best = std::max(best, d[0] * dx + d[1] * dy);
+      }
+    sum += best;
+  }
+  return points.empty() ? 0.0 : sum / static_cast<double>(points.size());
+}
+
+}  // namespace
+
+std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& points,
+                                               double angleStep, double minScore, int maxCount) {
+  if (points.size() < 8 || !(angleStep > 0.0)) return {};
+  cv::Point2d centre(0, 0);
+  for (const auto& p : points) centre += cv::Point2d(p.position.x, p.position.y);
+  centre *= 1.0 / static_cast<double>(points.size());
+  double reach = 0.0;
+  for (const auto& p : points)
+    reach = std::max(reach, std::hypot(p.position.x - centre.x, p.position.y - centre.y));
+  const PointRaster raster = rasterise(points, centre, reach);
+
+  const int n = std::max(8, static_cast<int>(std::ceil(kTwoPi / angleStep)));
+  std::vector<double> score(static_cast<std::size_t>(n));
+  for (int k = 0; k < n; ++k) score[k] = selfSimilarity(points, raster, centre, k * kTwoPi / n);
+  // Local maxima away from the identity (its own peak is several steps wide).
+  std::vector<ModelSymmetry> out;
+  const int guard = std::max(3, n / 36);
+  for (int k = guard; k <= n - guard; ++k) {
+    const double v = score[k];
+    if (v < minScore || v < score[(k + n - 1) % n] || v < score[(k + 1) % n]) continue;
+    out.push_back({wrapAngle(k * kTwoPi / n), centre, v});
+  }
+  std::sort(out.begin(), out.end(),
+            [](const ModelSymmetry& a, const ModelSymmetry& b) { return a.score > b.score; });
+  if (static_cast<int>(out.size()) > maxCount) out.resize(static_cast<std::size_t>(maxCount));
+  return out;
+}
+
+Pose2D turnedBy(const Pose2D& pose, const ModelSymmetry& symmetry) {
+  const double c = std::cos(symmetry.angle), s = std::sin(symmetry.angle);
+  const cv::Point2d& m = symmetry.centre;
+  const cv::Point2d turned(c * m.x + s * m.y, -s * m.x + c * m.y);
+  // t' = t + s R(theta) (c - R(a) c)
+  const cv::Point2d shift = pose.applyToVector(m - turned);
+  return {pose.x + shift.x, pose.y + shift.y, wrapAngle(pose.angle + symmetry.angle), pose.scale};
+}
+
+}  // namespace facet

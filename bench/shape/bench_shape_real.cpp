@@ -1,0 +1,333 @@
+// bench_shape_real: findShapeModel as a user gets it (default model, default search) beside a
+// pyramid NCC matcher (pyramid_ncc.hpp) in the same run:
+//   1. speed on generated bracket scenes, the first search after loading a model file ("cold")
+//      and the next ones ("warm"), and a 4096x3000 photograph with a large template;
+//   2. the real photographs of tests/data/photos (cases.txt): found / missed / false and the
+//      pose's distance from the independent reference, per image.
+//
+//   bench_shape_real [--smoke] [--data DIR]
+// Times are medians of the process's CPU time (all threads), ms, on this machine.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/shape_model.hpp"
+#include "algorithms/shape/shape_model_file.hpp"
+#include "bench/shape/pyramid_ncc.hpp"
+#include "tests/shape/bracket_scenes.hpp"
+
+namespace {
+
+using namespace facet;
+
+// CPU time of the whole process (all threads), ms: on a shared, loaded machine the wall time
+// measures the other jobs; CPU time is an upper bound of the wall time on an idle machine
+// (the search runs on at most 2 threads by default).
+double cpuMs() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return t.tv_sec * 1e3 + t.tv_nsec / 1e6;
+}
+
+struct Stopwatch {
+  double start = cpuMs();
+};
+
+double msSince(const Stopwatch& t0) {
+  return cpuMs() - t0.start;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return NAN;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// --- 1. Speed with the defaults -------------------------------------------------------------
+
+struct SpeedRow {
+  std::vector<double> cold, warm, greedy, ncc;
+  int found = 0, nccFound = 0, scenes = 0;
+};
+
+bool near(double x, double y, double angle, const Pose2D& truth) {
+  return std::hypot(x - truth.x, y - truth.y) < 2.0 &&
+         std::abs(degrees(wrapAngle(angle - truth.angle))) < 1.5;
+}
+
+void speedRow(const char* name, cv::Size size, int scenes, const std::filesystem::path& modelFile,
+              const cv::Mat& templ, bool withNcc, const char* target) {
+  SpeedRow row;
+  for (int i = 0; i < scenes; ++i) {
+    const double u = (i * 0.618034) - std::floor(i * 0.618034);
+    const Pose2D truth{size.width * (0.3 + 0.4 * u), size.height * (0.35 + 0.3 * (1 - u)),
+                       (2 * u - 1) * std::numbers::pi, 1.0};
+    const cv::Mat image = testing::bracketScene(size, {truth}, 500 + i);
+    // Cold: the first search after loading the model file; warm: the next search, on another
+    // image (the same part elsewhere), as on a line.
+    const Pose2D next{size.width - truth.x, size.height - truth.y, wrapAngle(truth.angle + 2.0),
+                      1.0};
+    const cv::Mat nextImage = testing::bracketScene(size, {next}, 900 + i);
+    const ShapeModel model = loadShapeModel(modelFile);
+    {
+      const Stopwatch t0;
+      const auto m = findShapeModel(image, model);
+      row.cold.push_back(msSince(t0));
+      row.found += !m.empty() && near(m[0].x, m[0].y, m[0].angle, truth);
+    }
+    {
+      const Stopwatch t0;
+      const auto m = findShapeModel(nextImage, model);
+      row.warm.push_back(msSince(t0));
+      row.found += !m.empty() && near(m[0].x, m[0].y, m[0].angle, next);
+    }
+    {
+      // The former default: greediness 0.9 (faster, but can drop clear parts).
+      FindParams greedy;
+      greedy.greediness = 0.9;
+      const Stopwatch t0;
+      (void)findShapeModel(image, model, greedy);
+      row.greedy.push_back(msSince(t0));
+    }
+    if (withNcc) {
+      const Stopwatch t0;
+      const auto n = bench::findByPyramidNcc(image, templ, 1);
+      row.ncc.push_back(msSince(t0));
+      row.nccFound += !n.empty() && near(n[0].x, n[0].y, radians(n[0].angleDeg), truth);
+    }
+    ++row.scenes;
+  }
+  std::printf("| %-24s | %3d | %3d/%d | %7.2f | %7.2f | %7.2f | %3d/%d | %8.2f | %6.1f | %s |\n",
+              name, row.scenes, row.found, 2 * row.scenes, median(row.cold), median(row.warm),
+              median(row.greedy), row.nccFound, row.scenes, median(row.ncc),
+              median(row.ncc) / median(row.warm), target);
+}
+
+// The large case: a photograph of a circuit board, enlarged to 4096x3000 and turned; the
+// template is its large chip (about 1100x950 pixels).
+void largeRow(const std::filesystem::path& data, int repeats) {
+  const cv::Mat board =
+      cv::imread((data / "board_qfp100_template.png").string(), cv::IMREAD_GRAYSCALE);
+  const cv::Mat photo = cv::imread((data / "board_source.jpg").string(), cv::IMREAD_GRAYSCALE);
+  if (board.empty() || photo.empty()) {
+    std::printf("| 4096x3000 photograph     | (missing %s) |\n", data.c_str());
+    return;
+  }
+  const double f = 6.4;
+  cv::Mat big, scene;
+  cv::resize(photo, big, {4096, 3072}, 0, 0, cv::INTER_CUBIC);
+  big = big(cv::Rect(0, 36, 4096, 3000)).clone();
+  const cv::Point2f centre(2047.5f, 1499.5f);
+  const double angle = 21.0;
+  const cv::Mat m = cv::getRotationMatrix2D(centre, angle, 1.0);
+  cv::warpAffine(big, scene, m, big.size(), cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  // The template: the chip's region of the enlarged photograph (board_qfp100 at 332,292 176x152).
+  const cv::Rect roi(cvRound(332 * f), cvRound(292 * f - 36), cvRound(176 * f), cvRound(152 * f));
+  const cv::Mat templ = big(roi).clone();
+  const cv::Point2d rc(roi.x + (roi.width - 1) / 2.0, roi.y + (roi.height - 1) / 2.0);
+  const Pose2D truth{m.at<double>(0, 0) * rc.x + m.at<double>(0, 1) * rc.y + m.at<double>(0, 2),
+                     m.at<double>(1, 0) * rc.x + m.at<double>(1, 1) * rc.y + m.at<double>(1, 2),
+                     radians(angle), 1.0};
+  Stopwatch t0;
+  const ShapeModel model = createShapeModel(templ);
+  const double createMs = msSince(t0);
+  std::vector<double> ours, ncc;
+  bool found = false, nccFound = false;
+  for (int i = 0; i < repeats; ++i) {
+    t0 = Stopwatch();
+    const auto r = findShapeModel(scene, model);
+    ours.push_back(msSince(t0));
+    found = !r.empty() && near(r[0].x, r[0].y, r[0].angle, truth);
+    t0 = Stopwatch();
+    const auto n = bench::findByPyramidNcc(scene, templ, 1);
+    ncc.push_back(msSince(t0));
+    nccFound = !n.empty() && near(n[0].x, n[0].y, radians(n[0].angleDeg), truth);
+  }
+  std::printf(
+      "| 4096x3000, %4dx%-4d tmpl | %3d | %3d/1 | %7s | %7.1f | %7s | %3d/1 | %8.1f | %6.1f | "
+      "faster than NCC (model %.0f ms, %d levels) |\n",
+      templ.cols, templ.rows, repeats, int(found), "-", median(ours), "-", int(nccFound),
+      median(ncc), median(ncc) / median(ours), createMs, model.numLevels());
+}
+
+// --- 2. Real photographs ----------------------------------------------------------------------
+
+struct PhotoCase {
+  std::string name, templ, scene, method;
+  int period = 360;
+  std::vector<Pose2D> refs;
+};
+
+std::vector<PhotoCase> readCases(const std::filesystem::path& file) {
+  std::vector<PhotoCase> out;
+  std::ifstream in(file);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream s(line);
+    PhotoCase c;
+    int n = 0;
+    s >> c.name >> c.templ >> c.scene >> c.period >> n;
+    for (int i = 0; i < n; ++i) {
+      double x, y, a, sc;
+      s >> x >> y >> a >> sc;
+      c.refs.push_back({x, y, radians(a), sc});
+    }
+    s >> c.method;
+    if (s) out.push_back(c);
+  }
+  return out;
+}
+
+struct Tally {
+  int found = 0, missed = 0, falses = 0;
+  double worstPos = 0.0, worstAngle = 0.0;
+  double lowestScore = NAN;  // of the matches found
+};
+
+// Matches within 3 px (and 2 degrees, modulo the case's period) of a reference are found.
+template <typename M>
+Tally tally(const PhotoCase& c, const std::vector<M>& matches, auto xOf, auto yOf, auto angleOf) {
+  Tally t;
+  std::vector<bool> used(c.refs.size(), false);
+  for (const auto& m : matches) {
+    bool hit = false;
+    for (std::size_t i = 0; i < c.refs.size() && !hit; ++i) {
+      const double dp = std::hypot(xOf(m) - c.refs[i].x, yOf(m) - c.refs[i].y);
+      double da = degrees(wrapAngle(angleOf(m) - c.refs[i].angle));
+      if (c.period == 180) da = std::min(std::abs(da), 180.0 - std::abs(da));
+      if (c.period == 0) da = 0.0;
+      if (used[i] || c.refs[i].scale == 0.0 || dp > 3.0 || std::abs(da) > 2.0) continue;
+      used[i] = hit = true;
+      t.worstPos = std::max(t.worstPos, dp);
+      t.worstAngle = std::max(t.worstAngle, std::abs(da));
+      t.lowestScore = std::isnan(t.lowestScore) ? m.score : std::min(t.lowestScore, m.score);
+    }
+    // Near an optional reference (a part cut by the image border, scale 0): not counted.
+    bool optional = false;
+    for (const auto& r : c.refs)
+      optional |= r.scale == 0.0 && std::hypot(xOf(m) - r.x, yOf(m) - r.y) < 3.0;
+    t.found += hit;
+    t.falses += !hit && !optional;
+  }
+  int required = 0;
+  for (const auto& r : c.refs) required += r.scale > 0.0;
+  t.missed = required - t.found;
+  return t;
+}
+
+void photoTable(const std::filesystem::path& data, bool smoke, const FindParams& base) {
+  const auto cases = readCases(data / "cases.txt");
+  std::printf(
+      "\n| photograph | refs | method | facet found/missed/false | facet worst pos px, "
+      "angle deg | facet lowest score found | facet ms | NCC found/missed/false | NCC worst pos "
+      "px, angle deg | NCC "
+      "ms |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  Tally sum, nccSum;
+  for (const auto& c : cases) {
+    const cv::Mat templ = cv::imread((data / c.templ).string(), cv::IMREAD_GRAYSCALE);
+    const cv::Mat scene = cv::imread((data / c.scene).string(), cv::IMREAD_GRAYSCALE);
+    if (templ.empty() || scene.empty()) {
+      std::printf("| %s | cannot read its files |\n", c.name.c_str());
+      continue;
+    }
+    const ShapeModel model = createShapeModel(templ);
+    const auto refCount = static_cast<int>(
+        std::count_if(c.refs.begin(), c.refs.end(), [](const Pose2D& r) { return r.scale > 0.0; }));
+    FindParams p = base;
+    p.numMatches = 0;  // all above the default minimum score
+    Stopwatch t0;
+    const auto ours = findShapeModel(scene, model, p);
+    const double ms = msSince(t0);
+    const Tally t = tally(
+        c, ours, [](auto& m) { return m.x; }, [](auto& m) { return m.y; },
+        [](auto& m) { return m.angle; });
+    Tally n;
+    double nccMs = NAN;
+    if (!smoke) {
+      t0 = Stopwatch();
+      const auto theirs = bench::findByPyramidNcc(scene, templ, refCount, 0.6);
+      nccMs = msSince(t0);
+      n = tally(
+          c, theirs, [](auto& m) { return m.x; }, [](auto& m) { return m.y; },
+          [](auto& m) { return radians(m.angleDeg); });
+    }
+    std::printf(
+        "| %s (%d levels) | %d | %s | %d/%d/%d | %.2f, %.2f | %.3f | %.1f | %d/%d/%d | %.2f, %.2f "
+        "| "
+        "%.1f |\n",
+        c.name.c_str(), model.numLevels(), refCount, c.method.c_str(), t.found, t.missed, t.falses,
+        t.worstPos, t.worstAngle, t.lowestScore, ms, n.found, n.missed, n.falses, n.worstPos,
+        n.worstAngle, nccMs);
+    sum.found += t.found, sum.missed += t.missed, sum.falses += t.falses;
+    nccSum.found += n.found, nccSum.missed += n.missed, nccSum.falses += n.falses;
+  }
+  std::printf("| all | | | %d/%d/%d | | | | %d/%d/%d | | |\n", sum.found, sum.missed, sum.falses,
+              nccSum.found, nccSum.missed, nccSum.falses);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
+  bool smoke = false, photosOnly = false, speedOnly = false;
+  FindParams photoParams;  // the defaults; --greediness G to compare
+  std::filesystem::path data = std::filesystem::path(FACET_SOURCE_DIR) / "tests/data/photos";
+  for (int i = 1; i < argc; ++i) {
+    if (!std::strcmp(argv[i], "--smoke")) smoke = true;
+    if (!std::strcmp(argv[i], "--data") && i + 1 < argc) data = argv[++i];
+    if (!std::strcmp(argv[i], "--greediness") && i + 1 < argc)
+      photoParams.greediness = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--photos-only")) photosOnly = true;
+    if (!std::strcmp(argv[i], "--speed-only")) speedOnly = true;
+  }
+  const cv::Mat templ = testing::bracketTemplate();
+  const auto modelFile = std::filesystem::temp_directory_path() / "bench_shape_real.model";
+  {
+    const ShapeModel model = createShapeModel(templ);
+    saveShapeModel(model, modelFile);
+    std::printf("bench_shape_real%s: default bracket model, %d levels, %zu points\n",
+                smoke ? " --smoke" : "", model.numLevels(), model.levels[0].points.size());
+  }
+  {
+    // The process's very first search (thread pool, first allocations), for the record.
+    const ShapeModel model = loadShapeModel(modelFile);
+    const cv::Mat image = testing::bracketScene({640, 480}, {{320, 240, 0.3, 1.0}}, 1);
+    const Stopwatch t0;
+    (void)findShapeModel(image, model);
+    std::printf("first search of the process: %.2f ms\n", msSince(t0));
+  }
+  if (photosOnly) {
+    photoTable(data, smoke, photoParams);
+    return 0;
+  }
+  const int scenes = smoke ? 2 : 20;
+  std::printf(
+      "\n| defaults, bracket scenes | scenes | found | cold ms | warm ms | warm ms, greediness "
+      "0.9 | NCC found | NCC ms | NCC / warm | target "
+      "|\n|---|---|---|---|---|---|---|---|---|---|\n");
+  speedRow("640x480, 360 deg", {640, 480}, scenes, modelFile, templ, true,
+           "<= 4 ms warm, <= 6 ms cold");
+  speedRow("1280x1024, 360 deg", {1280, 1024}, scenes, modelFile, templ, !smoke, "<= 8 ms");
+  if (!smoke) largeRow(data, 1);
+  double load[1] = {NAN};
+  getloadavg(load, 1);
+  std::printf("load average at the end of the speed rows: %.1f\n", load[0]);
+  if (!speedOnly) photoTable(data, smoke, photoParams);
+  std::filesystem::remove(modelFile);
+  return 0;
+}

@@ -1,0 +1,132 @@
+// findShapeModel never makes things worse than it has to: early termination keeps every clear
+// part, the least-squares refinement never lowers the score of the pose it started from and
+// follows a part slightly larger than its template, and the full search returns the best of the
+// near-symmetric poses of a part.
+#include <algorithm>
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "tests/shape/bracket_scenes.hpp"
+
+namespace facet {
+namespace {
+
+using testing::bracketScene;
+using testing::bracketSpec;
+using testing::bracketTemplate;
+
+double positionError(const ShapeMatch& m, const Pose2D& truth) {
+  return std::hypot(m.x - truth.x, m.y - truth.y);
+}
+
+// The default early termination may abandon a pose only when it cannot reach minScore. A model
+// whose first tenth of points (in the order the search scores them) never matches still scores
+// about 0.9 on a clean part, well above the default 0.7: it must be found.
+TEST(FindShapeModelSafety, EarlyTerminationKeepsAClearPartWhosePrefixMisses) {
+  ShapeModel model = createShapeModel(bracketTemplate());
+  for (std::size_t l = 1; l < model.levels.size(); ++l) {
+    auto& points = model.levels[l].points;
+    const std::size_t spoiled = points.size() / 10;
+    for (std::size_t i = 0; i < spoiled; ++i)
+      points[i].direction = {-points[i].direction.y, points[i].direction.x};  // 90 deg off
+  }
+  {
+    auto& points = model.levels[0].points;
+    for (std::size_t i = 0; i < points.size() / 10; ++i)
+      points[i].direction = {-points[i].direction.y, points[i].direction.x};
+  }
+  const Pose2D truth{201.4, 152.7, radians(23.0), 1.0};
+  const auto matches = findShapeModel(bracketScene({400, 300}, {truth}, 5), model);
+  ASSERT_EQ(matches.size(), 1u);
+  EXPECT_LT(positionError(matches[0], truth), 0.1);
+  EXPECT_GT(matches[0].score, 0.85);
+}
+
+// A part 1% larger than its template (the model has no scale range): the refinement adjusts
+// the scale within its default tolerance, reports it, and keeps the position.
+TEST(FindShapeModelSafety, RefinementFollowsASlightlyLargerPart) {
+  const ShapeModel model = createShapeModel(bracketTemplate());
+  const Pose2D truth{200.3, 150.6, radians(-41.0), 1.01};
+  const cv::Mat image = bracketScene({400, 300}, {truth}, 8);
+  const auto ls = findShapeModel(image, model);
+  FindParams interp;
+  interp.subpixel = SubpixelMode::Interpolation;
+  const auto in = findShapeModel(image, model, interp);
+  ASSERT_EQ(ls.size(), 1u);
+  ASSERT_EQ(in.size(), 1u);
+  EXPECT_LT(positionError(ls[0], truth), 0.05);
+  EXPECT_NEAR(ls[0].scale, 1.01, 1e-3);
+  EXPECT_GE(ls[0].score, in[0].score);
+  // Without the tolerance the scale stays fixed, and the score still never falls below the
+  // start pose's.
+  FindParams fixed;
+  fixed.refineScaleTolerance = 0.0;
+  const auto f = findShapeModel(image, model, fixed);
+  ASSERT_EQ(f.size(), 1u);
+  EXPECT_DOUBLE_EQ(f[0].scale, 1.0);
+  EXPECT_GE(f[0].score, in[0].score - 1e-9);
+}
+
+// A part 4% larger than the template is beyond the default tolerance: the refinement may not
+// stretch the scale that far, and the pose it returns scores at least as well as its start.
+TEST(FindShapeModelSafety, RefinementNeverLowersTheScore) {
+  const ShapeModel model = createShapeModel(bracketTemplate());
+  for (const double scale : {0.97, 1.04}) {
+    const Pose2D truth{199.6, 149.2, radians(77.0), scale};
+    const cv::Mat image = bracketScene({400, 300}, {truth}, 9);
+    FindParams interp;
+    interp.subpixel = SubpixelMode::Interpolation;
+    interp.minScore = 0.5;
+    FindParams ls;
+    ls.minScore = 0.5;
+    const auto in = findShapeModel(image, model, interp);
+    const auto out = findShapeModel(image, model, ls);
+    ASSERT_EQ(in.size(), 1u) << scale;
+    ASSERT_EQ(out.size(), 1u) << scale;
+    EXPECT_GE(out[0].score, in[0].score - 1e-9) << scale;
+    EXPECT_LE(std::abs(out[0].scale - 1.0), 0.02 + 1e-9) << scale;
+  }
+}
+
+// A cross whose four arms differ by a few pixels: each quarter turn is a near match. The full
+// search must return the exact one.
+scene::PartDrawing nearSymmetricCross() {
+  scene::PartDrawing part;
+  scene::Primitive cross;
+  cross.kind = scene::Primitive::Kind::Polygon;
+  const double w = 11;  // half width of an arm
+  const double right = 60, left = 57, up = 58, down = 55;
+  cross.vertices = {{w, -up},   {w, -w}, {right, -w}, {right, w},  {w, w},   {w, down},
+                    {-w, down}, {-w, w}, {-left, w},  {-left, -w}, {-w, -w}, {-w, -up}};
+  part.primitives.push_back(cross);
+  part.templateSize = {140, 134};
+  return part;
+}
+
+TEST(FindShapeModelSafety, FullSearchReturnsTheBestOfNearSymmetricPoses) {
+  const scene::PartDrawing part = nearSymmetricCross();
+  const cv::Mat templ =
+      scene::templateScene(part, bracketSpec({}, 31), testing::kPartGrey).render();
+  const ShapeModel model = createShapeModel(templ);
+  int wrong = 0;
+  for (int k = 0; k < 8; ++k) {
+    const Pose2D truth{200.2 + k, 180.7 - k, radians(-170.0 + 45.3 * k), 1.0};
+    scene::Scene s(bracketSpec({400, 360}, 40 + k));
+    scene::placePart(s, part, truth, testing::kPartGrey, testing::kBackground);
+    const auto matches = findShapeModel(s.render(), model);
+    ASSERT_EQ(matches.size(), 1u) << "pose " << k;
+    const double da = degrees(wrapAngle(matches[0].angle - truth.angle));
+    if (std::abs(da) > 0.1 || positionError(matches[0], truth) > 0.1) {
+      ++wrong;
+      ADD_FAILURE() << "pose " << k << ": found " << degrees(matches[0].angle) << " deg at "
+                    << matches[0].x << ", " << matches[0].y << " (score " << matches[0].score
+                    << "), truth " << degrees(truth.angle) << " deg";
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+}
+
+}  // namespace
+}  // namespace facet
