@@ -44,6 +44,35 @@ void toPlateOrder(const cv::Mat& image8, int cols, int rows, std::vector<cv::Poi
     std::reverse(p.begin(), p.end());
 }
 
+// True when squares continue beyond the grid's border: the grid found is part of a larger board
+// (a board spec with fewer corners than the plate has). Samples the cells one row beyond each
+// side, where a right board has its plain margin; they alternate on a larger board.
+bool squaresBeyondBorder(const cv::Mat& image8, int cols, int rows,
+                         const std::vector<cv::Point2d>& p) {
+  auto at = [&](int c, int r) { return p[static_cast<std::size_t>(r * cols + c)]; };
+  const double dark = meanGrey(image8, (at(0, 0) + at(1, 1)) / 2, 2);
+  const double light = meanGrey(image8, (at(1, 0) + at(2, 1)) / 2, 2);
+  const double contrast = std::abs(light - dark);
+  const cv::Rect inside(2, 2, image8.cols - 4, image8.rows - 4);
+  // A side: corners a(i) along the border, b(i) their neighbours one row inwards.
+  const auto side = [&](auto a, auto b, int n) {
+    double lo = 1e9, hi = -1e9;
+    for (int i = 0; i + 1 < n; ++i) {
+      const cv::Point2d edge = (a(i) + a(i + 1)) / 2, inner = (b(i) + b(i + 1)) / 2;
+      const cv::Point2d beyond = edge + 1.5 * (edge - inner);
+      if (!inside.contains(cv::Point(cvRound(beyond.x), cvRound(beyond.y)))) continue;
+      const double g = meanGrey(image8, beyond, 0.15 * cv::norm(edge - inner));
+      lo = std::min(lo, g), hi = std::max(hi, g);
+    }
+    return hi > lo && hi - lo > 0.5 * contrast;
+  };
+  return side([&](int i) { return at(i, 0); }, [&](int i) { return at(i, 1); }, cols) ||
+         side([&](int i) { return at(i, rows - 1); }, [&](int i) { return at(i, rows - 2); },
+              cols) ||
+         side([&](int i) { return at(0, i); }, [&](int i) { return at(1, i); }, rows) ||
+         side([&](int i) { return at(cols - 1, i); }, [&](int i) { return at(cols - 2, i); }, rows);
+}
+
 struct EdgeCurve {
   cv::Point2d origin, along, across;  // local frame: along the line, across it
   double a = 0, b = 0, q = 0;         // across = a + b t + q t^2
@@ -189,6 +218,12 @@ PatternDetection detectChessboard(const cv::Mat& image, const BoardSpec& board) 
     return out;
   }
   out.points.assign(found.begin(), found.end());
+  if (squaresBeyondBorder(image8, board.cols, board.rows, out.points)) {
+    out.points.clear();
+    out.why = "the plate has more squares than " + std::to_string(board.cols) + "x" +
+              std::to_string(board.rows) + " inner corners (is the board spec right?)";
+    return out;
+  }
   toPlateOrder(image8, board.cols, board.rows, out.points);
   out.found = refineChessboardCorners(image, board.cols, board.rows, out.points, out.why);
   if (!out.found) out.points.clear();

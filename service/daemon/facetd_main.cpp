@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "service/daemon/http_server.hpp"
+#include "service/daemon/calibration_check.hpp"
 #include "service/daemon/station.hpp"
 #include "service/daemon/systemd_notifier.hpp"
 
@@ -119,6 +120,7 @@ int main(int argc, char** argv) {
     };
   }
   try {
+    service::checkCalibrationImageSize(stationConfig);
     service::Station station(stationConfig, options);
     const auto& httpConfig = station.config().http;
     service::HttpServer http(station, {.bindAddress = httpConfig.bind,

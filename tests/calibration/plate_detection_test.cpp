@@ -59,14 +59,9 @@ TEST(PlateDetection, WrongBoardSpecIsNotFoundWithAReason) {
   BoardSpec wrong = test::chessboard();
   wrong.cols = 9, wrong.rows = 6;
   const PlateView view = detectPlate(s.render(), wrong, "view");
-  // OpenCV may find a 9x6 sub-grid of an 11x8 board; the plate order check or the corner count
-  // then no longer matches the board: either not found, or found with a reason-free 54 points
-  // that lie on real corners. What must not happen is a crash or garbage points.
-  if (view.detection.found) {
-    EXPECT_EQ(view.detection.points.size(), 54u);
-  } else {
-    EXPECT_NE(view.detection.why.find("9x6"), std::string::npos) << view.detection.why;
-  }
+  // OpenCV may find a 9x6 part of the 11x8 board; the squares beyond its border give it away.
+  EXPECT_FALSE(view.detection.found);
+  EXPECT_NE(view.detection.why.find("9x6"), std::string::npos) << view.detection.why;
 }
 
 TEST(PlateDetection, HeavilyBlurredBoardIsSkippedWithAReason) {
