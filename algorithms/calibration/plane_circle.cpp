@@ -50,11 +50,14 @@ std::optional<PlaneCircle> fitCircle(const std::vector<cv::Point2d>& points) {
 
 std::optional<PlaneCircle> circleInPlane(const CircleMeasurement& m, const WorldMapping& mapping) {
   if (!m.ok() || m.inlierPoints.size() < 3) return std::nullopt;
-  // The edge points' own circle in the image; the difference to the measurement's (grey-value
-  // refined) radius is the edges' inward shift on this rim.
+  // The edge points' own circle in the image, for the outward direction of each point.
   const auto edges = fitCircle(m.inlierPoints);
   if (!edges) return std::nullopt;
-  const double shift = m.radius - edges->diameterMm / 2;
+  // Second-derivative edges on a blurred curved rim sit k / r inside it, k = (sigma^2 + 1.2) / 2
+  // for a Gaussian blur sigma (circle_measure.hpp); the grey-value fit measured sigma. (Its
+  // radius cannot be used directly: it fits a circle to what may be an ellipse in the image.)
+  const double k = m.greyRefined ? (m.blur * m.blur + 1.2) / 2 : CircleMeasureParams{}.radiusBiasK;
+  const double shift = k / m.radius;
   std::vector<cv::Point2d> plane;
   plane.reserve(m.inlierPoints.size());
   for (const auto& p : m.inlierPoints) {

@@ -4,8 +4,8 @@
 // at an angle or through a distorting lens is no circle in the image; in the plane it is.
 //
 // The edge points of a curved rim sit slightly inside it (second-derivative edges on a blurred
-// curve); CircleMeasure's grey-value refinement measures that shift in the image, and each point
-// is moved outwards by it before mapping.
+// curve, about k / r with k from the blur that CircleMeasure's grey-value fit measured); each
+// point is moved outwards by that before mapping.
 
 #include <optional>
 #include <vector>

@@ -17,6 +17,7 @@
 // best rigid placement on the truth, which favours it).
 //
 // Usage: bench_calibration [--smoke] [--views N] [--seed N]
+// --smoke: 8 chessboard views without lens blur, one hole scene (a few seconds' check).
 // --seed 1 (default) is the set the code was developed on; --seed 2 and up are held out.
 #include <algorithm>
 #include <chrono>
@@ -34,6 +35,7 @@
 #include "algorithms/calibration/field_coverage.hpp"
 #include "algorithms/calibration/plane_circle.hpp"
 #include "algorithms/circle/circle_measure.hpp"
+#include "tests/calibration/model_error.hpp"
 #include "tests/support/scene/calibration_plates.hpp"
 
 namespace {
@@ -56,6 +58,8 @@ struct View {
   std::vector<cv::Point2d> truth;
 };
 
+double lensBlur = 0.7;  // --smoke: 0 (renders about 5x faster)
+
 std::vector<View> renderViews(const BoardSpec& board, int count, std::uint64_t seed) {
   std::vector<View> views;
   const auto camera = trueCamera();
@@ -70,7 +74,7 @@ std::vector<View> renderViews(const BoardSpec& board, int count, std::uint64_t s
       scene::addChessboardPlate(s, board.cols, board.rows, board.pitchMm);
     else
       scene::addCirclePlate(s, board.cols, board.rows, board.pitchMm, board.diameterMm);
-    s.lensBlurSigma = 0.7;
+    s.lensBlurSigma = lensBlur;
     s.noiseSigma = 2.0;
     s.seed = seed * 7717 + static_cast<std::uint64_t>(i);
     views.push_back(
@@ -100,36 +104,8 @@ struct Row {
   CameraModel camera;
 };
 
-// RMS pixel distance, over the covered field, between a pixel and where the estimated camera
-// puts the true camera's ray through it, after the best rotation between the cameras (Kabsch).
 double modelError(const CameraModel& est, const scene::LensCamera& truth, const cv::Mat& covered) {
-  std::vector<Eigen::Vector3d> a, b;
-  std::vector<cv::Point2d> pixels;
-  const CameraModel t{truth.matrix(), truth.distortion(), truth.size};
-  for (int y = 8; y < covered.rows; y += 16)
-    for (int x = 8; x < covered.cols; x += 16) {
-      if (!covered.at<uchar>(y, x)) continue;
-      const cv::Point2d nt = t.undistort({double(x), double(y)}),
-                        ne = est.undistort({double(x), double(y)});
-      a.push_back(Eigen::Vector3d(nt.x, nt.y, 1).normalized());
-      b.push_back(Eigen::Vector3d(ne.x, ne.y, 1).normalized());
-      pixels.emplace_back(x, y);
-    }
-  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-  for (std::size_t i = 0; i < a.size(); ++i) H += a[i] * b[i].transpose();
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d R = svd.matrixV() * svd.matrixU().transpose();
-  if (R.determinant() < 0) {
-    Eigen::Matrix3d V = svd.matrixV();
-    V.col(2) *= -1;
-    R = V * svd.matrixU().transpose();
-  }
-  double sum = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const Eigen::Vector3d r = R * a[i];
-    sum += std::pow(cv::norm(est.project({r.x(), r.y(), r.z()}) - pixels[i]), 2);
-  }
-  return std::sqrt(sum / static_cast<double>(std::max<std::size_t>(a.size(), 1)));
+  return test::modelError(est, {truth.matrix(), truth.distortion(), truth.size}, covered);
 }
 
 Row solveAndScore(const std::string& method, const BoardSpec& board,
@@ -284,7 +260,7 @@ void benchHoles(const CameraModel& calibrated, std::uint64_t seed, bool smoke) {
     plate.placement = placement;
     plate.placement.translationMm = placement.toCamera({-50, -35});  // plate origin, centred
     scene::addChessboardPlate(plate, board.cols, board.rows, board.pitchMm);
-    plate.lensBlurSigma = 0.7, plate.noiseSigma = 2,
+    plate.lensBlurSigma = lensBlur, plate.noiseSigma = 2,
     plate.seed = seed * 31 + static_cast<std::uint64_t>(k);
     PlanePose pose;
     std::string why;
@@ -303,7 +279,7 @@ void benchHoles(const CameraModel& calibrated, std::uint64_t seed, bool smoke) {
     for (int j = 0; j < 2; ++j)
       for (int i = 0; i < 3; ++i) holes.push_back({-12.0 + 62.0 * i, -22.0 + 114.0 * j});
     for (const auto& h : holes) part.addDisc(h, 3.0, 30);
-    part.lensBlurSigma = 0.7, part.noiseSigma = 2,
+    part.lensBlurSigma = lensBlur, part.noiseSigma = 2,
     part.seed = seed * 97 + static_cast<std::uint64_t>(k);
     const cv::Mat image = part.render();
     const scene::LensCamera& c = camera;
@@ -384,7 +360,8 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (smoke) count = 8;
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  if (smoke) count = 8, lensBlur = 0;
   std::printf("bench_calibration: %d views per board, 1280x1024, seed %llu%s\n", count,
               static_cast<unsigned long long>(seed), smoke ? " (smoke)" : "");
   CameraModel chessCamera, circleCamera;
