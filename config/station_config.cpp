@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "config/calibration_file.hpp"
 #include "config/station_format.hpp"
 #include "config/yaml_document.hpp"
 #include "config/yaml_validation.hpp"
@@ -277,38 +278,33 @@ class StationReader {
       cal.file = *p;
       readCalibrationFile(c["file"], *p);
     }
-    if (cal.mmPerPixel <= 0 && !c["mm_per_pixel"])
+    if (cal.mmPerPixel <= 0 && !c["mm_per_pixel"] && !out_.hasErrors())
       error(c, "calibration needs 'mm_per_pixel' (here or in the calibration file)");
   }
 
   void readCalibrationFile(const YAML::Node& key, const std::filesystem::path& p) {
     Calibration& cal = station_.calibration;
-    try {
-      cv::FileStorage fs(p.string(), cv::FileStorage::READ);
-      if (!fs.isOpened()) {
-        error(key, "calibration file '" + key.Scalar() + "' cannot be opened by OpenCV");
-        return;
-      }
-      fs["camera_matrix"] >> cal.cameraMatrix;
-      fs["distortion_coefficients"] >> cal.distortion;
-      if (cal.mmPerPixel <= 0 && !fs["mm_per_pixel"].empty())
-        cal.mmPerPixel = static_cast<double>(fs["mm_per_pixel"]);
-    } catch (const cv::Exception& e) {
-      error(key, "calibration file '" + key.Scalar() + "' is not readable: " + e.msg);
+    Diagnostics problems;
+    const auto data = config::readCalibrationFile(p, problems);
+    // The calibration file's own problems name that file (and line); the station's key says
+    // which file it was.
+    out_.append(problems);
+    if (!data) {
+      error(key, "calibration file '" + key.Scalar() + "' is not usable (see above)");
       return;
     }
-    if (cal.cameraMatrix.rows != 3 || cal.cameraMatrix.cols != 3)
-      error(key, "calibration file '" + key.Scalar() + "' needs a 3x3 'camera_matrix'");
-    const int n = static_cast<int>(cal.distortion.total());
-    if (n != 4 && n != 5 && n != 8 && n != 12 && n != 14)
-      error(key, "calibration file '" + key.Scalar() +
-                     "' needs 'distortion_coefficients' with 4, 5, 8, 12 or 14 values (has " +
-                     std::to_string(n) + ")");
-    if (!cal.cameraMatrix.empty()) cal.cameraMatrix.convertTo(cal.cameraMatrix, CV_64F);
-    if (!cal.distortion.empty()) {
-      cal.distortion = cal.distortion.reshape(1, 1);
-      cal.distortion.convertTo(cal.distortion, CV_64F);
+    if (cal.mmPerPixel <= 0) cal.mmPerPixel = data->mmPerPixel;
+    if (data->camera) {
+      cal.cameraMatrix = cv::Mat(data->camera->cameraMatrix, true);
+      cal.distortion = data->camera->distortion.clone();
+      cal.imageSize = data->camera->imageSize;
     }
+    cal.plane = data->plane;
+    // With a plane, the scale-only fallback is the plane's scale at the image centre.
+    if (cal.mmPerPixel <= 0 && cal.plane && !cal.imageSize.empty())
+      if (const auto mapping = cal.worldMapping())
+        cal.mmPerPixel = mapping->mmPerPixelAt(
+            {(cal.imageSize.width - 1) / 2.0, (cal.imageSize.height - 1) / 2.0});
   }
 
   const std::filesystem::path& file_;
@@ -318,6 +314,17 @@ class StationReader {
 };
 
 }  // namespace
+
+std::string Calibration::kind() const {
+  if (!cameraMatrix.empty() && plane) return "lens model + plane";
+  if (!cameraMatrix.empty()) return "lens model, scale only";
+  return "scale only, no lens model";
+}
+
+std::optional<WorldMapping> Calibration::worldMapping() const {
+  if (cameraMatrix.empty() || !plane) return std::nullopt;
+  return WorldMapping(CameraModel{cv::Matx33d(cameraMatrix), distortion, imageSize}, *plane);
+}
 
 std::vector<RegisterUse> StationConfig::reservedRegisters() const {
   std::vector<RegisterUse> uses;

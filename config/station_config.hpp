@@ -12,6 +12,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/calibration/world_mapping.hpp"
+
 #include "camera/camera_settings.hpp"
 #include "config/diagnostic.hpp"
 #include "config/recipe_loader.hpp"
@@ -41,9 +43,16 @@ struct HttpSettings {
 
 struct Calibration {
   double mmPerPixel = 0.0;                    // millimetres per pixel in the part's plane, > 0
-  std::optional<std::filesystem::path> file;  // OpenCV calibration file, absolute
-  cv::Mat cameraMatrix;                       // 3x3 CV_64F; empty without a file
-  cv::Mat distortion;  // 1xN CV_64F (N = 4, 5, 8, 12 or 14); empty without a file
+  std::optional<std::filesystem::path> file;  // calibration file (config/calibration_file.hpp)
+  cv::Mat cameraMatrix;                       // 3x3 CV_64F; empty without a lens model
+  cv::Mat distortion;  // 1xN CV_64F (N = 4, 5, 8, 12 or 14); empty without a lens model
+  cv::Size imageSize;  // the frames the lens model was made for; empty when the file has none
+  std::optional<PlanePose> plane;  // the measuring plane, when the file has one
+
+  // "lens model + plane", "lens model, scale only" or "scale only, no lens model".
+  [[nodiscard]] std::string kind() const;
+  // Image <-> plane mm, when there is a lens model and a plane.
+  [[nodiscard]] std::optional<WorldMapping> worldMapping() const;
 };
 
 struct StationConfig {

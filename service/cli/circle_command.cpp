@@ -9,6 +9,7 @@
 
 #include "algorithms/circle/circle_measure.hpp"
 #include "service/cli/command_line.hpp"
+#include "service/cli/world_circle.hpp"
 
 namespace facet::cli {
 namespace {
@@ -20,6 +21,7 @@ struct CircleOptions {
   double width = CircleMeasureParams{}.width;
   std::string polarity = "any";
   double minCoverage = CircleMeasureParams{}.minCoverageDeg;
+  std::string calibration;  // calibration file: adds the circle in the measuring plane, mm
   bool json = false;
 };
 
@@ -61,21 +63,25 @@ void run(const CircleOptions& o) {
   if (m.has(CircleFailure::BadInput)) throw InputError(o.image + ": " + m.message);
   if (!m.ok()) throw MeasurementFailure(circleFailureCause(m.failures), o.image + ": " + m.message);
 
+  const nlohmann::json world =
+      o.calibration.empty() ? nlohmann::json() : worldCircle(o.calibration, image.size(), m);
   if (o.json) {
-    printJson({{"x", m.centre.x},
-               {"y", m.centre.y},
-               {"radius", m.radius},
-               {"diameter", m.diameter},
-               {"roundness", m.roundness},
-               {"rms", m.rms},
-               {"inliers", m.inliers},
-               {"coverage_deg", m.coverageDeg},
-               // Whether centre and radius come from the grey-value fit (and its blur) or, when
-               // that fit did not converge, from the edge points alone: an engineer judging a
-               // result needs to know which.
-               {"grey_refined", m.greyRefined},
-               {"blur", m.blur},
-               {"time_ms", ms}});
+    nlohmann::json out{{"x", m.centre.x},
+                       {"y", m.centre.y},
+                       {"radius", m.radius},
+                       {"diameter", m.diameter},
+                       {"roundness", m.roundness},
+                       {"rms", m.rms},
+                       {"inliers", m.inliers},
+                       {"coverage_deg", m.coverageDeg},
+                       // Whether centre and radius come from the grey-value fit (and its blur) or,
+                       // when that fit did not converge, from the edge points alone: an engineer
+                       // judging a result needs to know which.
+                       {"grey_refined", m.greyRefined},
+                       {"blur", m.blur},
+                       {"time_ms", ms}};
+    if (!world.is_null()) out["world"] = world;
+    printJson(out);
   } else {
     std::cout << "centre (" << m.centre.x << ", " << m.centre.y << ") px, radius " << m.radius
               << " px, diameter " << m.diameter << " px\nroundness " << m.roundness << " px, rms "
@@ -86,6 +92,11 @@ void run(const CircleOptions& o) {
                       : std::string("from the edge points only (grey-value fit did not "
                                     "converge)"))
               << "\n";
+    if (!world.is_null())
+      std::cout << "in the plane: centre (" << world["x_mm"].get<double>() << ", "
+                << world["y_mm"].get<double>() << ") mm, diameter "
+                << world["diameter_mm"].get<double>() << " mm ("
+                << world["calibration"].get<std::string>() << ")\n";
   }
 }
 
@@ -104,6 +115,8 @@ void addCircleCommand(CLI::App& app) {
                   "dark_to_light (dark inside), light_to_dark (light inside) or any (default)");
   cmd->add_option("--min-coverage", o->minCoverage,
                   "minimum angular coverage of the rim in degrees (default 180)");
+  cmd->add_option("--calibration", o->calibration,
+                  "calibration file (facet calibrate): adds the circle in the measuring plane, mm");
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o] { run(*o); });
 }

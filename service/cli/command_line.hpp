@@ -45,5 +45,6 @@ void addRecipeCommand(CLI::App& app, const config::StepKindRegistry& kinds);
 // The whole program (main.cpp), for the step kinds its recipes may use.
 int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds);
 void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds);
+void addCalibrateCommand(CLI::App& app);
 
 }  // namespace facet::cli

@@ -26,6 +26,7 @@ int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds) {
   addRegisterCommand(app);
   addRecipeCommand(app, kinds);
   addReplayCommand(app, kinds);
+  addCalibrateCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";

@@ -12,6 +12,7 @@
 
 #include "service/daemon/facetd_main.hpp"
 #include "service/daemon/http_server.hpp"
+#include "service/daemon/calibration_check.hpp"
 #include "service/daemon/station.hpp"
 #include "service/daemon/systemd_notifier.hpp"
 
@@ -121,6 +122,7 @@ int facet::service::runFacetd(int argc, char** argv, const config::StepKindRegis
     };
   }
   try {
+    service::checkCalibrationImageSize(stationConfig);
     service::Station station(stationConfig, kinds, options);
     const auto& httpConfig = station.config().http;
     service::HttpServer http(station, {.bindAddress = httpConfig.bind,

@@ -48,6 +48,10 @@ nlohmann::json Station::health() const {
                  {"reconnects", cam.reconnects},
                  {"skipped_files", cam.skipped_files},
                  {"last_error", cam.last_error}};
+  // "scale only, no lens model" tells the engineer that mm come from mm_per_pixel alone.
+  h["calibration"] = {{"kind", config_.calibration.kind()},
+                      {"mm_per_pixel", config_.calibration.mmPerPixel},
+                      {"file", config_.calibration.file ? config_.calibration.file->string() : ""}};
   bool degraded = false;
   if (plc_) {
     h["plc"] = plc_->health();

@@ -1,5 +1,6 @@
 #include "service/engine/steps/circle_step.hpp"
 
+#include "algorithms/calibration/plane_circle.hpp"
 #include "algorithms/registration/register_images.hpp"
 #include "config/recipe_format.hpp"
 #include "config/yaml_validation.hpp"
@@ -53,22 +54,40 @@ std::shared_ptr<const config::StepParams> CircleStep::read(config::StepReading& 
 StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   const auto& c = step.as<CircleParams>();
   const cv::Point2d expected = mapPoint(part.frameOf(c.relativeTo), c.centre);
+  // With a lens model and a measuring plane the rim is mapped into the plane and the circle
+  // fitted there, in mm; the search annulus uses the plane's scale at the expected centre.
+  const auto plane = part.calibration.worldMapping();
+  const double scale = plane ? plane->mmPerPixelAt(expected) : part.mmPerPixel();
   CircleMeasureParams p;
   p.centre = expected;
-  p.radius = c.nominalDiameter / 2.0 / part.mmPerPixel();
-  p.width = c.searchWidth / part.mmPerPixel();
+  p.radius = c.nominalDiameter / 2.0 / scale;
+  p.width = c.searchWidth / scale;
   p.polarity = c.polarity;
   const CircleMeasurement m = measureCircle(part.grey, p);
   part.overlay.circle(expected, std::max(1.0, p.radius - p.width), true, true);
   part.overlay.circle(expected, p.radius + p.width, true, true);
   if (!m.ok()) return StepResult::failed("circle not measured: " + circleFailureCause(m.failures));
   StepResult r;
-  r.values["diameter"] = m.diameter;
-  r.values["x"] = m.centre.x - expected.x;
-  r.values["y"] = m.centre.y - expected.y;
-  r.values["position"] = cv::norm(m.centre - expected);
-  r.values["roundness"] = m.roundness;
-  r.point = m.centre;
+  if (plane) {
+    const auto w = circleInPlane(m, *plane);
+    if (!w) return StepResult::failed("circle not measured: its rim does not map into the plane");
+    // Offsets along the plane's axes (the calibration plate's x and y), mm.
+    const cv::Point2d nominal = plane->toPlane(expected);
+    r.lengthsInMm = true;
+    r.values["diameter"] = w->diameterMm;
+    r.values["x"] = w->centreMm.x - nominal.x;
+    r.values["y"] = w->centreMm.y - nominal.y;
+    r.values["position"] = cv::norm(w->centreMm - nominal);
+    r.values["roundness"] = m.roundness * plane->mmPerPixelAt(m.centre);
+    r.point = plane->toImage(w->centreMm);
+  } else {
+    r.values["diameter"] = m.diameter;
+    r.values["x"] = m.centre.x - expected.x;
+    r.values["y"] = m.centre.y - expected.y;
+    r.values["position"] = cv::norm(m.centre - expected);
+    r.values["roundness"] = m.roundness;
+    r.point = m.centre;
+  }
   part.overlay.circle(m.centre, m.radius, true);
   part.overlay.cross(m.centre, 4, true);
   return r;

@@ -71,26 +71,44 @@ StepResult DistanceStep::run(const config::Step& step, StepContext& part) const 
   const auto& d = step.as<DistanceParams>();
   const StepResult& from = part.done.at(d.from);
   const StepResult& to = part.done.at(d.to);
+  // With a lens model and a measuring plane, points and lines are mapped into the plane and the
+  // distance or angle computed there, in mm and plane degrees.
+  const auto plane = part.calibration.worldMapping();
+  const auto where = [&](cv::Point2d p) { return plane ? plane->toPlane(p) : p; };
+  // A line's direction in the plane: the image direction (cos a, -sin a) mapped through two
+  // points 10 px apart; angles stay counter-clockwise as seen on screen.
+  const auto direction = [&](cv::Point2d p, double deg) {
+    const double a = radians(deg);
+    const cv::Point2d dir(std::cos(a), -std::sin(a));
+    if (!plane) return dir;
+    const cv::Point2d v = plane->toPlane(p + 10.0 * dir) - plane->toPlane(p);
+    return v / cv::norm(v);
+  };
   StepResult r;
+  r.lengthsInMm = plane.has_value();
   switch (d.measure) {
     case Measure::CentreToCentre:
       if (!from.point || !to.point) return StepResult::failed("a step gives no position");
-      r.values["distance"] = cv::norm(*from.point - *to.point);
+      r.values["distance"] = cv::norm(where(*from.point) - where(*to.point));
       part.overlay.polyline({*from.point, *to.point}, true);
       break;
     case Measure::PointToLine: {
       if (!from.point || !to.point || !to.angleDeg)
         return StepResult::failed("a step gives no line");
-      const double a = radians(*to.angleDeg);
-      const cv::Point2d dir(std::cos(a), -std::sin(a));
-      const cv::Point2d v = *from.point - *to.point;
+      const cv::Point2d dir = direction(*to.point, *to.angleDeg);
+      const cv::Point2d v = where(*from.point) - where(*to.point);
       r.values["distance"] = std::abs(v.x * dir.y - v.y * dir.x);
       break;
     }
-    case Measure::Angle:
+    case Measure::Angle: {
       if (!from.angleDeg || !to.angleDeg) return StepResult::failed("a step gives no orientation");
-      r.values["angle"] = degrees(wrapAngle(radians(*to.angleDeg - *from.angleDeg)));
+      // A direction maps into the plane where it lies; without a position, at the image centre.
+      const cv::Point2d centre((part.grey.cols - 1) / 2.0, (part.grey.rows - 1) / 2.0);
+      const cv::Point2d a = direction(from.point.value_or(centre), *from.angleDeg);
+      const cv::Point2d b = direction(to.point.value_or(centre), *to.angleDeg);
+      r.values["angle"] = degrees(wrapAngle(std::atan2(a.x * b.y - a.y * b.x, a.dot(b)) * -1.0));
       break;
+    }
   }
   return r;
 }

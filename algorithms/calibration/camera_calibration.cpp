@@ -1,0 +1,180 @@
+#include "algorithms/calibration/camera_calibration.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+#include <opencv2/calib3d.hpp>
+
+#include "algorithms/calibration/chessboard_corners.hpp"
+#include "algorithms/calibration/circle_marks.hpp"
+#include "algorithms/calibration/field_coverage.hpp"
+
+namespace facet {
+namespace {
+
+std::vector<cv::Point3f> plateFloat(const BoardSpec& board) {
+  std::vector<cv::Point3f> out;
+  for (const auto& p : board.platePoints()) out.emplace_back(p);
+  return out;
+}
+
+std::vector<cv::Point2f> imageFloat(const std::vector<cv::Point2d>& points) {
+  return {points.begin(), points.end()};
+}
+
+struct Solution {
+  CameraModel camera;
+  double rms = 0;
+  std::vector<cv::Mat> rvecs, tvecs;
+};
+
+Solution solve(const BoardSpec& board, cv::Size size,
+               const std::vector<std::vector<cv::Point2d>>& points) {
+  // OpenCV wants float points; float keeps 1e-4 px at 2000 px, two orders below the noise.
+  std::vector<std::vector<cv::Point3f>> objects(points.size(), plateFloat(board));
+  std::vector<std::vector<cv::Point2f>> images;
+  for (const auto& p : points) images.push_back(imageFloat(p));
+  Solution s;
+  cv::Mat K, D;
+  s.rms = cv::calibrateCamera(
+      objects, images, size, K, D, s.rvecs, s.tvecs, 0,
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
+  s.camera.cameraMatrix = cv::Matx33d(K);
+  s.camera.distortion = D.reshape(1, 1).clone();
+  s.camera.imageSize = size;
+  return s;
+}
+
+cv::Matx33d rotationOf(const cv::Mat& rvec) {
+  cv::Mat R;
+  cv::Rodrigues(rvec, R);
+  return cv::Matx33d(R);
+}
+
+std::string percent(double share) {
+  std::ostringstream o;
+  o.precision(0);
+  o << std::fixed << 100 * share << "%";
+  return o.str();
+}
+
+}  // namespace
+
+PlateView detectPlate(const cv::Mat& image, const BoardSpec& board, std::string name) {
+  PlateView view;
+  view.name = std::move(name);
+  if (board.kind == BoardSpec::Kind::Chessboard) {
+    view.detection = detectChessboard(image, board);
+  } else {
+    CircleMarks marks = detectCircleMarks(image, board);
+    view.detection = std::move(marks.detection);
+    view.rims = std::move(marks.rims);
+  }
+  return view;
+}
+
+CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
+                                  const std::vector<PlateView>& views,
+                                  const CalibrationOptions& options) {
+  CameraCalibration out;
+  std::vector<std::size_t> used;
+  for (std::size_t i = 0; i < views.size(); ++i) {
+    ViewFit fit;
+    fit.name = views[i].name;
+    fit.why = views[i].detection.why;
+    fit.points = views[i].detection.points;
+    if (views[i].detection.found) used.push_back(i);
+    out.views.push_back(std::move(fit));
+  }
+  if (static_cast<int>(used.size()) < options.minViews) {
+    out.why = "the pattern was found in " + std::to_string(used.size()) + " of " +
+              std::to_string(views.size()) + " images; at least " +
+              std::to_string(options.minViews) + " are needed";
+    return out;
+  }
+  std::vector<std::vector<cv::Point2d>> points, outlines;
+  for (std::size_t i : used) {
+    points.push_back(views[i].detection.points);
+    outlines.push_back(gridOutline(views[i].detection.points, board.cols, board.rows));
+  }
+  out.coverage = coveredShare(coveredField(imageSize, outlines));
+  if (out.coverage < options.minCoverage) {
+    out.why = "the views cover " + percent(out.coverage) + " of the image; at least " +
+              percent(options.minCoverage) + " are needed (move the plate into the corners)";
+    return out;
+  }
+  if (out.coverage < options.warnCoverage)
+    out.warning = "the views cover only " + percent(out.coverage) +
+                  " of the image: the lens model is extrapolated outside them";
+
+  Solution s = solve(board, imageSize, points);
+  if (board.kind == BoardSpec::Kind::Circles) {
+    // Re-centre every mark with the perspective-correct centre of the current solution.
+    for (int round = 0; round < 4; ++round) {
+      double moved = 0;
+      for (std::size_t k = 0; k < used.size(); ++k) {
+        CircleMarks marks{views[used[k]].detection, views[used[k]].rims};
+        auto centres = perspectiveCentres(marks, s.camera, rotationOf(s.rvecs[k]));
+        for (std::size_t j = 0; j < centres.size(); ++j)
+          moved = std::max(moved, cv::norm(centres[j] - points[k][j]));
+        points[k] = std::move(centres);
+      }
+      s = solve(board, imageSize, points);
+      if (moved < 1e-4) break;
+    }
+  }
+  out.camera = s.camera;
+  out.rmsPx = s.rms;
+  const auto plate = board.platePoints();
+  for (std::size_t k = 0; k < used.size(); ++k) {
+    ViewFit& fit = out.views[used[k]];
+    fit.used = true;
+    fit.points = points[k];
+    fit.rotation = rotationOf(s.rvecs[k]);
+    fit.translationMm = cv::Vec3d(s.tvecs[k].ptr<double>());
+    double sum = 0;
+    for (std::size_t j = 0; j < plate.size(); ++j) {
+      const cv::Vec3d c =
+          fit.rotation * cv::Vec3d(plate[j].x, plate[j].y, plate[j].z) + fit.translationMm;
+      const cv::Point2d r = points[k][j] - s.camera.project(c);
+      fit.residuals.push_back(r);
+      sum += r.dot(r);
+    }
+    fit.rmsPx = std::sqrt(sum / static_cast<double>(plate.size()));
+  }
+  if (out.rmsPx > options.maxRmsPx) {
+    out.why = "the RMS reprojection error is " + std::to_string(out.rmsPx) +
+              " px, above the limit of " + std::to_string(options.maxRmsPx) +
+              " px (wrong square size, a bent plate, or motion blur?)";
+    return out;
+  }
+  out.ok = true;
+  return out;
+}
+
+bool estimatePlanePose(const BoardSpec& board, const CameraModel& camera, const PlateView& view,
+                       double offsetMm, PlanePose& pose, std::string& why) {
+  if (!view.detection.found) {
+    why = view.name + ": " + view.detection.why;
+    return false;
+  }
+  std::vector<cv::Point2d> points = view.detection.points;
+  cv::Mat rvec, tvec;
+  std::vector<cv::Point3d> plate = board.platePoints();
+  const cv::Mat K(camera.cameraMatrix);
+  cv::solvePnP(plate, points, K, camera.distortion, rvec, tvec, false, cv::SOLVEPNP_IPPE);
+  if (board.kind == BoardSpec::Kind::Circles) {
+    CircleMarks marks{view.detection, view.rims};
+    points = perspectiveCentres(marks, camera, rotationOf(rvec));
+  }
+  cv::solvePnPRefineLM(
+      plate, points, K, camera.distortion, rvec, tvec,
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
+  pose.rotation = rotationOf(rvec);
+  pose.translationMm = cv::Vec3d(tvec.ptr<double>());
+  pose.offsetMm = offsetMm;
+  return true;
+}
+
+}  // namespace facet

@@ -1,0 +1,233 @@
+#include "algorithms/calibration/chessboard_corners.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/edges/subpixel_edges.hpp"
+
+namespace facet {
+namespace {
+
+cv::Mat to8Bit(const cv::Mat& image) {
+  if (image.depth() == CV_8U) return image;
+  cv::Mat out;
+  image.convertTo(out, CV_8U, 1.0 / 256.0);
+  return out;
+}
+
+double meanGrey(const cv::Mat& image8, cv::Point2d centre, double radius) {
+  const int r = std::max(1, static_cast<int>(radius));
+  const cv::Rect box =
+      cv::Rect(cvRound(centre.x) - r, cvRound(centre.y) - r, 2 * r + 1, 2 * r + 1) &
+      cv::Rect(0, 0, image8.cols, image8.rows);
+  if (box.empty()) return 128.0;
+  return cv::mean(image8(box))[0];
+}
+
+// Puts OpenCV's grid into the plate's order: right-handed as seen by the camera (x right of y
+// turns clockwise on screen, like the image axes), the dark outer square at the origin.
+void toPlateOrder(const cv::Mat& image8, int cols, int rows, std::vector<cv::Point2d>& p) {
+  auto at = [&](int c, int r) -> cv::Point2d& { return p[static_cast<std::size_t>(r * cols + c)]; };
+  const cv::Point2d ex = at(1, 0) - at(0, 0), ey = at(0, 1) - at(0, 0);
+  if (ex.cross(ey) < 0)
+    for (int r = 0; r < rows; ++r) std::reverse(&at(0, r), &at(0, r) + cols);
+  const auto outerGrey = [&](int c, int r, int dc, int dr) {
+    const cv::Point2d sx = at(c + dc, r) - at(c, r), sy = at(c, r + dr) - at(c, r);
+    const cv::Point2d centre = at(c, r) - 0.5 * sx - 0.5 * sy;
+    return meanGrey(image8, centre, 0.15 * std::min(cv::norm(sx), cv::norm(sy)));
+  };
+  if (outerGrey(0, 0, 1, 1) > outerGrey(cols - 1, rows - 1, -1, -1))
+    std::reverse(p.begin(), p.end());
+}
+
+// True when squares continue beyond the grid's border: the grid found is part of a larger board
+// (a board spec with fewer corners than the plate has). Samples the cells one row beyond each
+// side, where a right board has its plain margin; they alternate on a larger board.
+bool squaresBeyondBorder(const cv::Mat& image8, int cols, int rows,
+                         const std::vector<cv::Point2d>& p) {
+  auto at = [&](int c, int r) { return p[static_cast<std::size_t>(r * cols + c)]; };
+  const double dark = meanGrey(image8, (at(0, 0) + at(1, 1)) / 2, 2);
+  const double light = meanGrey(image8, (at(1, 0) + at(2, 1)) / 2, 2);
+  const double contrast = std::abs(light - dark);
+  const cv::Rect inside(2, 2, image8.cols - 4, image8.rows - 4);
+  // A side: corners a(i) along the border, b(i) their neighbours one row inwards.
+  const auto side = [&](auto a, auto b, int n) {
+    double lo = 1e9, hi = -1e9;
+    for (int i = 0; i + 1 < n; ++i) {
+      const cv::Point2d edge = (a(i) + a(i + 1)) / 2, inner = (b(i) + b(i + 1)) / 2;
+      const cv::Point2d beyond = edge + 1.5 * (edge - inner);
+      if (!inside.contains(cv::Point(cvRound(beyond.x), cvRound(beyond.y)))) continue;
+      const double g = meanGrey(image8, beyond, 0.15 * cv::norm(edge - inner));
+      lo = std::min(lo, g), hi = std::max(hi, g);
+    }
+    return hi > lo && hi - lo > 0.5 * contrast;
+  };
+  return side([&](int i) { return at(i, 0); }, [&](int i) { return at(i, 1); }, cols) ||
+         side([&](int i) { return at(i, rows - 1); }, [&](int i) { return at(i, rows - 2); },
+              cols) ||
+         side([&](int i) { return at(0, i); }, [&](int i) { return at(1, i); }, rows) ||
+         side([&](int i) { return at(cols - 1, i); }, [&](int i) { return at(cols - 2, i); }, rows);
+}
+
+struct EdgeCurve {
+  cv::Point2d origin, along, across;  // local frame: along the line, across it
+  double a = 0, b = 0, q = 0;         // across = a + b t + q t^2
+  [[nodiscard]] cv::Point2d point(double t) const {
+    return origin + t * along + (a + b * t + q * t * t) * across;
+  }
+  [[nodiscard]] cv::Point2d tangent(double t) const { return along + (b + 2 * q * t) * across; }
+};
+
+// Least-squares quadratic through the points of one line; one pass drops points more than
+// 3 RMS (at least 0.2 px) off. False when either side of the corner has fewer than 4 points.
+bool fitCurve(const std::vector<cv::Point2d>& pts, EdgeCurve& curve) {
+  std::vector<double> t, e;
+  for (const auto& p : pts) {
+    t.push_back((p - curve.origin).dot(curve.along));
+    e.push_back((p - curve.origin).dot(curve.across));
+  }
+  std::vector<char> keep(pts.size(), 1);
+  for (int pass = 0; pass < 2; ++pass) {
+    int neg = 0, pos = 0, n = 0;
+    for (std::size_t i = 0; i < t.size(); ++i)
+      if (keep[i]) (t[i] < 0 ? neg : pos)++, ++n;
+    if (neg < 4 || pos < 4) return false;
+    Eigen::MatrixXd A(n, 3);
+    Eigen::VectorXd y(n);
+    for (std::size_t i = 0, k = 0; i < t.size(); ++i) {
+      if (!keep[i]) continue;
+      A.row(static_cast<Eigen::Index>(k)) << 1.0, t[i], t[i] * t[i];
+      y(static_cast<Eigen::Index>(k++)) = e[i];
+    }
+    const Eigen::Vector3d c = A.colPivHouseholderQr().solve(y);
+    curve.a = c(0), curve.b = c(1), curve.q = c(2);
+    if (pass == 1) break;
+    const double rms = std::sqrt((A * c - y).squaredNorm() / n);
+    const double limit = std::max(3 * rms, 0.2);
+    for (std::size_t i = 0; i < t.size(); ++i)
+      keep[i] = std::abs(e[i] - (c(0) + c(1) * t[i] + c(2) * t[i] * t[i])) <= limit;
+  }
+  return true;
+}
+
+std::optional<cv::Point2d> intersect(const EdgeCurve& u, const EdgeCurve& v, cv::Point2d start) {
+  cv::Point2d p = start;
+  for (int it = 0; it < 8; ++it) {
+    const double tu = (p - u.origin).dot(u.along), tv = (p - v.origin).dot(v.along);
+    const cv::Point2d pu = u.point(tu), du = u.tangent(tu), pv = v.point(tv), dv = v.tangent(tv);
+    // pu + s du = pv + w dv
+    const double det = du.cross(-dv);
+    if (std::abs(det) < 1e-9) return std::nullopt;
+    const cv::Point2d rhs = pv - pu;
+    const double s = rhs.cross(-dv) / det;
+    const cv::Point2d next = pu + s * du;
+    const double step = cv::norm(next - p);
+    p = next;
+    if (step < 1e-9) break;
+  }
+  return p;
+}
+
+}  // namespace
+
+bool refineChessboardCorners(const cv::Mat& image, int cols, int rows,
+                             std::vector<cv::Point2d>& corners, std::string& why) {
+  auto at = [&](int c, int r) { return corners[static_cast<std::size_t>(r * cols + c)]; };
+  std::vector<cv::Point2d> refined(corners.size());
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      const cv::Point2d p = at(c, r);
+      const cv::Point2d xa = c > 0 ? at(c - 1, r) : p, xb = c + 1 < cols ? at(c + 1, r) : p;
+      const cv::Point2d ya = r > 0 ? at(c, r - 1) : p, yb = r + 1 < rows ? at(c, r + 1) : p;
+      double spacing = 1e9;
+      for (const cv::Point2d& n : {xa, xb, ya, yb})
+        if (n != p) spacing = std::min(spacing, cv::norm(n - p));
+      const cv::Point2d dx = (xb - xa) / cv::norm(xb - xa), dy = (yb - ya) / cv::norm(yb - ya);
+      const double sine = std::max(std::abs(dx.cross(dy)), 0.3);
+      // The edges' profile fit looks up to 6.5 px across and 3 px along an edge, and the blurred
+      // X bends the edges out to about 3 sigma from the junction: edge points of one line are
+      // clean where the other line (at the corner, and at the neighbouring corners) is farther
+      // than that, measured across the narrower of the X's angles.
+      const int probe = static_cast<int>(std::ceil(0.5 * spacing));
+      EdgeParams params;
+      params.roi =
+          cv::Rect(cvRound(p.x) - probe, cvRound(p.y) - probe, 2 * probe + 1, 2 * probe + 1);
+      EdgeContours edges = detectSubpixelEdges(image, params);
+      const double inner = (6.75 + 3.0 * edges.blurSigma) / sine + 1.0;
+      const double outer = spacing - inner;
+      if (outer < inner + 4.0) {
+        why = "squares too small for the blur and the view angle (" + std::to_string(spacing) +
+              " px between corners, edge blur sigma " + std::to_string(edges.blurSigma) + " px)";
+        return false;
+      }
+      const int half = static_cast<int>(std::ceil(outer)) + 1;
+      if (half > probe) {
+        params.roi = cv::Rect(cvRound(p.x) - half, cvRound(p.y) - half, 2 * half + 1, 2 * half + 1);
+        edges = detectSubpixelEdges(image, params);
+      }
+      EdgeCurve lx{p, dx, {-dx.y, dx.x}}, ly{p, dy, {-dy.y, dy.x}};
+      std::vector<cv::Point2d> onX, onY;
+      for (const EdgePoint& e : edges.points) {
+        const cv::Point2d d = e.position - p;
+        const double dist = cv::norm(d);
+        if (dist < inner || dist > outer) continue;
+        // An edge point of the line along dx has its normal across dx, and lies near that line.
+        if (std::abs(e.normal.dot(dx)) < 0.34 && std::abs(d.dot(lx.across)) < 2.5)
+          onX.push_back(e.position);
+        else if (std::abs(e.normal.dot(dy)) < 0.34 && std::abs(d.dot(ly.across)) < 2.5)
+          onY.push_back(e.position);
+      }
+      std::optional<cv::Point2d> q;
+      if (fitCurve(onX, lx) && fitCurve(onY, ly)) q = intersect(lx, ly, p);
+      if (!q || cv::norm(*q - p) > 2.0) {
+        why = "corner (" + std::to_string(c) + ", " + std::to_string(r) +
+              ") has too few clean edge points on its two lines (blurred or partly hidden?)";
+        return false;
+      }
+      refined[static_cast<std::size_t>(r * cols + c)] = *q;
+    }
+  }
+  corners = std::move(refined);
+  return true;
+}
+
+PatternDetection detectChessboard(const cv::Mat& image, const BoardSpec& board) {
+  PatternDetection out;
+  const cv::Mat image8 = to8Bit(image);
+  // The grid only needs to be found to within a pixel or two (the refinement does the rest):
+  // large images are searched at half size, where OpenCV's detectors run about 4x faster.
+  const bool halve = image8.cols > 800;
+  cv::Mat coarse = image8;
+  if (halve) cv::resize(image8, coarse, {}, 0.5, 0.5, cv::INTER_AREA);
+  std::vector<cv::Point2f> found;
+  const cv::Size grid(board.cols, board.rows);
+  bool ok = cv::findChessboardCorners(
+      coarse, grid, found,
+      cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE | cv::CALIB_CB_FAST_CHECK);
+  if (!ok) ok = cv::findChessboardCornersSB(coarse, grid, found, cv::CALIB_CB_NORMALIZE_IMAGE);
+  if (ok && halve)
+    for (auto& f : found) f = f * 2.0f + cv::Point2f(0.5f, 0.5f);
+  if (!ok) {
+    out.why = "no chessboard of " + std::to_string(board.cols) + "x" + std::to_string(board.rows) +
+              " inner corners found (wrong board spec, board partly outside the image, or too "
+              "blurred)";
+    return out;
+  }
+  out.points.assign(found.begin(), found.end());
+  if (squaresBeyondBorder(image8, board.cols, board.rows, out.points)) {
+    out.points.clear();
+    out.why = "the plate has more squares than " + std::to_string(board.cols) + "x" +
+              std::to_string(board.rows) + " inner corners (is the board spec right?)";
+    return out;
+  }
+  toPlateOrder(image8, board.cols, board.rows, out.points);
+  out.found = refineChessboardCorners(image, board.cols, board.rows, out.points, out.why);
+  if (!out.found) out.points.clear();
+  return out;
+}
+
+}  // namespace facet

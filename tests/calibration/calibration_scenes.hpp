@@ -1,0 +1,45 @@
+#pragma once
+// Rendered plate views shared by the calibration tests.
+#include <cstdint>
+#include <vector>
+
+#include <opencv2/core.hpp>
+
+#include "algorithms/calibration/board_spec.hpp"
+#include "tests/support/scene/calibration_plates.hpp"
+
+namespace facet::test {
+
+inline scene::LensCamera testCamera() {
+  scene::LensCamera c;
+  c.fx = 1500, c.fy = 1502, c.cx = 645.2, c.cy = 508.7;
+  c.k1 = -0.22, c.k2 = 0.08, c.p1 = 0.0012, c.p2 = -0.0008;
+  return c;
+}
+
+inline scene::PlaneScene plateScene(const BoardSpec& board, const scene::LensCamera& camera,
+                                    std::uint64_t seed, int index, double noise = 2.0) {
+  scene::PlaneScene s;
+  s.camera = camera;
+  const double margin =
+      board.kind == BoardSpec::Kind::Chessboard ? 2 * board.pitchMm : board.pitchMm;
+  s.placement = scene::seriesPlacement(
+      camera, {(board.cols - 1) * board.pitchMm, (board.rows - 1) * board.pitchMm}, margin, seed,
+      index);
+  if (board.kind == BoardSpec::Kind::Chessboard)
+    scene::addChessboardPlate(s, board.cols, board.rows, board.pitchMm);
+  else
+    scene::addCirclePlate(s, board.cols, board.rows, board.pitchMm, board.diameterMm);
+  s.noiseSigma = noise;
+  s.seed = seed * 7717 + static_cast<std::uint64_t>(index);
+  return s;
+}
+
+inline BoardSpec chessboard() {
+  return {BoardSpec::Kind::Chessboard, 11, 8, 10.0, 0.0};
+}
+inline BoardSpec circleGrid() {
+  return {BoardSpec::Kind::Circles, 9, 7, 12.0, 6.0};
+}
+
+}  // namespace facet::test

@@ -1,0 +1,90 @@
+// Calibration from rendered views against the renderer's camera.
+#include "algorithms/calibration/camera_calibration.hpp"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/calibration/field_coverage.hpp"
+#include "tests/calibration/calibration_scenes.hpp"
+#include "tests/calibration/model_error.hpp"
+
+namespace facet {
+namespace {
+
+std::vector<PlateView> renderViews(const BoardSpec& board, const scene::LensCamera& camera, int n,
+                                   std::uint64_t seed) {
+  std::vector<PlateView> views;
+  for (int i = 0; i < n; ++i)
+    views.push_back(detectPlate(test::plateScene(board, camera, seed, i).render(), board,
+                                "view" + std::to_string(i)));
+  return views;
+}
+
+cv::Mat covered(const CameraCalibration& c, cv::Size size) {
+  std::vector<std::vector<cv::Point2d>> outlines;
+  for (const auto& v : c.views)
+    if (v.used) outlines.push_back(v.points);
+  // The convex hull of each view's points is its outline.
+  for (auto& o : outlines) {
+    std::vector<cv::Point2f> f(o.begin(), o.end()), hull;
+    cv::convexHull(f, hull);
+    o.assign(hull.begin(), hull.end());
+  }
+  return coveredField(size, outlines);
+}
+
+void expectCamera(const CameraCalibration& c, const scene::LensCamera& truth) {
+  ASSERT_TRUE(c.ok) << c.why;
+  EXPECT_LT(c.rmsPx, 0.1);
+  EXPECT_NEAR(c.camera.cameraMatrix(0, 0), truth.fx, 0.005 * truth.fx);
+  EXPECT_NEAR(c.camera.cameraMatrix(1, 1), truth.fy, 0.005 * truth.fy);
+  EXPECT_NEAR(c.camera.cameraMatrix(0, 2), truth.cx, 3.0);
+  EXPECT_NEAR(c.camera.cameraMatrix(1, 2), truth.cy, 3.0);
+  EXPECT_NEAR(c.camera.distortion.at<double>(0), truth.k1, 0.02);
+  // Where it matters: the estimated camera puts the true camera's rays where it does.
+  const cv::Mat all(truth.size, CV_8U, cv::Scalar(255));
+  const double error = test::modelError(c.camera, {truth.matrix(), truth.distortion(), truth.size},
+                                        covered(c, truth.size));
+  std::printf("model error over the covered field %.4f px (whole field %.4f px)\n", error,
+              test::modelError(c.camera, {truth.matrix(), truth.distortion(), truth.size}, all));
+  EXPECT_LT(error, 0.05);
+}
+
+TEST(CameraCalibration, ChessboardViewsGiveTheRenderedCamera) {
+  const auto camera = test::testCamera();
+  const auto c = calibrateCamera(test::chessboard(), camera.size,
+                                 renderViews(test::chessboard(), camera, 10, 21));
+  expectCamera(c, camera);
+  EXPECT_GT(c.coverage, 0.3);
+}
+
+TEST(CameraCalibration, CircleGridViewsGiveTheRenderedCamera) {
+  const auto camera = test::testCamera();
+  const auto c = calibrateCamera(test::circleGrid(), camera.size,
+                                 renderViews(test::circleGrid(), camera, 10, 22));
+  expectCamera(c, camera);
+}
+
+TEST(CameraCalibration, RefusesTooFewViewsNamingTheCount) {
+  const auto camera = test::testCamera();
+  const auto c = calibrateCamera(test::chessboard(), camera.size,
+                                 renderViews(test::chessboard(), camera, 5, 23));
+  EXPECT_FALSE(c.ok);
+  EXPECT_NE(c.why.find("5 of 5"), std::string::npos) << c.why;
+  EXPECT_NE(c.why.find("at least 8"), std::string::npos) << c.why;
+}
+
+TEST(CameraCalibration, RefusesAnRmsAboveTheLimit) {
+  const auto camera = test::testCamera();
+  CalibrationOptions strict;
+  strict.maxRmsPx = 1e-6;
+  const auto c = calibrateCamera(test::chessboard(), camera.size,
+                                 renderViews(test::chessboard(), camera, 8, 24), strict);
+  EXPECT_FALSE(c.ok);
+  EXPECT_NE(c.why.find("RMS"), std::string::npos) << c.why;
+}
+
+}  // namespace
+}  // namespace facet

@@ -1,0 +1,77 @@
+// Pattern points found in rendered plate views, against the renderer's exact projections.
+#include <cmath>
+
+#include <gtest/gtest.h>
+#include <opencv2/calib3d.hpp>
+
+#include "algorithms/calibration/camera_calibration.hpp"
+#include "algorithms/calibration/circle_marks.hpp"
+#include "tests/calibration/calibration_scenes.hpp"
+
+namespace facet {
+namespace {
+
+double rmsError(const std::vector<cv::Point2d>& a, const std::vector<cv::Point2d>& b) {
+  double s = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) s += std::pow(cv::norm(a[i] - b[i]), 2);
+  return std::sqrt(s / static_cast<double>(a.size()));
+}
+
+TEST(PlateDetection, ChessboardCornersInPlateOrderAndSubpixel) {
+  const BoardSpec board = test::chessboard();
+  for (int i = 0; i < 3; ++i) {
+    const auto s = test::plateScene(board, test::testCamera(), 11, i);
+    const auto truth = scene::patternImagePoints(s, board.cols, board.rows, board.pitchMm);
+    const PlateView view = detectPlate(s.render(), board, "view");
+    ASSERT_TRUE(view.detection.found) << view.detection.why;
+    ASSERT_EQ(view.detection.points.size(), truth.size());
+    // Plate order: the first point is the origin, not a corner of the other end.
+    EXPECT_LT(cv::norm(view.detection.points[0] - truth[0]), 0.5);
+    const double rms = rmsError(view.detection.points, truth);
+    std::printf("view %d: corner RMS %.4f px\n", i, rms);
+    EXPECT_LT(rms, 0.05);
+  }
+}
+
+TEST(PlateDetection, CircleCentresArePerspectiveCorrectWithTheTrueCamera) {
+  const BoardSpec board = test::circleGrid();
+  const auto camera = test::testCamera();
+  for (int i = 0; i < 3; ++i) {
+    const auto s = test::plateScene(board, camera, 12, i);
+    const auto truth = scene::patternImagePoints(s, board.cols, board.rows, board.pitchMm);
+    const cv::Mat image = s.render();
+    const CircleMarks marks = detectCircleMarks(image, board);
+    ASSERT_TRUE(marks.detection.found) << marks.detection.why;
+    EXPECT_LT(cv::norm(marks.detection.points[0] - truth[0]), 1.0);
+    const double ellipseRms = rmsError(marks.detection.points, truth);
+    CameraModel model{camera.matrix(), camera.distortion(), camera.size};
+    const auto centres = perspectiveCentres(marks, model, s.placement.rotation);
+    const double rms = rmsError(centres, truth);
+    std::printf("view %d: ellipse centres %.4f px, perspective centres %.4f px\n", i, ellipseRms,
+                rms);
+    EXPECT_LT(rms, 0.03);
+    EXPECT_LT(rms, ellipseRms);
+  }
+}
+
+TEST(PlateDetection, WrongBoardSpecIsNotFoundWithAReason) {
+  const auto s = test::plateScene(test::chessboard(), test::testCamera(), 11, 0);
+  BoardSpec wrong = test::chessboard();
+  wrong.cols = 9, wrong.rows = 6;
+  const PlateView view = detectPlate(s.render(), wrong, "view");
+  // OpenCV may find a 9x6 part of the 11x8 board; the squares beyond its border give it away.
+  EXPECT_FALSE(view.detection.found);
+  EXPECT_NE(view.detection.why.find("9x6"), std::string::npos) << view.detection.why;
+}
+
+TEST(PlateDetection, HeavilyBlurredBoardIsSkippedWithAReason) {
+  auto s = test::plateScene(test::chessboard(), test::testCamera(), 11, 0);
+  s.lensBlurSigma = 12;
+  s.fineFactor = 1;  // blur on the pixel grid: this test is about the refusal, not the model
+  const PlateView view = detectPlate(s.render(), test::chessboard(), "view");
+  EXPECT_FALSE(view.detection.found);
+  EXPECT_FALSE(view.detection.why.empty());
+}
+
+}  // namespace
+}  // namespace facet
