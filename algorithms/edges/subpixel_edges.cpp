@@ -106,7 +106,10 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   // Profile refinement where its window fits in the image, with one blur width per image.
   EdgeProfileParams profile;
   if (params.fitProfile) {
-    profile.width = estimateEdgeWidth(image, seeds, profile);
+    const EdgeBlur blur = estimateEdgeBlur(image, seeds, profile);
+    profile.width = blur.width;
+    profile.blurOnPixelGrid = blur.onPixelGrid;
+    result.blurOnPixelGrid = blur.onPixelGrid;
     result.blurSigma = std::sqrt(std::max(profile.width * profile.width - 1.0 / 12, 0.0));
     // What separates the offset from the background level is the plateau on either side; keep
     // about 4 widths of it in the window when the blur is wide.

@@ -52,6 +52,9 @@ struct EdgeContours {
   // Blur (Gaussian sigma, pixels, without the pixel aperture) estimated from the edges' profiles;
   // 0 when the profile fit is off or there were no edges.
   double blurSigma = 0;
+  // Where that blur acted, as the profiles tell: true = on the sampled image (a blur filter),
+  // false = before pixel integration (a lens); see EdgeProfileParams::blurOnPixelGrid.
+  bool blurOnPixelGrid = false;
   double lowThreshold = 0;  // thresholds actually used
   double highThreshold = 0;
 };

@@ -55,18 +55,19 @@ cv::Mat renderLensBlurred(const std::vector<Primitive>& primitives, const SceneS
   cv::Mat out(spec.size, CV_64F);
   constexpr int kBand = 16;  // output rows per band
   std::vector<double> rowOut(static_cast<size_t>(width));
+  cv::Mat fine, across;  // reused by every band
   for (int j0 = 0; j0 < height; j0 += kBand) {
     const int j1 = std::min(height, j0 + kBand);
     // Fine rows and columns every output pixel of the band reads.
     const cv::Rect window((0 - reach) * s, (j0 - reach) * s, (width + 2 * reach) * s,
                           (j1 - j0 + 2 * reach) * s);
-    const cv::Mat fine = paintCoverage(primitives, window, spec.background, s, subrows);
+    paintCoverageInto(primitives, window, spec.background, s, subrows, fine);
     // Along x: H(r, i) = sum_d w[d] F(r, i s + d). By parts, with C_d the cumulative weights
     // (1 left of the kernel, 0 right of it): H = F(first) + sum_d C_d (F(d) - F(d - 1)), and
     // the differences vanish except at edges, so each row costs its length plus its edges.
     std::vector<double> tail(static_cast<size_t>(n) + 1, 0.0);  // tail[d] = sum_{e >= d} w[e]
     for (int d = n - 1; d >= 0; --d) tail[d] = tail[d + 1] + k.w[d];
-    cv::Mat across(fine.rows, width, CV_64F);
+    across.create(fine.rows, width, CV_64F);
     for (int r = 0; r < fine.rows; ++r) {
       const double* f = fine.ptr<double>(r);
       double* h = across.ptr<double>(r);

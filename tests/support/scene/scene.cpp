@@ -73,7 +73,15 @@ cv::Mat renderCoverage(const Primitive& primitive, cv::Size size, int subrows) {
 }
 
 cv::Mat renderCoverage(const Primitive& primitive, const cv::Rect& window, int subrows) {
-  cv::Mat coverage = cv::Mat::zeros(window.size(), CV_64F);
+  cv::Mat coverage;
+  renderCoverageInto(primitive, window, subrows, coverage);
+  return coverage;
+}
+
+void renderCoverageInto(const Primitive& primitive, const cv::Rect& window, int subrows,
+                        cv::Mat& coverage) {
+  coverage.create(window.size(), CV_64F);
+  coverage.setTo(0.0);
   const cv::Rect2d box = boundingBox(primitive);
   const int r0 = std::max(window.y, static_cast<int>(std::floor(box.y + 0.5)));
   const int r1 = std::min(window.y + window.height - 1,
@@ -97,7 +105,6 @@ cv::Mat renderCoverage(const Primitive& primitive, const cv::Rect& window, int s
       row[c] += run;
     }
   }
-  return coverage;
 }
 
 Primitive scaled(const Primitive& primitive, int scale) {
@@ -236,7 +243,16 @@ cv::Mat Scene::renderIdeal() const {
 
 cv::Mat paintCoverage(const std::vector<Primitive>& primitives, const cv::Rect& window,
                       double background, int scale, int subrows) {
-  cv::Mat image(window.size(), CV_64F, cv::Scalar(background));
+  cv::Mat image;
+  paintCoverageInto(primitives, window, background, scale, subrows, image);
+  return image;
+}
+
+void paintCoverageInto(const std::vector<Primitive>& primitives, const cv::Rect& window,
+                       double background, int scale, int subrows, cv::Mat& image) {
+  image.create(window.size(), CV_64F);
+  image.setTo(background);
+  thread_local cv::Mat cov;  // reused: large buffers cost more in page faults than in filling
   for (const Primitive& primitive : primitives) {
     const Primitive p = scale == 1 ? primitive : scaled(primitive, scale);
     const cv::Rect2d b = boundingBox(p);
@@ -246,13 +262,16 @@ cv::Mat paintCoverage(const std::vector<Primitive>& primitives, const cv::Rect& 
                                             static_cast<int>(std::ceil(b.y + b.height + 2)))) &
                          window;
     if (box.empty()) continue;
-    const cv::Mat cov = renderCoverage(p, box, subrows);
+    renderCoverageInto(p, box, subrows, cov);
     // Painter's algorithm on coverage: image = image * (1 - c) + grey * c.
     cv::Mat part = image(box - window.tl());
-    const cv::Mat blended = part.mul(1.0 - cov) + cov * p.grey;
-    blended.copyTo(part);
+    for (int r = 0; r < cov.rows; ++r) {
+      const auto* c = cov.ptr<double>(r);
+      auto* v = part.ptr<double>(r);
+      for (int x = 0; x < cov.cols; ++x)
+        if (c[x] != 0.0) v[x] += c[x] * (p.grey - v[x]);
+    }
   }
-  return image;
 }
 
 cv::Mat Scene::render() const {

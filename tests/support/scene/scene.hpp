@@ -97,6 +97,9 @@ cv::Mat renderCoverage(const Primitive& primitive, cv::Size size, int subrows = 
 // The same over the pixels of `window` only (which may reach outside any image: the primitive
 // is defined everywhere); element (r, c) is pixel (window.x + c, window.y + r).
 cv::Mat renderCoverage(const Primitive& primitive, const cv::Rect& window, int subrows);
+// The same into `coverage` (reallocated only when its size or type differs).
+void renderCoverageInto(const Primitive& primitive, const cv::Rect& window, int subrows,
+                        cv::Mat& coverage);
 
 // The primitive in the coordinates of a grid `scale` times finer (pixel (i, j) of the image
 // covers fine cells i*scale .. i*scale+scale-1 in x, likewise in y).
@@ -108,6 +111,8 @@ const char* blurModelName(BlurModel model);
 // of a grid `scale` times finer than the image, on `background`, as doubles on the 8-bit scale.
 cv::Mat paintCoverage(const std::vector<Primitive>& primitives, const cv::Rect& window,
                       double background, int scale, int subrows);
+void paintCoverageInto(const std::vector<Primitive>& primitives, const cv::Rect& window,
+                       double background, int scale, int subrows, cv::Mat& image);
 
 double polygonArea(const std::vector<cv::Point2d>& vertices);  // unsigned
 cv::Point2d polygonCentroid(const std::vector<cv::Point2d>& vertices);
