@@ -412,7 +412,8 @@ void gatherAny(const cv::Mat& image, const EdgeSeed& seed, const EdgeProfilePara
 // with their subpixel phase. Also why not the erf width alone: an axis-aligned edge shows the
 // profile at one phase only, which biases the erf width by up to +-0.05 px.
 EdgeBlur fitBlurModel(const cv::Mat& image, const std::vector<const EdgeSeed*>& seeds,
-                      const EdgeProfileParams& params, double width) {
+                      const EdgeProfileParams& params, double width,
+                      std::optional<bool> onlyModel) {
   std::vector<Samples> samples(seeds.size());
   for (size_t i = 0; i < seeds.size(); ++i) {
     if (image.depth() == CV_16U)
@@ -433,6 +434,7 @@ EdgeBlur fitBlurModel(const cv::Mat& image, const std::vector<const EdgeSeed*>& 
   double best = std::numeric_limits<double>::infinity(), bestSigma = sigma0;
   bool bestGrid = false;
   for (const bool grid : {false, true}) {
+    if (onlyModel && *onlyModel != grid) continue;
     double modelBest = std::numeric_limits<double>::infinity();
     int bestStep = 0;
     const auto tryStep = [&](int step) {
@@ -528,7 +530,8 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
 }
 
 EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
-                          const EdgeProfileParams& params, int maxSamples) {
+                          const EdgeProfileParams& params, int maxSamples,
+                          std::optional<bool> onlyModel) {
   EdgeProfileParams fitParams = params;
   fitParams.width = 0;
   fitParams.iterations = std::max(params.iterations, 3);
@@ -564,7 +567,7 @@ EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& see
       fewer.push_back(chosen[i * chosen.size() / kModelSeeds]);
     chosen.swap(fewer);
   }
-  const EdgeBlur blur = fitBlurModel(image, chosen, params, width);
+  const EdgeBlur blur = fitBlurModel(image, chosen, params, width, onlyModel);
   return axisDominated ? blur : EdgeBlur{width, blur.onPixelGrid};
 }
 

@@ -88,8 +88,10 @@ struct EdgeBlur {
 // width is biased by their single subpixel phase, that search's sigma replaces the width too).
 // So the default needs no knowledge of how the images were formed. Returns
 // `params.initialWidth` and `params.blurOnPixelGrid` when no fit succeeds.
+// `onlyModel` restricts the search to one model (true = pixel grid, false = lens).
 EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
-                          const EdgeProfileParams& params = {}, int maxSamples = 64);
+                          const EdgeProfileParams& params = {}, int maxSamples = 64,
+                          std::optional<bool> onlyModel = std::nullopt);
 // estimateEdgeBlur(...).width.
 double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
                          const EdgeProfileParams& params = {}, int maxSamples = 64);

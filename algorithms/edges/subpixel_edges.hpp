@@ -43,6 +43,10 @@ struct EdgeParams {
   // edge. Off gives the plain facet zero crossings. Points closer than 5 px to the image border
   // keep their facet position.
   bool fitProfile = true;
+  // Where the blur acts, for the profile fit: true = on the sampled image (a blur filter run
+  // after sampling), false = before pixel integration (a lens). Unset (default): chosen per image
+  // from the edges' profiles (estimateEdgeBlur), so neither has to be known.
+  std::optional<bool> blurOnPixelGrid;
 };
 
 struct EdgeContours {

@@ -1,7 +1,7 @@
 // bench_edges: accuracy of the facet subpixel edges on straight edges at every orientation and on
 // circles, and full-frame speed beside cv::Canny (pixel level) measured in the same run.
 //
-//   bench_edges [--smoke]
+//   bench_edges [--smoke] [--model pixel-grid|lens] [--profile-model grid|lens]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <cstring>
 #include <ctime>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -27,6 +28,10 @@ using facet::scene::Scene;
 using facet::scene::SceneSpec;
 
 constexpr double kPi = std::numbers::pi;
+
+// --profile-model grid|lens fixes the edges' profile model (the baseline: before the model was
+// chosen per image, it was always grid); unset = the default, chosen per image.
+std::optional<bool> gProfileModel;
 
 struct StraightResult {
   double rms = 0;
@@ -61,6 +66,7 @@ StraightResult measureStraight(double deg, double blur, double noise, std::uint6
   params.low = 5;
   params.high = 10;
   params.correctCurvatureBias = correct;
+  params.blurOnPixelGrid = gProfileModel;
   const EdgeContours edges = facet::detectSubpixelEdges(image, params);
   StraightResult r;
   double sum = 0;
@@ -106,6 +112,7 @@ double measureRadiusBias(double radius, double blur, bool correct, std::uint64_t
   params.low = 5;
   params.high = 10;
   params.correctCurvatureBias = correct;
+  params.blurOnPixelGrid = gProfileModel;
   const EdgeContours edges = facet::detectSubpixelEdges(scene.render(), params);
   double sum = 0;
   int n = 0;
@@ -133,7 +140,13 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   bool smoke = false;
-  for (int i = 1; i < argc; ++i) smoke = smoke || std::strcmp(argv[i], "--smoke") == 0;
+  const char* only = nullptr;  // --model pixel-grid|lens: that scene model alone
+  for (int i = 1; i < argc; ++i) {
+    smoke = smoke || std::strcmp(argv[i], "--smoke") == 0;
+    if (std::strcmp(argv[i], "--profile-model") == 0 && i + 1 < argc)
+      gProfileModel = std::strcmp(argv[++i], "grid") == 0;
+    if (std::strcmp(argv[i], "--model") == 0 && i + 1 < argc) only = argv[++i];
+  }
   // Development aid: --angle DEG BLUR NOISE [lens] prints every point's error for one straight
   // edge.
   for (int i = 1; i + 3 < argc; ++i)
@@ -158,8 +171,12 @@ int main(int argc, char** argv) {
   std::printf("%-10s %6s %6s %8s %10s %10s %8s %10s %8s\n", "model", "blur", "noise", "points",
               "rms_all", "worst_rms", "at_deg", "dbl@45deg", "pass");
   bool allPass = true;
+  if (gProfileModel)
+    std::printf("edge profile model fixed to %s (not the default)\n",
+                *gProfileModel ? "grid" : "lens");
   for (const BlurModel model : {BlurModel::PixelGrid, BlurModel::Lens})
     for (double blur : {0.5, 0.7, 1.0, 1.5}) {
+      if (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0) continue;
       for (double noise : {0.0, 2.0}) {
         double sum = 0, worst = 0;
         int count = 0, worstDeg = 0;
@@ -187,6 +204,7 @@ int main(int argc, char** argv) {
       smoke ? std::vector<double>{10, 50} : std::vector<double>{10, 15, 20, 30, 50, 100, 200};
   for (const BlurModel model : {BlurModel::PixelGrid, BlurModel::Lens})
     for (double blur : smoke ? std::vector<double>{1.0} : std::vector<double>{0.7, 1.0, 1.5}) {
+      if (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0) continue;
       for (double r : radii) {
         const double raw = measureRadiusBias(r, blur, false, 5, model);
         const double cor = measureRadiusBias(r, blur, true, 5, model);
