@@ -60,6 +60,9 @@ struct RegistrationParams {
   // more global inliers is kept. false = plain Harris only.
   bool escalateToAffine = true;
   int affineBelowInliers = 20;
+  // Last step of registerImages for a homography after the re-matching: Levenberg-Marquardt on
+  // the transfer error of the re-matched pairs within finalThreshold (registration_stages.cpp).
+  bool polishHomography = true;
 };
 
 // One correspondence between the reference and the image.
