@@ -77,10 +77,11 @@ TEST(LensBlur, StraightEdgeMatchesTheClosedFormAtEveryOrientation) {
   for (double sigma : {0.5, 0.7, 1.0, 1.5})
     for (double deg : {0.0, 7.0, 22.5, 33.0, 45.0, 71.0, 90.0, 128.0}) {
       const Agreement r = compare(deg, sigma, SceneSpec{}.lensSupersampling);
-      EXPECT_LT(std::abs(r.position), 2.5e-4) << "sigma " << sigma << " deg " << deg;
+      EXPECT_LT(std::abs(r.position), 5e-4) << "sigma " << sigma << " deg " << deg;
       // Cut cells widen the blur symmetrically (at most h^2/4 in variance, see lens_blur.hpp):
-      // 0.023 grey of 100 at sigma 0.5, no shift.
-      EXPECT_LT(r.maxGrey, 0.03) << "sigma " << sigma << " deg " << deg;
+      // 0.14 grey of 100 at sigma 0.5 and scale 8 (0.028 at scale 16). Shift: the sub-scanlines
+      // place a horizontal edge to 1/4096 px (0.0003 px measured at 90 deg).
+      EXPECT_LT(r.maxGrey, 0.15) << "sigma " << sigma << " deg " << deg;
     }
 }
 

@@ -7,7 +7,7 @@
 namespace facet::scene {
 namespace {
 
-constexpr int kLensSubrows = 128;  // sub-scanlines per fine row
+constexpr int kLensSubrows = 256;  // sub-scanlines per fine row
 
 double normalCdf(double x) {
   return 0.5 * std::erfc(-x / std::numbers::sqrt2);
@@ -45,7 +45,7 @@ double lensStepProfile(double u, double sigma) {
 cv::Mat renderLensBlurred(const std::vector<Primitive>& primitives, const SceneSpec& spec) {
   const int s = spec.lensSupersampling;
   // The sub-scanlines place an edge along y to half their spacing, so a horizontal edge sits up to
-  // 1/(2 * 2048) px off with 128 per fine row at scale 16: finer than spec.subrows, which is meant
+  // 1/(2 * 2048) px off with 256 per fine row at scale 8: finer than spec.subrows, which is meant
   // for the pixel-grid model.
   const int subrows = std::max(kLensSubrows, (spec.subrows + s - 1) / s);
   const int reach = static_cast<int>(std::ceil(0.5 + 6.0 * spec.blurSigma));  // pixels

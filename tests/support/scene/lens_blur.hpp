@@ -4,7 +4,7 @@
 // square), which is separable in x and y.
 //
 // How: the scene is painted on a grid `lensSupersampling` times finer than the image (coverage
-// exact in x, 128 sub-scanlines per fine row in y), and each fine cell is weighted by
+// exact in x, 256 sub-scanlines per fine row in y), and each fine cell is weighted by
 // the exact integral of K over the cell, from the antiderivative of K
 //   C(u) = sigma [g((u + 1/2) / sigma) - g((u - 1/2) / sigma)],  g(x) = x Phi(x) + phi(x).
 // That is exact for a scene constant within each fine cell; a cell cut by an edge counts with its

@@ -34,7 +34,7 @@ struct SceneSpec {
   double background = 40.0;                    // grey of the empty scene, on the 8-bit scale
   double blurSigma = 0.0;                      // Gaussian PSF sigma, pixels (0 = none)
   BlurModel blurModel = BlurModel::PixelGrid;  // where the blur acts (see above)
-  int lensSupersampling = 16;  // Lens: fine cells per pixel and axis for the scene's coverage
+  int lensSupersampling = 8;  // Lens: fine cells per pixel and axis for the scene's coverage
   double noiseSigma = 0.0;     // additive Gaussian noise, grey levels on the 8-bit scale
   cv::Point2d illuminationGradient{0.0, 0.0};  // grey levels added per pixel in x and y,
                                                // zero at the image centre
