@@ -343,8 +343,8 @@ EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& see
   fitParams.iterations = std::max(params.iterations, 3);
   const int reach = edgeProfileReach(fitParams);
   std::vector<double> widths;
-  std::vector<const EdgeSeed*> fitted, axis;  // axis: normal within 0.5 deg of an axis
-  constexpr double kAxisSine = 0.0087;        // sin(0.5 deg)
+  std::vector<const EdgeSeed*> fitted, axis;  // axis: normal within 10 deg of an axis
+  constexpr double kAxisSine = 0.1736;        // sin(10 deg)
   const size_t stride = std::max<size_t>(1, seeds.size() / std::max(1, maxSamples));
   for (size_t i = 0; i < seeds.size(); i += stride) {
     const EdgeSeed& s = seeds[i];
@@ -360,10 +360,11 @@ EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& see
   if (widths.empty()) return {params.initialWidth, params.blurOnPixelGrid};
   std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
   const double width = widths[widths.size() / 2];
-  // Where axis-aligned edges dominate, their erf width is biased by their one subpixel phase and
-  // the exact profiles' best sigma replaces it; elsewhere the median erf width stands (on curved
-  // edges the exact straight-edge profiles fit the arc's spread as blur) and the search picks
-  // the model only.
+  // Where edges within 10 degrees of an axis dominate, their erf width is biased by their
+  // subpixel phase (one phase for an axis-aligned edge, a slowly drifting one near it: at sigma
+  // 0.5 on the pixel grid that cost 0.035 px at 2-3 degrees) and the exact profiles' best sigma
+  // replaces it; elsewhere the median erf width stands (on curved edges the exact straight-edge
+  // profiles would take the arc's spread for blur) and the search picks the model only.
   const bool axisDominated = axis.size() * 2 >= widths.size();
   std::vector<const EdgeSeed*>& chosen = axisDominated ? axis : fitted;
   constexpr size_t kModelSeeds = 16;
