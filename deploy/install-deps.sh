@@ -20,6 +20,8 @@ packages=(
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   python3-pymodbus python3-serial python3-serial-asyncio python3-numpy python3-opencv mbpoll
   python3-jsonschema python3-yaml
+  # photographs for bench_registration (examples/data of the OpenCV documentation)
+  opencv-doc
   # browser checks of the dashboard and report
   chromium chromium-driver
   # media helpers (image conversions in tests)

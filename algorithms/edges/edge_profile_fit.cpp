@@ -1,5 +1,7 @@
 #include "algorithms/edges/edge_profile_fit.hpp"
 
+#include "algorithms/edges/edge_profile_tables.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -14,208 +16,12 @@
 namespace facet {
 namespace {
 
-// Standard normal CDF and PDF, tabulated on [-kRange, kRange] with linear interpolation
-// (step 1/64: interpolation error below 1e-5).
-constexpr float kRange = 6.0f;
-constexpr int kPerUnit = 64;
-constexpr int kTableSize = static_cast<int>(2 * kRange * kPerUnit) + 2;
-
-struct NormalTable {
-  std::array<float, kTableSize> cdf{}, pdf{};
-  // The same, packed per interval for the vectorised fit: value and slope of CDF and PDF.
-  struct alignas(16) Interval {
-    float cdf, cdfSlope, pdf, pdfSlope;
-  };
-  std::array<Interval, kTableSize> packed{};
-  NormalTable() {
-    for (int i = 0; i < kTableSize; ++i) {
-      const double z = -kRange + static_cast<double>(i) / kPerUnit;
-      cdf[i] = static_cast<float>(0.5 * std::erfc(-z / std::numbers::sqrt2));
-      pdf[i] = static_cast<float>(std::exp(-0.5 * z * z) / std::sqrt(2 * std::numbers::pi));
-    }
-    for (int i = 0; i + 1 < kTableSize; ++i)
-      packed[i] = {cdf[i], cdf[i + 1] - cdf[i], pdf[i], pdf[i + 1] - pdf[i]};
-    packed[kTableSize - 1] = {cdf[kTableSize - 1], 0, pdf[kTableSize - 1], 0};
-  }
-};
-
-const NormalTable& normalTable() {
-  static const NormalTable table;
-  return table;
-}
-
-// A tabulated edge profile: value P and derivative D per interval (value and slope), looked up
-// at table coordinate (u * coordScale + range) * perUnit for the distance u to the edge line.
-struct ProfileView {
-  const NormalTable::Interval* data = nullptr;
-  int size = 0;
-  float coordScale = 1, range = 0, perUnit = 1;
-  double derivScale = 1;  // D * derivScale = dP/du * (1 / coordScale) convention, see step()
-};
-
-// Profiles of a blurred step seen through the pixel aperture, for one PSF sigma and normal
-// angles 0..45 degrees (1 degree steps; the profile depends only on {|cos|, |sin|}).
-// For the unit pixel square the aperture projected on the normal is box(c) * box(s) with
-// c = |cos|, s = |sin|, so with G(x) = x Phi(x) + phi(x) and H(x) = ((x^2 + 1) Phi(x) + x phi(x))/2
-// (the first and second antiderivatives of Phi):
-//   P(u)  = sigma^2 / (c s) [H((u+p)/sigma) - H((u+m)/sigma) - H((u-m)/sigma) + H((u-p)/sigma)]
-//   P'(u) = sigma   / (c s) [G(...)         - G(...)         - G(...)         + G(...)]
-// with p = (c + s)/2, m = (c - s)/2; for s -> 0 the single box gives
-//   P(u) = sigma / c [G((u+c/2)/sigma) - G((u-c/2)/sigma)],  P'(u) = [Phi(..) - Phi(..)] / c.
-constexpr float kApertureRange = 7.5f;  // pixels either side of the edge
-constexpr int kAperturePerPixel = 16;
-constexpr int kApertureSize = static_cast<int>(2 * kApertureRange * kAperturePerPixel) + 2;
-constexpr int kApertureAngles = 46;
-
-struct ApertureProfiles {
-  double sigma = 0;
-  bool gridBlur = false;
-  std::vector<NormalTable::Interval> rows;  // kApertureAngles x kApertureSize, built on use
-  std::unique_ptr<std::once_flag[]> built;
-
-  ApertureProfiles(double psfSigma, bool blurOnGrid)
-      : sigma(psfSigma), gridBlur(blurOnGrid), built(new std::once_flag[kApertureAngles]) {
-    rows.resize(static_cast<size_t>(kApertureAngles) * kApertureSize);
-  }
-
-  void buildRow(int k) {
-    std::vector<double> value(kApertureSize), slope(kApertureSize);
-    {
-      const double angle = k * std::numbers::pi / 180.0;
-      const double c = std::cos(angle), sn = std::sin(angle);
-      for (int i = 0; i < kApertureSize; ++i) {
-        const double u = -kApertureRange + static_cast<double>(i) / kAperturePerPixel;
-        if (gridBlur)
-          gridProfile(u, c, sn, value[i], slope[i]);
-        else
-          profile(u, c, sn, value[i], slope[i]);
-      }
-      NormalTable::Interval* row = &rows[static_cast<size_t>(k) * kApertureSize];
-      for (int i = 0; i < kApertureSize; ++i) {
-        const int j = std::min(i + 1, kApertureSize - 1);
-        row[i] = {static_cast<float>(value[i]), static_cast<float>(value[j] - value[i]),
-                  static_cast<float>(slope[i]), static_cast<float>(slope[j] - slope[i])};
-      }
-    }
-  }
-
-  ProfileView view(cv::Point2d normal) {
-    const double lo = std::min(std::abs(normal.x), std::abs(normal.y));
-    const double hi = std::max(std::abs(normal.x), std::abs(normal.y));
-    // The nearest whole degree of atan(lo / hi), by comparing with tan(k + 1/2 degree).
-    static const std::array<double, kApertureAngles> tanHalf = [] {
-      std::array<double, kApertureAngles> t{};
-      for (int k = 0; k < kApertureAngles; ++k) t[k] = std::tan((k + 0.5) * std::numbers::pi / 180);
-      return t;
-    }();
-    const double ratio = hi > 0 ? lo / hi : 0.0;
-    const int k = std::min(
-        static_cast<int>(std::lower_bound(tanHalf.begin(), tanHalf.end(), ratio) - tanHalf.begin()),
-        kApertureAngles - 1);
-    std::call_once(built[k], [this, k] { buildRow(k); });
-    return {&rows[static_cast<size_t>(k) * kApertureSize],
-            kApertureSize,
-            1.0f,
-            kApertureRange,
-            static_cast<float>(kAperturePerPixel),
-            1.0};
-  }
-
- private:
-  static double cdf(double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }
-  static double pdf(double x) { return std::exp(-0.5 * x * x) / std::sqrt(2 * std::numbers::pi); }
-  static double g(double x) { return x * cdf(x) + pdf(x); }
-  static double h(double x) { return 0.5 * ((x * x + 1) * cdf(x) + x * pdf(x)); }
-
-  // The sharp step integrated over the pixel square: the CDF and density of the aperture
-  // box(c) * box(s) at x.
-  static void sharpStep(double x, double c, double s, double& value, double& slope) {
-    if (s < 1e-6) {
-      value = std::clamp((x + c / 2) / c, 0.0, 1.0);
-      slope = std::abs(x) < c / 2 ? 1 / c : 0.0;
-      return;
-    }
-    const double p = (c + s) / 2, m = (c - s) / 2;
-    if (x <= -p) {
-      value = 0, slope = 0;
-    } else if (x <= -m) {
-      value = (x + p) * (x + p) / (2 * c * s), slope = (x + p) / (c * s);
-    } else if (x <= m) {
-      value = s / (2 * c) + (x + m) / c, slope = 1 / c;
-    } else if (x < p) {
-      value = 1 - (p - x) * (p - x) / (2 * c * s), slope = (p - x) / (c * s);
-    } else {
-      value = 1, slope = 0;
-    }
-  }
-
-  // Blur on the pixel grid: the pixel-integrated sharp step convolved with the sampled Gaussian
-  // kernel (truncated at 4 sigma, normalised), as a blur applied to the sampled image does:
-  //   P(u) = sum_k g(kx) g(ky) sharpStep(u - kx c - ky s).
-  void gridProfile(double u, double c, double s, double& value, double& slope) const {
-    const int r = static_cast<int>(std::ceil(4 * sigma));
-    thread_local std::vector<double> kernel;
-    kernel.assign(2 * r + 1, 0.0);
-    double sum = 0;
-    for (int k = -r; k <= r; ++k) sum += kernel[k + r] = std::exp(-0.5 * k * k / (sigma * sigma));
-    value = slope = 0;
-    if (s < 1e-9) {  // axis-aligned: the kernel's rows all project to the same offsets
-      for (int kx = -r; kx <= r; ++kx) {
-        double v, d;
-        sharpStep(u - kx * c, c, s, v, d);
-        value += kernel[kx + r] / sum * v;
-        slope += kernel[kx + r] / sum * d;
-      }
-      return;
-    }
-    for (int ky = -r; ky <= r; ++ky)
-      for (int kx = -r; kx <= r; ++kx) {
-        double v, d;
-        sharpStep(u - kx * c - ky * s, c, s, v, d);
-        const double weight = kernel[kx + r] * kernel[ky + r] / (sum * sum);
-        value += weight * v;
-        slope += weight * d;
-      }
-  }
-
-  void profile(double u, double c, double s, double& value, double& slope) const {
-    const double sg = sigma;
-    if (s < 1e-3) {
-      value = sg / c * (g((u + c / 2) / sg) - g((u - c / 2) / sg));
-      slope = (cdf((u + c / 2) / sg) - cdf((u - c / 2) / sg)) / c;
-      return;
-    }
-    const double p = (c + s) / 2, m = (c - s) / 2;
-    value =
-        sg * sg / (c * s) * (h((u + p) / sg) - h((u + m) / sg) - h((u - m) / sg) + h((u - p) / sg));
-    slope = sg / (c * s) * (g((u + p) / sg) - g((u + m) / sg) - g((u - m) / sg) + g((u - p) / sg));
-  }
-};
-
-// Profiles are pure functions of sigma; keep the last few so that a camera's images (whose blur
-// estimate varies little) build them once.
-std::shared_ptr<ApertureProfiles> apertureProfiles(double sigma, bool gridBlur) {
-  static std::mutex mutex;
-  static std::vector<std::shared_ptr<ApertureProfiles>> cache;
-  const double key = std::round(sigma * 50) / 50;
-  std::lock_guard lock(mutex);
-  for (const auto& p : cache)
-    if (p->sigma == key && p->gridBlur == gridBlur) return p;
-  auto made = std::make_shared<ApertureProfiles>(key, gridBlur);
-  if (cache.size() >= 24) cache.erase(cache.begin());
-  cache.push_back(made);
-  return made;
-}
-
-ProfileView erfView(double w) {
-  const auto& t = normalTable();
-  return {t.packed.data(),
-          kTableSize,
-          static_cast<float>(1.0 / w),
-          kRange,
-          static_cast<float>(kPerUnit),
-          w};
-}
+using edge_profile::apertureProfiles;
+using edge_profile::ApertureProfiles;
+using edge_profile::apertureView;
+using edge_profile::erfView;
+using edge_profile::ProfileInterval;
+using edge_profile::ProfileView;
 
 constexpr int kCapacity = 512;
 
@@ -325,7 +131,7 @@ template <Extra X>
 bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, double& e,
           double& w, double& phi) {
   constexpr int N = X == Extra::None ? 3 : 4;
-  const NormalTable::Interval* packed = profile.data;
+  const ProfileInterval* packed = profile.data;
   const Lanes vScale = Lanes{} + profile.coordScale, vE = Lanes{} + static_cast<float>(e),
               vPhi = Lanes{} + static_cast<float>(phi);
   const Lanes vLow = Lanes{}, vHigh = Lanes{} + (static_cast<float>(profile.size) - 1.001f);
@@ -404,30 +210,51 @@ void gatherAny(const cv::Mat& image, const EdgeSeed& seed, const EdgeProfilePara
             std::is_same_v<T, ushort> ? 1.0f / 256 : 1.0f, out);
 }
 
-// Axis-aligned edges show the profile at one subpixel phase only, which biases the erf width by
-// up to +-0.05 px depending on that phase. When they dominate, the blur is chosen instead as the
-// one whose exact (pixel-grid) profile fits them best.
-double refineWidthOnAxisEdges(const cv::Mat& image, const std::vector<const EdgeSeed*>& axis,
-                              const EdgeProfileParams& params, double width) {
-  std::vector<Samples> samples(axis.size());
-  for (size_t i = 0; i < axis.size(); ++i) {
+// The blur model and sigma whose exact profiles fit the seeds best (least residual sum of
+// squares), searched around the erf width's sigma in steps of 0.02 px. Why both models: a lens
+// blurs before the pixel integrates (a continuous Gaussian times the pixel square), a blur filter
+// run on a sampled image after it (a discrete kernel); at sigma 0.5-0.8 the two profiles differ by
+// up to 3% of the contrast, and fitting the wrong one moves axis-aligned edges by up to 0.03 px
+// with their subpixel phase. Also why not the erf width alone: an axis-aligned edge shows the
+// profile at one phase only, which biases the erf width by up to +-0.05 px.
+EdgeBlur fitBlurModel(const cv::Mat& image, const std::vector<const EdgeSeed*>& seeds,
+                      const EdgeProfileParams& params, double width,
+                      std::optional<bool> onlyModel) {
+  std::vector<Samples> samples(seeds.size());
+  for (size_t i = 0; i < seeds.size(); ++i) {
     if (image.depth() == CV_16U)
-      gatherAny<ushort>(image, *axis[i], params, samples[i]);
+      gatherAny<ushort>(image, *seeds[i], params, samples[i]);
     else
-      gatherAny<uchar>(image, *axis[i], params, samples[i]);
+      gatherAny<uchar>(image, *seeds[i], params, samples[i]);
   }
   const double sigma0 = std::round(std::sqrt(std::max(width * width - 1.0 / 12, 0.04)) * 50) / 50;
-  double best = std::numeric_limits<double>::infinity(), bestSigma = sigma0;
-  for (int step = -6; step <= 6; ++step) {
-    const double sigma = sigma0 + 0.02 * step;
-    if (sigma < 0.2) continue;
-    const auto profiles = apertureProfiles(sigma, true);
+  const auto rssAt = [&](double sigma, bool grid) {
+    const auto profiles = apertureProfiles(sigma, grid);
     double rss = 0;
-    for (size_t i = 0; i < axis.size(); ++i)
-      rss += fitResidual(samples[i], profiles->view(axis[i]->normal), axis[i]->offset);
-    if (rss < best) best = rss, bestSigma = sigma;
+    for (size_t i = 0; i < seeds.size(); ++i)
+      rss += fitResidual(samples[i], apertureView(*profiles, seeds[i]->normal), seeds[i]->offset);
+    return rss;
+  };
+  // Per model: every third step of +-6 first, then the steps next to the best of those (the
+  // residual is smooth and single-welled in sigma).
+  double best = std::numeric_limits<double>::infinity(), bestSigma = sigma0;
+  bool bestGrid = false;
+  for (const bool grid : {false, true}) {
+    if (onlyModel && *onlyModel != grid) continue;
+    double modelBest = std::numeric_limits<double>::infinity();
+    int bestStep = 0;
+    const auto tryStep = [&](int step) {
+      const double sigma = sigma0 + 0.02 * step;
+      if (sigma < 0.2) return;
+      const double rss = rssAt(sigma, grid);
+      if (rss < modelBest) modelBest = rss, bestStep = step;
+    };
+    for (int step = -6; step <= 6; step += 3) tryStep(step);
+    const int coarse = bestStep;
+    for (const int d : {-2, -1, 1, 2}) tryStep(coarse + d);
+    if (modelBest < best) best = modelBest, bestSigma = sigma0 + 0.02 * bestStep, bestGrid = grid;
   }
-  return std::sqrt(bestSigma * bestSigma + 1.0 / 12);
+  return {std::sqrt(bestSigma * bestSigma + 1.0 / 12), bestGrid};
 }
 
 }  // namespace
@@ -477,7 +304,7 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
       ok = step<Extra::Width>(smp, erfView(w), a, b, e, w, phi) &&
            (!last || step<Extra::Turn>(smp, erfView(w), a, b, e, w, phi));
     } else {
-      const ProfileView view = aperture->view(normal);
+      const ProfileView view = apertureView(*aperture, normal);
       ok = last ? step<Extra::Turn>(smp, view, a, b, e, w, phi)
                 : step<Extra::None>(smp, view, a, b, e, w, phi);
     }
@@ -487,7 +314,7 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   // steps: the linearisation in phi is only good for small turns. Give up when they do not
   // settle.
   if (!fitWidth && std::abs(phi) > 0.03) {
-    const ProfileView view = aperture->view(normal);
+    const ProfileView view = apertureView(*aperture, normal);
     double previous = phi;
     for (int extra = 0; extra < 3; ++extra) {
       if (!step<Extra::Turn>(smp, view, a, b, e, w, phi)) return std::nullopt;
@@ -508,15 +335,16 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
                    b / (w * std::sqrt(2 * std::numbers::pi))};
 }
 
-double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
-                         const EdgeProfileParams& params, int maxSamples) {
+EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
+                          const EdgeProfileParams& params, int maxSamples,
+                          std::optional<bool> onlyModel) {
   EdgeProfileParams fitParams = params;
   fitParams.width = 0;
   fitParams.iterations = std::max(params.iterations, 3);
   const int reach = edgeProfileReach(fitParams);
   std::vector<double> widths;
-  std::vector<const EdgeSeed*> axis;    // seeds whose normal is within 0.5 deg of an axis
-  constexpr double kAxisSine = 0.0087;  // sin(0.5 deg)
+  std::vector<const EdgeSeed*> fitted, axis;  // axis: normal within 10 deg of an axis
+  constexpr double kAxisSine = 0.1736;        // sin(10 deg)
   const size_t stride = std::max<size_t>(1, seeds.size() / std::max(1, maxSamples));
   for (size_t i = 0; i < seeds.size(); i += stride) {
     const EdgeSeed& s = seeds[i];
@@ -526,18 +354,33 @@ double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seed
     double w = 0;
     if (!fitEdgeProfile(image, s.pixel, s.normal, s.offset, fitParams, &w)) continue;
     widths.push_back(w);
+    fitted.push_back(&s);
     if (std::min(std::abs(s.normal.x), std::abs(s.normal.y)) < kAxisSine) axis.push_back(&s);
   }
-  if (widths.empty()) return params.initialWidth;
+  if (widths.empty()) return {params.initialWidth, params.blurOnPixelGrid};
   std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
   const double width = widths[widths.size() / 2];
-  if (!params.blurOnPixelGrid || axis.empty() || axis.size() * 2 < widths.size()) return width;
-  if (axis.size() > 16) {
+  // Where edges within 10 degrees of an axis dominate, their erf width is biased by their
+  // subpixel phase (one phase for an axis-aligned edge, a slowly drifting one near it: at sigma
+  // 0.5 on the pixel grid that cost 0.035 px at 2-3 degrees) and the exact profiles' best sigma
+  // replaces it; elsewhere the median erf width stands (on curved edges the exact straight-edge
+  // profiles would take the arc's spread for blur) and the search picks the model only.
+  const bool axisDominated = axis.size() * 2 >= widths.size();
+  std::vector<const EdgeSeed*>& chosen = axisDominated ? axis : fitted;
+  constexpr size_t kModelSeeds = 16;
+  if (chosen.size() > kModelSeeds) {
     std::vector<const EdgeSeed*> fewer;
-    for (size_t i = 0; i < 16; ++i) fewer.push_back(axis[i * axis.size() / 16]);
-    axis.swap(fewer);
+    for (size_t i = 0; i < kModelSeeds; ++i)
+      fewer.push_back(chosen[i * chosen.size() / kModelSeeds]);
+    chosen.swap(fewer);
   }
-  return refineWidthOnAxisEdges(image, axis, params, width);
+  const EdgeBlur blur = fitBlurModel(image, chosen, params, width, onlyModel);
+  return axisDominated ? blur : EdgeBlur{width, blur.onPixelGrid};
+}
+
+double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
+                         const EdgeProfileParams& params, int maxSamples) {
+  return estimateEdgeBlur(image, seeds, params, maxSamples).width;
 }
 
 }  // namespace facet

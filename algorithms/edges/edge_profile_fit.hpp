@@ -43,10 +43,10 @@ struct EdgeProfileParams {
   // With a known width the profile is tabulated exactly for the pixel aperture at the point's
   // normal angle. Where the blur acts: true = on the sampled image, as a discrete Gaussian kernel
   // (the image formation of tests/support/scene, and of any blur filter applied after
-  // sampling); false = a continuous Gaussian PSF before pixel integration (ideal optics). The
-  // two differ by up to 0.03 of the contrast at sigma 0.8 (0.02 px in position), vanishing as
-  // sigma grows; choose the one that matches how the images are formed.
-  bool blurOnPixelGrid = true;
+  // sampling); false = a continuous Gaussian PSF before pixel integration (a lens). The two
+  // differ by up to 0.03 of the contrast at sigma 0.5-0.8 (0.03 px in position), vanishing as
+  // sigma grows. detectSubpixelEdges chooses it per image with estimateEdgeBlur.
+  bool blurOnPixelGrid = false;
 };
 
 // Refines the edge near pixel `pixel` of a CV_8UC1 / CV_16UC1 image, starting from the unit
@@ -70,14 +70,29 @@ double profileWindowBias(const EdgeProfileParams& params = {});
 // The window radius (pixels) the fit reads around its pixel.
 int edgeProfileReach(const EdgeProfileParams& params = {});
 
-// One profile width for an image: the median of per-point fitted widths over up to `maxSamples`
-// of the given seeds (pixel, facet normal, facet offset), spread evenly over the list. Returns
-// `params.initialWidth` when no fit succeeds.
 struct EdgeSeed {
   cv::Point pixel;
   cv::Point2d normal;
   double offset = 0;
 };
+// The blur of an image's edges: profile width (EdgeProfileParams::width) and where the blur acts
+// (EdgeProfileParams::blurOnPixelGrid).
+struct EdgeBlur {
+  double width = 0;
+  bool onPixelGrid = false;
+};
+// One blur for an image, from up to `maxSamples` of the given seeds (pixel, facet normal, facet
+// offset), spread evenly over the list: the median of their fitted erf widths gives the width;
+// then both blur models' exact profiles, at sigmas around it, are fitted to up to 16 of those
+// seeds and the model with the least residual wins (where axis-aligned edges dominate, whose erf
+// width is biased by their single subpixel phase, that search's sigma replaces the width too).
+// So the default needs no knowledge of how the images were formed. Returns
+// `params.initialWidth` and `params.blurOnPixelGrid` when no fit succeeds.
+// `onlyModel` restricts the search to one model (true = pixel grid, false = lens).
+EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
+                          const EdgeProfileParams& params = {}, int maxSamples = 64,
+                          std::optional<bool> onlyModel = std::nullopt);
+// estimateEdgeBlur(...).width.
 double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
                          const EdgeProfileParams& params = {}, int maxSamples = 64);
 

@@ -106,7 +106,18 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   // Profile refinement where its window fits in the image, with one blur width per image.
   EdgeProfileParams profile;
   if (params.fitProfile) {
-    profile.width = estimateEdgeWidth(image, seeds, profile);
+    EdgeBlur blur;
+    if (params.blurOnPixelGrid) {
+      // The model is known: only the width is estimated, with that model's profiles.
+      profile.blurOnPixelGrid = *params.blurOnPixelGrid;
+      blur = {estimateEdgeBlur(image, seeds, profile, 64, profile.blurOnPixelGrid).width,
+              profile.blurOnPixelGrid};
+    } else {
+      blur = estimateEdgeBlur(image, seeds, profile);
+    }
+    profile.width = blur.width;
+    profile.blurOnPixelGrid = blur.onPixelGrid;
+    result.blurOnPixelGrid = blur.onPixelGrid;
     result.blurSigma = std::sqrt(std::max(profile.width * profile.width - 1.0 / 12, 0.0));
     // What separates the offset from the background level is the plateau on either side; keep
     // about 4 widths of it in the window when the blur is wide.

@@ -43,6 +43,10 @@ struct EdgeParams {
   // edge. Off gives the plain facet zero crossings. Points closer than 5 px to the image border
   // keep their facet position.
   bool fitProfile = true;
+  // Where the blur acts, for the profile fit: true = on the sampled image (a blur filter run
+  // after sampling), false = before pixel integration (a lens). Unset (default): chosen per image
+  // from the edges' profiles (estimateEdgeBlur), so neither has to be known.
+  std::optional<bool> blurOnPixelGrid;
 };
 
 struct EdgeContours {
@@ -52,6 +56,9 @@ struct EdgeContours {
   // Blur (Gaussian sigma, pixels, without the pixel aperture) estimated from the edges' profiles;
   // 0 when the profile fit is off or there were no edges.
   double blurSigma = 0;
+  // Where that blur acted, as the profiles tell: true = on the sampled image (a blur filter),
+  // false = before pixel integration (a lens); see EdgeProfileParams::blurOnPixelGrid.
+  bool blurOnPixelGrid = false;
   double lowThreshold = 0;  // thresholds actually used
   double highThreshold = 0;
 };

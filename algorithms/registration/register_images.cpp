@@ -303,9 +303,10 @@ std::vector<cv::Vec4d> RegistrationResult::pairs() const {
   return out;
 }
 
-RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
-                                  const RegistrationParams& params) {
+RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& image,
+                                       const RegistrationParams& params) {
   RegistrationResult result;
+  result.stage = params.affineRegions ? "harris-affine" : "harris";
   if (refImage.empty() || image.empty())
     return failure(result, "empty_image",
                    refImage.empty() ? "the reference image is empty" : "the image is empty");
@@ -345,6 +346,7 @@ RegistrationResult registerImages(const cv::Mat& refImage, const cv::Mat& image,
   result.inliers = stage.inliers;
 
   const std::size_t globalInliers = result.inliers.size();
+  result.globalInliers = static_cast<int>(globalInliers);
   if (params.refineIterations > 0) {
     TransformFitParams tight;
     tight.model = params.model;

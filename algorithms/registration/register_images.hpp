@@ -54,6 +54,16 @@ struct RegistrationParams {
   int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
   double finalThreshold = 1.0;  // pixels; RANSAC threshold of the fit to the re-matched pairs
   double refineMinScore = 0.8;  // minimum NCC of a re-matched patch
+  // Escalation to Harris-Affine regions (registerImages only, when affineRegions is off): when
+  // the plain Harris stage fails, or its global fit rests on fewer than `affineBelowInliers`
+  // inliers (a large viewpoint change leaves plain windows few true matches, and a transform on
+  // so few can be wrong), the pair is registered again with affine regions and the result with
+  // more global inliers is kept. false = plain Harris only.
+  bool escalateToAffine = true;
+  int affineBelowInliers = 20;
+  // Last step of registerImages for a homography after the re-matching: Levenberg-Marquardt on
+  // the transfer error of the re-matched pairs within finalThreshold (registration_stages.cpp).
+  bool polishHomography = true;
 };
 
 // One correspondence between the reference and the image.
@@ -76,12 +86,21 @@ struct RegistrationResult {
   std::vector<int> inliers;            // indices into `matches` consistent with H
   int refCorners = 0;                  // points detected in the reference / image
   int imageCorners = 0;
+  int globalInliers = 0;  // inliers of the global (feature) fit, before the re-matching
+  // The stage whose result this is: "harris" (plain multi-scale Harris windows) or
+  // "harris-affine" (Harris-Affine regions); `escalated` when both ran (the plain one first).
+  std::string stage;
+  bool escalated = false;
   // Inlier correspondences as (x_ref, y_ref, x_img, y_img).
   [[nodiscard]] std::vector<cv::Vec4d> pairs() const;
 };
 
-// Registers `image` to `ref` (8-bit or 16-bit, 1 or 3 channels; converted to grey).
+// Registers `image` to `ref` (8-bit or 16-bit, 1 or 3 channels; converted to grey), escalating
+// to Harris-Affine regions as RegistrationParams::escalateToAffine says (registration_stages.cpp).
 RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
                                   const RegistrationParams& params = {});
+// One stage only: the detector that params.affineRegions names, no escalation between them.
+RegistrationResult registerSingleStage(const cv::Mat& ref, const cv::Mat& image,
+                                       const RegistrationParams& params = {});
 
 }  // namespace facet

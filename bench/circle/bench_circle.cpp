@@ -15,6 +15,9 @@
 //
 // Usage: bench_circle [--smoke] [--scenes N] [--case clean|hard|low-contrast] [--radius R]
 //                     [--seed N] [--verbose] [--no-grey-refinement] [--no-bias-correction]
+//                     [--blur-model pixel-grid|lens]
+// --blur-model: where the scenes' Gaussian acts, on the sampled image (default) or before pixel
+// integration as a lens does (tests/support/scene/lens_blur.hpp; slower to render).
 // --seed N (default 0) draws other scenes: the accuracy must not depend on one set of scenes.
 #include <algorithm>
 #include <cmath>
@@ -80,12 +83,16 @@ cv::Mat foreignPixels(const facet::scene::Scene& scene) {
   return diff >= 0.25;
 }
 
+// Where the scenes' blur acts (--blur-model lens|pixel-grid).
+facet::scene::BlurModel gBlurModel = facet::scene::BlurModel::PixelGrid;
+
 Trial makeTrial(double radius, Case kind, bool hole, int subrows, std::mt19937_64& rng) {
   std::uniform_real_distribution<double> u(0.0, 1.0);
   const int side = static_cast<int>(2 * radius + 60);
   facet::scene::SceneSpec spec;
   spec.size = {side, side};
   spec.blurSigma = 1.0;
+  spec.blurModel = gBlurModel;
   spec.noiseSigma = 2.0;
   spec.subrows = subrows;
   spec.seed = rng();
@@ -283,6 +290,17 @@ int main(int argc, char** argv) {
       onlyRadius = std::atof(argv[++i]);
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc)
       seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--blur-model") && i + 1 < argc) {
+      const std::string m = argv[++i];
+      if (m != "lens" && m != "pixel-grid") {
+        std::fprintf(stderr, "bench_circle: --blur-model must be lens or pixel-grid\n");
+        return 2;
+      }
+      gBlurModel = m == "lens" ? facet::scene::BlurModel::Lens : facet::scene::BlurModel::PixelGrid;
+    } else {
+      std::fprintf(stderr, "bench_circle: unknown argument %s\n", argv[i]);
+      return 2;
+    }
   }
   if (smoke) scenes = 2;
   const int subrows = smoke ? 32 : 256;
@@ -290,9 +308,10 @@ int main(int argc, char** argv) {
 
   const double radii[] = {10, 20, 50, 100, 200};
   std::printf(
-      "bench_circle: %d scenes per radius and case (half discs, half holes), blur 1, noise 2, "
-      "seed %llu%s\n",
-      scenes, static_cast<unsigned long long>(seed), smoke ? " [smoke]" : "");
+      "bench_circle: %d scenes per radius and case (half discs, half holes), blur 1 (%s model), "
+      "noise 2, seed %llu%s\n",
+      scenes, facet::scene::blurModelName(gBlurModel), static_cast<unsigned long long>(seed),
+      smoke ? " [smoke]" : "");
   std::printf(
       "errors in px over the scenes measured: |centre error| (2D) and |radius error|; fail = no "
       "result\n"

@@ -1,7 +1,7 @@
 // bench_edges: accuracy of the facet subpixel edges on straight edges at every orientation and on
 // circles, and full-frame speed beside cv::Canny (pixel level) measured in the same run.
 //
-//   bench_edges [--smoke]
+//   bench_edges [--smoke] [--model pixel-grid|lens] [--profile-model grid|lens]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -10,6 +10,7 @@
 #include <cstring>
 #include <ctime>
 #include <numbers>
+#include <optional>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -22,10 +23,15 @@ namespace {
 
 using facet::EdgeContours;
 using facet::EdgeParams;
+using facet::scene::BlurModel;
 using facet::scene::Scene;
 using facet::scene::SceneSpec;
 
 constexpr double kPi = std::numbers::pi;
+
+// --profile-model grid|lens fixes the edges' profile model (the baseline: before the model was
+// chosen per image, it was always grid); unset = the default, chosen per image.
+std::optional<bool> gProfileModel;
 
 struct StraightResult {
   double rms = 0;
@@ -36,7 +42,7 @@ struct StraightResult {
 // A straight edge through a subpixel point near the image centre with normal angle `deg`
 // (dark 40 -> light 140 along the normal). Points within `margin` of the border are ignored.
 StraightResult measureStraight(double deg, double blur, double noise, std::uint64_t seed,
-                               bool correct) {
+                               bool correct, BlurModel model = BlurModel::PixelGrid) {
   const int size = 160, margin = 12;
   SceneSpec spec;
   spec.size = {size, size};
@@ -45,6 +51,7 @@ StraightResult measureStraight(double deg, double blur, double noise, std::uint6
   spec.noiseSigma = noise;
   spec.seed = seed;
   spec.subrows = 128;
+  spec.blurModel = model;
   Scene scene(spec);
   const double a = deg * kPi / 180;
   const cv::Point2d n{std::cos(a), std::sin(a)}, t{-n.y, n.x};
@@ -59,6 +66,7 @@ StraightResult measureStraight(double deg, double blur, double noise, std::uint6
   params.low = 5;
   params.high = 10;
   params.correctCurvatureBias = correct;
+  params.blurOnPixelGrid = gProfileModel;
   const EdgeContours edges = facet::detectSubpixelEdges(image, params);
   StraightResult r;
   double sum = 0;
@@ -87,7 +95,8 @@ StraightResult measureStraight(double deg, double blur, double noise, std::uint6
 }
 
 // Mean signed radial error of the points of a disc of radius r (light disc on dark).
-double measureRadiusBias(double radius, double blur, bool correct, std::uint64_t seed) {
+double measureRadiusBias(double radius, double blur, bool correct, std::uint64_t seed,
+                         BlurModel model = BlurModel::PixelGrid) {
   const int size = static_cast<int>(2 * radius + 30);
   SceneSpec spec;
   spec.size = {size, size};
@@ -95,6 +104,7 @@ double measureRadiusBias(double radius, double blur, bool correct, std::uint64_t
   spec.blurSigma = blur;
   spec.subrows = 64;
   spec.seed = seed;
+  spec.blurModel = model;
   Scene scene(spec);
   const cv::Point2d c{size / 2.0 + 0.31, size / 2.0 - 0.17};
   scene.addDisc(c, radius, 140);
@@ -102,6 +112,7 @@ double measureRadiusBias(double radius, double blur, bool correct, std::uint64_t
   params.low = 5;
   params.high = 10;
   params.correctCurvatureBias = correct;
+  params.blurOnPixelGrid = gProfileModel;
   const EdgeContours edges = facet::detectSubpixelEdges(scene.render(), params);
   double sum = 0;
   int n = 0;
@@ -129,55 +140,78 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   bool smoke = false;
-  for (int i = 1; i < argc; ++i) smoke = smoke || std::strcmp(argv[i], "--smoke") == 0;
-  // Development aid: --angle DEG BLUR NOISE prints every point's error for one straight edge.
+  const char* only = nullptr;  // --model pixel-grid|lens: that scene model alone
+  for (int i = 1; i < argc; ++i) {
+    smoke = smoke || std::strcmp(argv[i], "--smoke") == 0;
+    if (std::strcmp(argv[i], "--profile-model") == 0 && i + 1 < argc)
+      gProfileModel = std::strcmp(argv[++i], "grid") == 0;
+    if (std::strcmp(argv[i], "--model") == 0 && i + 1 < argc) only = argv[++i];
+  }
+  // Development aid: --angle DEG BLUR NOISE [lens] prints every point's error for one straight
+  // edge.
   for (int i = 1; i + 3 < argc; ++i)
     if (std::strcmp(argv[i], "--angle") == 0) {
       setenv("BENCH_EDGES_DUMP", "1", 1);
+      const bool lens = i + 4 < argc && std::strcmp(argv[i + 4], "lens") == 0;
       const StraightResult r =
           measureStraight(std::atof(argv[i + 1]), std::atof(argv[i + 2]), std::atof(argv[i + 3]),
-                          1000 + static_cast<std::uint64_t>(std::atof(argv[i + 1])), false);
+                          1000 + static_cast<std::uint64_t>(std::atof(argv[i + 1])), false,
+                          lens ? BlurModel::Lens : BlurModel::PixelGrid);
       std::printf("rms %.4f points %d doubled %d\n", r.rms, r.points, r.doubled);
       return 0;
     }
   const int angleStep = smoke ? 15 : 1;
   cv::setNumThreads(1);  // one core for both us and the baseline
 
-  std::printf("Straight edges, orientation 0..179 deg step %d, contrast 100, 8-bit\n", angleStep);
-  std::printf("%6s %6s %8s %10s %10s %8s %10s %8s\n", "blur", "noise", "points", "rms_all",
-              "worst_rms", "at_deg", "dbl@45deg", "pass");
+  std::printf(
+      "Straight edges, orientation 0..179 deg step %d, contrast 100, 8-bit, defaults\n"
+      "blur model: pixel-grid = Gaussian on the sampled image; lens = Gaussian before pixel "
+      "integration\n",
+      angleStep);
+  std::printf("%-10s %6s %6s %8s %10s %10s %8s %10s %8s\n", "model", "blur", "noise", "points",
+              "rms_all", "worst_rms", "at_deg", "dbl@45deg", "pass");
   bool allPass = true;
-  for (double blur : {0.8, 1.0, 1.5}) {
-    for (double noise : {0.0, 2.0}) {
-      double sum = 0, worst = 0;
-      int count = 0, worstDeg = 0;
-      for (int deg = 0; deg < 180; deg += angleStep) {
-        const StraightResult r = measureStraight(deg, blur, noise, 1000 + deg, false);
-        sum += r.rms * r.rms * r.points;
-        count += r.points;
-        if (r.rms > worst) worst = r.rms, worstDeg = deg;
+  if (gProfileModel)
+    std::printf("edge profile model fixed to %s (not the default)\n",
+                *gProfileModel ? "grid" : "lens");
+  for (const BlurModel model : {BlurModel::PixelGrid, BlurModel::Lens})
+    for (double blur : {0.5, 0.7, 1.0, 1.5}) {
+      if (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0) continue;
+      for (double noise : {0.0, 2.0}) {
+        double sum = 0, worst = 0;
+        int count = 0, worstDeg = 0;
+        for (int deg = 0; deg < 180; deg += angleStep) {
+          const StraightResult r = measureStraight(deg, blur, noise, 1000 + deg, false, model);
+          sum += r.rms * r.rms * r.points;
+          count += r.points;
+          if (r.rms > worst) worst = r.rms, worstDeg = deg;
+        }
+        const StraightResult d45 = measureStraight(45, blur, noise, 77, false, model);
+        const double bound = noise > 0 ? 0.03 : 0.01;
+        const bool pass = worst <= bound && d45.doubled == 0;
+        allPass = allPass && pass;
+        std::printf("%-10s %6.1f %6.1f %8d %10.4f %10.4f %8d %10d %8s\n",
+                    facet::scene::blurModelName(model), blur, noise, count,
+                    std::sqrt(sum / std::max(count, 1)), worst, worstDeg, d45.doubled,
+                    pass ? "yes" : "NO");
       }
-      const StraightResult d45 = measureStraight(45, blur, noise, 77, false);
-      const double bound = noise > 0 ? 0.03 : 0.01;
-      const bool pass = worst <= bound && d45.doubled == 0;
-      allPass = allPass && pass;
-      std::printf("%6.1f %6.1f %8d %10.4f %10.4f %8d %10d %8s\n", blur, noise, count,
-                  std::sqrt(sum / std::max(count, 1)), worst, worstDeg, d45.doubled,
-                  pass ? "yes" : "NO");
     }
-  }
 
   std::printf("\nCircle radius bias (light disc on dark, no noise): mean radial error, px\n");
-  std::printf("%6s %8s %12s %12s %14s\n", "blur", "radius", "raw", "corrected", "raw*radius");
+  std::printf("%-10s %6s %8s %12s %12s %14s\n", "model", "blur", "radius", "raw", "corrected",
+              "raw*radius");
   const std::vector<double> radii =
       smoke ? std::vector<double>{10, 50} : std::vector<double>{10, 15, 20, 30, 50, 100, 200};
-  for (double blur : smoke ? std::vector<double>{1.0} : std::vector<double>{0.8, 1.0, 1.5}) {
-    for (double r : radii) {
-      const double raw = measureRadiusBias(r, blur, false, 5);
-      const double cor = measureRadiusBias(r, blur, true, 5);
-      std::printf("%6.1f %8.0f %12.4f %12.4f %14.3f\n", blur, r, raw, cor, raw * r);
+  for (const BlurModel model : {BlurModel::PixelGrid, BlurModel::Lens})
+    for (double blur : smoke ? std::vector<double>{1.0} : std::vector<double>{0.7, 1.0, 1.5}) {
+      if (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0) continue;
+      for (double r : radii) {
+        const double raw = measureRadiusBias(r, blur, false, 5, model);
+        const double cor = measureRadiusBias(r, blur, true, 5, model);
+        std::printf("%-10s %6.1f %8.0f %12.4f %12.4f %14.3f\n", facet::scene::blurModelName(model),
+                    blur, r, raw, cor, raw * r);
+      }
     }
-  }
 
   // Speed: a 1280x1024 scene with parts and clutter, blur 1, noise 2.
   SceneSpec spec;

@@ -16,6 +16,7 @@ struct RegisterOptions {
   std::string image;
   std::string model = "homography";
   bool affine = false;
+  bool noEscalation = false;
   int corners = RegistrationParams{}.corners.maxCorners;
   bool json = false;
 };
@@ -31,6 +32,7 @@ void run(const RegisterOptions& o) {
   if (!parseTransformModel(o.model, p.model))
     throw InputError("--model must be similarity, affine or homography (got \"" + o.model + "\")");
   p.affineRegions = o.affine;
+  p.escalateToAffine = !o.noEscalation;
   p.corners.maxCorners = o.corners;
   const cv::Mat ref = readImage(o.ref);
   const cv::Mat image = readImage(o.image);
@@ -51,6 +53,9 @@ void run(const RegisterOptions& o) {
     printJson({{"H", H},
                {"matches", r.matches.size()},
                {"inliers", r.inliers.size()},
+               {"global_inliers", r.globalInliers},
+               {"stage", r.stage},
+               {"escalated", r.escalated},
                {"pairs", jp},
                {"time_ms", ms}});
   } else {
@@ -58,7 +63,8 @@ void run(const RegisterOptions& o) {
     for (int i = 0; i < 3; ++i)
       std::cout << "  " << r.H(i, 0) << " " << r.H(i, 1) << " " << r.H(i, 2) << "\n";
     std::cout << r.matches.size() << " matches, " << r.inliers.size() << " inliers, " << ms
-              << " ms\n";
+              << " ms, stage " << r.stage << (r.escalated ? " (after the plain Harris stage)" : "")
+              << "\n";
   }
 }
 
@@ -73,7 +79,11 @@ void addRegisterCommand(CLI::App& app) {
   cmd->add_option("--image", o->image, "Image to register to the reference")->required();
   cmd->add_option("--model", o->model, "Transform: similarity, affine or homography")
       ->capture_default_str();
-  cmd->add_flag("--affine", o->affine, "Harris-Affine regions (large viewpoint changes; slower)");
+  cmd->add_flag("--affine", o->affine,
+                "Harris-Affine regions from the start (by default they are used only when plain "
+                "Harris corners find no transform to stand on)");
+  cmd->add_flag("--no-escalation", o->noEscalation,
+                "Plain Harris corners only: never escalate to Harris-Affine regions");
   cmd->add_option("--corners", o->corners, "Corner budget per image")->capture_default_str();
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o] { run(*o); });

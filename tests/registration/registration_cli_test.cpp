@@ -66,6 +66,10 @@ TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairs) {
     EXPECT_LT(std::hypot(t[0] - pair[2].get<double>(), t[1] - pair[3].get<double>()), 3.0);
   }
   EXPECT_GT(j.at("time_ms").get<double>(), 0.0);
+  // An easy pair: the fast stage stands on its own.
+  EXPECT_EQ(j.at("stage").get<std::string>(), "harris");
+  EXPECT_FALSE(j.at("escalated").get<bool>());
+  EXPECT_GE(j.at("global_inliers").get<int>(), 20);
 }
 
 TEST_F(RegisterCli, BlankImageIsAMeasurementFailureWithItsCause) {

@@ -120,6 +120,29 @@ TEST(RegisterImages, HarrisAffineRegionsHandleAStrongTilt) {
   EXPECT_LT(cornerError(r.H, truth, ref.size()), 2.0);
 }
 
+TEST(RegisterImages, DefaultsEscalateToHarrisAffineUnderAStrongTilt) {
+  const cv::Mat ref = texturedScene({320, 320}, 9);
+  // Foreshortening by 2.5 along a 30 degree axis plus a perspective term.
+  const double c = std::cos(CV_PI / 6), s = std::sin(CV_PI / 6);
+  const cv::Matx22d R(c, -s, s, c), D(1.0, 0, 0, 0.4);
+  const cv::Matx22d A = R * D * R.t();
+  const cv::Matx33d truth(A(0, 0), A(0, 1), 60, A(1, 0), A(1, 1), 80, 1e-4, 0, 1);
+  const cv::Mat image = warp(ref, truth, {360, 340});
+  RegistrationParams plainOnly;
+  plainOnly.escalateToAffine = false;
+  const RegistrationResult plain = registerImages(ref, image, plainOnly);
+  EXPECT_EQ(plain.stage, "harris");
+  EXPECT_FALSE(plain.escalated);
+  // The plain stage has nothing to stand on here, which is what triggers the escalation.
+  ASSERT_TRUE(!plain.ok || plain.globalInliers < RegistrationParams{}.affineBelowInliers)
+      << plain.globalInliers << " global inliers";
+  const RegistrationResult r = registerImages(ref, image, {});
+  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  EXPECT_EQ(r.stage, "harris-affine");
+  EXPECT_TRUE(r.escalated);
+  EXPECT_LT(cornerError(r.H, truth, ref.size()), 2.0);
+}
+
 TEST(TransformFit, RobustHomographyIgnoresOutliers) {
   const cv::Matx33d truth(0.9, 0.2, 30, -0.1, 1.1, -20, 1e-4, -2e-4, 1);
   cv::RNG rng(1);

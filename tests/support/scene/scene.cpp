@@ -1,5 +1,7 @@
 #include "tests/support/scene/scene.hpp"
 
+#include "tests/support/scene/lens_blur.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <fstream>
@@ -67,28 +69,57 @@ void addSpan(double* row, double* diff, int width, double x0, double x1, double 
 }  // namespace
 
 cv::Mat renderCoverage(const Primitive& primitive, cv::Size size, int subrows) {
-  cv::Mat coverage = cv::Mat::zeros(size, CV_64F);
+  return renderCoverage(primitive, cv::Rect({0, 0}, size), subrows);
+}
+
+cv::Mat renderCoverage(const Primitive& primitive, const cv::Rect& window, int subrows) {
+  cv::Mat coverage;
+  renderCoverageInto(primitive, window, subrows, coverage);
+  return coverage;
+}
+
+void renderCoverageInto(const Primitive& primitive, const cv::Rect& window, int subrows,
+                        cv::Mat& coverage) {
+  coverage.create(window.size(), CV_64F);
+  coverage.setTo(0.0);
   const cv::Rect2d box = boundingBox(primitive);
-  const int r0 = std::max(0, static_cast<int>(std::floor(box.y + 0.5)));
-  const int r1 = std::min(size.height - 1, static_cast<int>(std::floor(box.y + box.height + 0.5)));
-  std::vector<double> xs, diff(static_cast<std::size_t>(size.width) + 1);
+  const int r0 = std::max(window.y, static_cast<int>(std::floor(box.y + 0.5)));
+  const int r1 = std::min(window.y + window.height - 1,
+                          static_cast<int>(std::floor(box.y + box.height + 0.5)));
+  std::vector<double> xs, diff(static_cast<std::size_t>(window.width) + 1);
   const double w = 1.0 / subrows;
+  // Spans are cut in window-local x: pixel window.x + c covers [c - 0.5, c + 0.5] there.
+  const double shift = window.x;
   for (int r = r0; r <= r1; ++r) {
-    auto* row = coverage.ptr<double>(r);
+    auto* row = coverage.ptr<double>(r - window.y);
     std::fill(diff.begin(), diff.end(), 0.0);
     for (int k = 0; k < subrows; ++k) {
       const double y = r - 0.5 + (k + 0.5) * w;
       crossings(primitive, y, xs);
       for (std::size_t i = 0; i + 1 < xs.size(); i += 2)
-        addSpan(row, diff.data(), size.width, xs[i], xs[i + 1], w);
+        addSpan(row, diff.data(), window.width, xs[i] - shift, xs[i + 1] - shift, w);
     }
     double run = 0.0;
-    for (int c = 0; c < size.width; ++c) {
+    for (int c = 0; c < window.width; ++c) {
       run += diff[static_cast<std::size_t>(c)];
       row[c] += run;
     }
   }
-  return coverage;
+}
+
+Primitive scaled(const Primitive& primitive, int scale) {
+  Primitive p = primitive;
+  const auto map = [scale](cv::Point2d q) {
+    return (q + cv::Point2d(0.5, 0.5)) * scale - cv::Point2d(0.5, 0.5);
+  };
+  for (auto& v : p.vertices) v = map(v);
+  p.centre = map(p.centre);
+  p.radius *= scale;
+  return p;
+}
+
+const char* blurModelName(BlurModel model) {
+  return model == BlurModel::Lens ? "lens" : "pixel-grid";
 }
 
 double polygonArea(const std::vector<cv::Point2d>& v) {
@@ -113,6 +144,8 @@ Scene::Scene(SceneSpec spec) : spec_(spec) {
   if (spec_.depth != CV_8U && spec_.depth != CV_16U)
     throw std::invalid_argument("scene: depth must be CV_8U or CV_16U");
   if (spec_.subrows < 1) throw std::invalid_argument("scene: subrows must be >= 1");
+  if (spec_.lensSupersampling < 1)
+    throw std::invalid_argument("scene: lensSupersampling must be >= 1");
 }
 
 void Scene::add(Primitive primitive) {
@@ -204,17 +237,46 @@ std::vector<cv::Point2d> Scene::addOccluder(const cv::Rect2d& region, double sha
 }
 
 cv::Mat Scene::renderIdeal() const {
-  cv::Mat image(spec_.size, CV_64F, cv::Scalar(spec_.background));
-  for (const Primitive& p : primitives_) {
-    const cv::Mat cov = renderCoverage(p, spec_.size, spec_.subrows);
-    // Painter's algorithm on coverage: image = image * (1 - c) + grey * c.
-    image = image.mul(1.0 - cov) + cov * p.grey;
-  }
+  return paintCoverage(primitives_, cv::Rect({0, 0}, spec_.size), spec_.background, 1,
+                       spec_.subrows);
+}
+
+cv::Mat paintCoverage(const std::vector<Primitive>& primitives, const cv::Rect& window,
+                      double background, int scale, int subrows) {
+  cv::Mat image;
+  paintCoverageInto(primitives, window, background, scale, subrows, image);
   return image;
 }
 
+void paintCoverageInto(const std::vector<Primitive>& primitives, const cv::Rect& window,
+                       double background, int scale, int subrows, cv::Mat& image) {
+  image.create(window.size(), CV_64F);
+  image.setTo(background);
+  thread_local cv::Mat cov;  // reused: large buffers cost more in page faults than in filling
+  for (const Primitive& primitive : primitives) {
+    const Primitive p = scale == 1 ? primitive : scaled(primitive, scale);
+    const cv::Rect2d b = boundingBox(p);
+    const cv::Rect box = cv::Rect(cv::Point(static_cast<int>(std::floor(b.x - 1)),
+                                            static_cast<int>(std::floor(b.y - 1))),
+                                  cv::Point(static_cast<int>(std::ceil(b.x + b.width + 2)),
+                                            static_cast<int>(std::ceil(b.y + b.height + 2)))) &
+                         window;
+    if (box.empty()) continue;
+    renderCoverageInto(p, box, subrows, cov);
+    // Painter's algorithm on coverage: image = image * (1 - c) + grey * c.
+    cv::Mat part = image(box - window.tl());
+    for (int r = 0; r < cov.rows; ++r) {
+      const auto* c = cov.ptr<double>(r);
+      auto* v = part.ptr<double>(r);
+      for (int x = 0; x < cov.cols; ++x)
+        if (c[x] != 0.0) v[x] += c[x] * (p.grey - v[x]);
+    }
+  }
+}
+
 cv::Mat Scene::render() const {
-  cv::Mat image = renderIdeal();
+  const bool lens = spec_.blurModel == BlurModel::Lens && spec_.blurSigma > 0.0;
+  cv::Mat image = lens ? renderLensBlurred(primitives_, spec_) : renderIdeal();
   const auto [gx, gy] = spec_.illuminationGradient;
   if (gx != 0.0 || gy != 0.0) {
     const double cx = (spec_.size.width - 1) / 2.0, cy = (spec_.size.height - 1) / 2.0;
@@ -223,7 +285,7 @@ cv::Mat Scene::render() const {
       for (int c = 0; c < image.cols; ++c) row[c] += gx * (c - cx) + gy * (r - cy);
     }
   }
-  if (spec_.blurSigma > 0.0) {
+  if (spec_.blurSigma > 0.0 && !lens) {
     const int k = 2 * static_cast<int>(std::ceil(4.0 * spec_.blurSigma)) + 1;
     cv::GaussianBlur(image, image, cv::Size(k, k), spec_.blurSigma, spec_.blurSigma,
                      cv::BORDER_REFLECT);
@@ -265,6 +327,8 @@ nlohmann::json Scene::groundTruth() const {
             {"height", spec_.size.height},
             {"background", spec_.background},
             {"blur_sigma", spec_.blurSigma},
+            {"blur_model", blurModelName(spec_.blurModel)},
+            {"lens_supersampling", spec_.lensSupersampling},
             {"noise_sigma", spec_.noiseSigma},
             {"illumination_gradient", {spec_.illuminationGradient.x, spec_.illuminationGradient.y}},
             {"bits", spec_.depth == CV_8U ? 8 : 16},

@@ -1,0 +1,214 @@
+// Tabulated edge profiles for edge_profile_fit: the erf, and the exact profiles of a step blurred
+// by a Gaussian and integrated over the pixel square, for both blur models.
+#include "algorithms/edges/edge_profile_tables.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <vector>
+
+namespace facet::edge_profile {
+namespace {
+
+// Standard normal CDF and PDF, tabulated on [-kRange, kRange] with linear interpolation
+// (step 1/64: interpolation error below 1e-5).
+constexpr float kRange = 6.0f;
+constexpr int kPerUnit = 64;
+constexpr int kTableSize = static_cast<int>(2 * kRange * kPerUnit) + 2;
+
+struct NormalTable {
+  std::array<float, kTableSize> cdf{}, pdf{};
+  // The same, packed per interval for the vectorised fit: value and slope of CDF and PDF.
+  using Interval = ProfileInterval;
+  std::array<Interval, kTableSize> packed{};
+  NormalTable() {
+    for (int i = 0; i < kTableSize; ++i) {
+      const double z = -kRange + static_cast<double>(i) / kPerUnit;
+      cdf[i] = static_cast<float>(0.5 * std::erfc(-z / std::numbers::sqrt2));
+      pdf[i] = static_cast<float>(std::exp(-0.5 * z * z) / std::sqrt(2 * std::numbers::pi));
+    }
+    for (int i = 0; i + 1 < kTableSize; ++i)
+      packed[i] = {cdf[i], cdf[i + 1] - cdf[i], pdf[i], pdf[i + 1] - pdf[i]};
+    packed[kTableSize - 1] = {cdf[kTableSize - 1], 0, pdf[kTableSize - 1], 0};
+  }
+};
+
+const NormalTable& normalTable() {
+  static const NormalTable table;
+  return table;
+}
+
+// Profiles of a blurred step seen through the pixel aperture, for one PSF sigma and normal
+// angles 0..45 degrees (1 degree steps; the profile depends only on {|cos|, |sin|}).
+// For the unit pixel square the aperture projected on the normal is box(c) * box(s) with
+// c = |cos|, s = |sin|, so with G(x) = x Phi(x) + phi(x) and H(x) = ((x^2 + 1) Phi(x) + x phi(x))/2
+// (the first and second antiderivatives of Phi):
+//   P(u)  = sigma^2 / (c s) [H((u+p)/sigma) - H((u+m)/sigma) - H((u-m)/sigma) + H((u-p)/sigma)]
+//   P'(u) = sigma   / (c s) [G(...)         - G(...)         - G(...)         + G(...)]
+// with p = (c + s)/2, m = (c - s)/2; for s -> 0 the single box gives
+//   P(u) = sigma / c [G((u+c/2)/sigma) - G((u-c/2)/sigma)],  P'(u) = [Phi(..) - Phi(..)] / c.
+constexpr float kApertureRange = 7.5f;  // pixels either side of the edge
+constexpr int kAperturePerPixel = 16;
+constexpr int kApertureSize = static_cast<int>(2 * kApertureRange * kAperturePerPixel) + 2;
+constexpr int kApertureAngles = 46;
+
+}  // namespace
+
+class ApertureProfiles {
+ public:
+  double sigma = 0;
+  bool gridBlur = false;
+  std::vector<NormalTable::Interval> rows;  // kApertureAngles x kApertureSize, built on use
+  std::unique_ptr<std::once_flag[]> built;
+
+  ApertureProfiles(double psfSigma, bool blurOnGrid)
+      : sigma(psfSigma), gridBlur(blurOnGrid), built(new std::once_flag[kApertureAngles]) {
+    rows.resize(static_cast<size_t>(kApertureAngles) * kApertureSize);
+  }
+
+  void buildRow(int k) {
+    std::vector<double> value(kApertureSize), slope(kApertureSize);
+    {
+      const double angle = k * std::numbers::pi / 180.0;
+      const double c = std::cos(angle), sn = std::sin(angle);
+      for (int i = 0; i < kApertureSize; ++i) {
+        const double u = -kApertureRange + static_cast<double>(i) / kAperturePerPixel;
+        if (gridBlur)
+          gridProfile(u, c, sn, value[i], slope[i]);
+        else
+          profile(u, c, sn, value[i], slope[i]);
+      }
+      NormalTable::Interval* row = &rows[static_cast<size_t>(k) * kApertureSize];
+      for (int i = 0; i < kApertureSize; ++i) {
+        const int j = std::min(i + 1, kApertureSize - 1);
+        row[i] = {static_cast<float>(value[i]), static_cast<float>(value[j] - value[i]),
+                  static_cast<float>(slope[i]), static_cast<float>(slope[j] - slope[i])};
+      }
+    }
+  }
+
+  ProfileView view(cv::Point2d normal) {
+    const double lo = std::min(std::abs(normal.x), std::abs(normal.y));
+    const double hi = std::max(std::abs(normal.x), std::abs(normal.y));
+    // The nearest whole degree of atan(lo / hi), by comparing with tan(k + 1/2 degree).
+    static const std::array<double, kApertureAngles> tanHalf = [] {
+      std::array<double, kApertureAngles> t{};
+      for (int k = 0; k < kApertureAngles; ++k) t[k] = std::tan((k + 0.5) * std::numbers::pi / 180);
+      return t;
+    }();
+    const double ratio = hi > 0 ? lo / hi : 0.0;
+    const int k = std::min(
+        static_cast<int>(std::lower_bound(tanHalf.begin(), tanHalf.end(), ratio) - tanHalf.begin()),
+        kApertureAngles - 1);
+    std::call_once(built[k], [this, k] { buildRow(k); });
+    return {&rows[static_cast<size_t>(k) * kApertureSize],
+            kApertureSize,
+            1.0f,
+            kApertureRange,
+            static_cast<float>(kAperturePerPixel),
+            1.0};
+  }
+
+ private:
+  static double cdf(double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }
+  static double pdf(double x) { return std::exp(-0.5 * x * x) / std::sqrt(2 * std::numbers::pi); }
+  static double g(double x) { return x * cdf(x) + pdf(x); }
+  static double h(double x) { return 0.5 * ((x * x + 1) * cdf(x) + x * pdf(x)); }
+
+  // The sharp step integrated over the pixel square: the CDF and density of the aperture
+  // box(c) * box(s) at x.
+  static void sharpStep(double x, double c, double s, double& value, double& slope) {
+    if (s < 1e-6) {
+      value = std::clamp((x + c / 2) / c, 0.0, 1.0);
+      slope = std::abs(x) < c / 2 ? 1 / c : 0.0;
+      return;
+    }
+    const double p = (c + s) / 2, m = (c - s) / 2;
+    if (x <= -p) {
+      value = 0, slope = 0;
+    } else if (x <= -m) {
+      value = (x + p) * (x + p) / (2 * c * s), slope = (x + p) / (c * s);
+    } else if (x <= m) {
+      value = s / (2 * c) + (x + m) / c, slope = 1 / c;
+    } else if (x < p) {
+      value = 1 - (p - x) * (p - x) / (2 * c * s), slope = (p - x) / (c * s);
+    } else {
+      value = 1, slope = 0;
+    }
+  }
+
+  // Blur on the pixel grid: the pixel-integrated sharp step convolved with the sampled Gaussian
+  // kernel (truncated at 4 sigma, normalised), as a blur applied to the sampled image does:
+  //   P(u) = sum_k g(kx) g(ky) sharpStep(u - kx c - ky s).
+  void gridProfile(double u, double c, double s, double& value, double& slope) const {
+    const int r = static_cast<int>(std::ceil(4 * sigma));
+    thread_local std::vector<double> kernel;
+    kernel.assign(2 * r + 1, 0.0);
+    double sum = 0;
+    for (int k = -r; k <= r; ++k) sum += kernel[k + r] = std::exp(-0.5 * k * k / (sigma * sigma));
+    value = slope = 0;
+    if (s < 1e-9) {  // axis-aligned: the kernel's rows all project to the same offsets
+      for (int kx = -r; kx <= r; ++kx) {
+        double v, d;
+        sharpStep(u - kx * c, c, s, v, d);
+        value += kernel[kx + r] / sum * v;
+        slope += kernel[kx + r] / sum * d;
+      }
+      return;
+    }
+    for (int ky = -r; ky <= r; ++ky)
+      for (int kx = -r; kx <= r; ++kx) {
+        double v, d;
+        sharpStep(u - kx * c - ky * s, c, s, v, d);
+        const double weight = kernel[kx + r] * kernel[ky + r] / (sum * sum);
+        value += weight * v;
+        slope += weight * d;
+      }
+  }
+
+  void profile(double u, double c, double s, double& value, double& slope) const {
+    const double sg = sigma;
+    if (s < 1e-3) {
+      value = sg / c * (g((u + c / 2) / sg) - g((u - c / 2) / sg));
+      slope = (cdf((u + c / 2) / sg) - cdf((u - c / 2) / sg)) / c;
+      return;
+    }
+    const double p = (c + s) / 2, m = (c - s) / 2;
+    value =
+        sg * sg / (c * s) * (h((u + p) / sg) - h((u + m) / sg) - h((u - m) / sg) + h((u - p) / sg));
+    slope = sg / (c * s) * (g((u + p) / sg) - g((u + m) / sg) - g((u - m) / sg) + g((u - p) / sg));
+  }
+};
+
+// Profiles are pure functions of sigma; keep the last few so that a camera's images (whose blur
+// estimate varies little) build them once.
+std::shared_ptr<ApertureProfiles> apertureProfiles(double sigma, bool gridBlur) {
+  static std::mutex mutex;
+  static std::vector<std::shared_ptr<ApertureProfiles>> cache;
+  const double key = std::round(sigma * 50) / 50;
+  std::lock_guard lock(mutex);
+  for (const auto& p : cache)
+    if (p->sigma == key && p->gridBlur == gridBlur) return p;
+  auto made = std::make_shared<ApertureProfiles>(key, gridBlur);
+  if (cache.size() >= 64) cache.erase(cache.begin());
+  cache.push_back(made);
+  return made;
+}
+
+ProfileView erfView(double w) {
+  const auto& t = normalTable();
+  return {t.packed.data(),
+          kTableSize,
+          static_cast<float>(1.0 / w),
+          kRange,
+          static_cast<float>(kPerUnit),
+          w};
+}
+
+ProfileView apertureView(ApertureProfiles& profiles, cv::Point2d normal) {
+  return profiles.view(normal);
+}
+
+}  // namespace facet::edge_profile

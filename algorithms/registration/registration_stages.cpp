@@ -1,0 +1,71 @@
+// The default registration pipeline: the fast plain-Harris stage first, Harris-Affine regions
+// when that finds no transform it can stand on. Why not always Harris-Affine: its shape
+// adaptation costs several times the plain windows, and most pairs (small viewpoint changes,
+// rotation, zoom) do not need it; why not plain Harris alone: beyond about 30 degrees of
+// viewpoint change its windows no longer match, and the few chance matches left can still agree
+// on a wrong transform.
+#include "algorithms/registration/register_images.hpp"
+
+#include <opencv2/calib3d.hpp>
+
+namespace facet {
+namespace {
+
+// The last step for a homography: the re-matched pairs within `finalThreshold` of H fitted by
+// Levenberg-Marquardt on their transfer error (OpenCV's findHomography, method 0: normalised DLT,
+// then LM). The DLT before it minimises an algebraic error, which weights pairs unevenly across
+// the image (by their homogeneous scale), so it stops short of the precision the pairs hold.
+void polishHomography(RegistrationResult& r, const RegistrationParams& params) {
+  std::vector<cv::Point2f> src, dst;
+  for (const FeatureMatch& m : r.matches)
+    if (transferError(r.H, m.ref, m.image) <= params.finalThreshold) {
+      src.emplace_back(m.ref);
+      dst.emplace_back(m.image);
+    }
+  if (src.size() < 8) return;
+  const cv::Mat H = cv::findHomography(src, dst, 0);
+  if (H.empty()) return;
+  cv::Matx33d polished(H);
+  polished *= 1.0 / polished(2, 2);
+  double before = 0, after = 0;
+  for (std::size_t i = 0; i < src.size(); ++i) {
+    before += std::pow(transferError(r.H, src[i], dst[i]), 2);
+    after += std::pow(transferError(polished, src[i], dst[i]), 2);
+  }
+  if (!(after < before)) return;
+  std::vector<int> inliers;
+  for (std::size_t i = 0; i < r.matches.size(); ++i)
+    if (transferError(polished, r.matches[i].ref, r.matches[i].image) <= params.inlierThreshold)
+      inliers.push_back(static_cast<int>(i));
+  if (inliers.size() < r.inliers.size()) return;
+  r.H = polished;
+  r.inliers = std::move(inliers);
+}
+
+RegistrationResult registerStages(const cv::Mat& ref, const cv::Mat& image,
+                                  const RegistrationParams& params) {
+  RegistrationResult fast = registerSingleStage(ref, image, params);
+  if (params.affineRegions || !params.escalateToAffine ||
+      (fast.ok && fast.globalInliers >= params.affineBelowInliers))
+    return fast;
+  RegistrationParams affine = params;
+  affine.affineRegions = true;
+  RegistrationResult adapted = registerSingleStage(ref, image, affine);
+  adapted.escalated = fast.escalated = true;
+  if (!adapted.ok && fast.ok) return fast;
+  if (adapted.ok && fast.ok && adapted.globalInliers <= fast.globalInliers) return fast;
+  return adapted;
+}
+
+}  // namespace
+
+RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
+                                  const RegistrationParams& params) {
+  RegistrationResult r = registerStages(ref, image, params);
+  if (r.ok && params.model == TransformModel::Homography && params.refineIterations > 0 &&
+      params.polishHomography)
+    polishHomography(r, params);
+  return r;
+}
+
+}  // namespace facet
