@@ -147,7 +147,10 @@ class RecipeReader {
   void readStep(const YAML::Node& item) {
     if (!item.IsMap() || !item["kind"] || !item["kind"].IsScalar()) return;
     const auto kind = stepKindNamed(item["kind"].Scalar());
-    if (!kind) return;  // reported by the validator
+    if (!kind) {  // reported by the validator; references to it are not errors of their own
+      if (item["id"] && item["id"].IsScalar()) unknownKindIds_.insert(item["id"].Scalar());
+      return;
+    }
     Step step;
     step.kind = *kind;
     step.where = where(item);
@@ -190,6 +193,7 @@ class RecipeReader {
   std::optional<std::string> stepRef(const YAML::Node& n, Need need, const std::string& key) {
     if (!n || !n.IsScalar()) return std::nullopt;
     const std::string id = n.Scalar();
+    if (unknownKindIds_.contains(id)) return id;  // one error per cause: the unknown kind
     const auto it = earlier_.find(id);
     if (it == earlier_.end()) {
       if (const auto later = allIds_.find(id); later != allIds_.end()) {
@@ -516,14 +520,17 @@ class RecipeReader {
     const ModelStatus status = modelStatus(*model, *source, trainingParameters(step));
     const std::string advice = "; run `facet recipe train " + file_.string() + "`";
     const std::string what = "model " + inQuotes(item["model"].Scalar()) + " ";
+    // A file that is no model at all (or one of another facet version) is that, not "stale".
+    if (status.state != ModelState::Missing) {
+      try {
+        loadShapeModel(*model);
+      } catch (const std::exception& e) {
+        error(item["model"], what + "cannot be loaded: " + e.what() + advice);
+        return;
+      }
+    }
     switch (status.state) {
       case ModelState::Fresh:
-        // Also refuses a model written by another (incompatible) version of facet.
-        try {
-          loadShapeModel(*model);
-        } catch (const std::exception& e) {
-          error(item["model"], what + "cannot be loaded: " + e.what() + advice);
-        }
         break;
       case ModelState::Untracked:
         out_.warning(where(item["model"]),
@@ -556,6 +563,7 @@ class RecipeReader {
   Recipe recipe_;
   std::map<std::string, EarlierStep> earlier_;  // ids of the steps read so far
   std::map<std::string, int> allIds_;           // every step id -> its line
+  std::set<std::string> unknownKindIds_;        // steps whose kind is unknown (already an error)
   std::map<std::filesystem::path, cv::Size> imageSizes_;
   std::vector<RegisterUse> uses_;
 };
