@@ -54,6 +54,10 @@ TEST(PlcSimulator, TriggersAtARateAndReadsEveryResult) {
   link.setActiveRecipe(3);
   link.start();
   sim.start();
+  // Not ready: the rate raises nothing (a daemon still starting would only miss its triggers).
+  std::this_thread::sleep_for(200ms);
+  EXPECT_EQ(sim.stats().triggersRaised, 0u);
+  link.setReady(true);
   constexpr int kParts = 10;
   for (int i = 0; i < kParts; ++i) {
     const auto trigger = link.waitTrigger(5s);
