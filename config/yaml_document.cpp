@@ -1,6 +1,7 @@
 #include "config/yaml_document.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -61,6 +62,38 @@ std::optional<std::string> unterminatedQuote(const std::string& bytes, std::size
   return std::nullopt;
 }
 
+// A quoted value that opens on a line up to `lastLine` (1-based) and runs on: the syntax error
+// yaml-cpp reports further down ("end of map not found") is its consequence, so this is the
+// error to report.
+std::optional<SourceLocation> openQuoteUpTo(const std::string& bytes, int lastLine,
+                                            const std::filesystem::path& file,
+                                            std::string& message) {
+  const auto keyChar = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '_';
+  };
+  std::size_t start = 0;
+  for (int line = 1; start < bytes.size() && line <= lastLine; ++line) {
+    const std::size_t end = std::min(bytes.find('\n', start), bytes.size());
+    std::size_t i = start;
+    const auto skipSpaces = [&] {
+      while (i < end && bytes[i] == ' ') ++i;
+    };
+    skipSpaces();
+    if (i + 1 < end && bytes[i] == '-' && bytes[i + 1] == ' ') i += 2, skipSpaces();
+    std::size_t k = i;
+    while (k < end && keyChar(bytes[k])) ++k;
+    if (k > i && k < end && bytes[k] == ':') i = k + 1, skipSpaces();
+    if (i < end && (bytes[i] == '"' || bytes[i] == '\'')) {
+      if (auto problem = unterminatedQuote(bytes, i)) {
+        message = *problem;
+        return SourceLocation{file, line, static_cast<int>(i - start) + 1};
+      }
+    }
+    start = end + 1;
+  }
+  return std::nullopt;
+}
+
 // The first quoted scalar (key or value) of the document whose quote is not closed properly.
 std::optional<SourceLocation> findUnterminatedQuote(const YAML::Node& node,
                                                     const std::string& bytes,
@@ -107,7 +140,12 @@ std::optional<YamlFile> readYamlFile(const std::filesystem::path& file, Diagnost
   } catch (const YAML::Exception& e) {
     SourceLocation where{file};
     if (!e.mark.is_null()) where = {file, e.mark.line + 1, e.mark.column + 1};
-    out.error(where, "not valid YAML: " + e.msg);
+    std::string message;
+    if (const auto quote =
+            openQuoteUpTo(result.bytes, where.line > 0 ? where.line : 1 << 30, file, message))
+      out.error(*quote, "not valid YAML: " + message);
+    else
+      out.error(where, "not valid YAML: " + e.msg);
     return std::nullopt;
   }
   if (!result.root.IsDefined() || result.root.IsNull()) {
