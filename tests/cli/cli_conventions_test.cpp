@@ -155,7 +155,7 @@ TEST_F(CliConventions, CorruptImagesGetOurMessageOnly) {
 }
 
 TEST_F(CliConventions, CircleTakesTheRecipeWords) {
-  for (const std::string& words :
+  for (const std::string words :
        {"--centre 80,70 --polarity dark_inside", "--center 80,70 --polarity dark_inside",
         "--centre 80,70 --polarity dark_to_light"}) {
     const CliRun r = facet("circle --image " + hole_ + " --radius 30 --json " + words);

@@ -149,8 +149,8 @@ TEST(ShapeCli, MatchSaysWhenTheModelCutsTheRequestedRange) {
   ASSERT_EQ(inside.exitCode, 0) << readText(err);
   EXPECT_TRUE(nlohmann::json::parse(inside.out).at("warnings").empty()) << inside.out;
 
-  for (const std::string& option : {"--min-score 1.5", "--min-score 0", "--max-overlap 2",
-                                    "--greediness -1", "--num-matches -3"}) {
+  for (const std::string option : {"--min-score 1.5", "--min-score 0", "--max-overlap 2",
+                                   "--greediness -1", "--num-matches -3"}) {
     const CliRun bad = run(match + " " + option, err);
     EXPECT_EQ(bad.exitCode, 1) << option;
     const std::string message = readText(err);
