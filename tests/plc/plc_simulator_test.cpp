@@ -52,6 +52,7 @@ TEST(PlcSimulator, TriggersAtARateAndReadsEveryResult) {
   });
   PlcLink link(exampleMap(), settingsFor(sim.port(), HandshakeMode::Triggered));
   link.setActiveRecipe(3);
+  link.setReady(false);
   link.start();
   sim.start();
   // Not ready: the rate raises nothing (a daemon still starting would only miss its triggers).
