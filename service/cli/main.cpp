@@ -1,5 +1,7 @@
 // facet: the command-line tool. Runs facet's algorithms one image at a time, trains models,
 // checks recipes and replays folders. See command_line.hpp for the output conventions.
+// runFacet() is the whole program for a set of step kinds; facet_main.cpp runs it with facet's
+// own (a test adds a kind of its own).
 #include <iostream>
 
 #include <opencv2/core/utils/logger.hpp>
@@ -67,10 +69,8 @@ std::string commandPath(CLI::App& app) {
 }
 
 }  // namespace
-}  // namespace facet::cli
 
-int main(int argc, char** argv) {
-  using namespace facet::cli;
+int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds) {
   // Decoders report through our own messages (readGreyImage); OpenCV's log would only repeat
   // them as "[ WARN:0@0.037] global ... findDecoder imread_(...)" on stderr.
   cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
@@ -85,8 +85,8 @@ int main(int argc, char** argv) {
   addModelCommand(app);
   addMatchCommand(app);
   addRegisterCommand(app);
-  addRecipeCommand(app);
-  addReplayCommand(app);
+  addRecipeCommand(app, kinds);
+  addReplayCommand(app, kinds);
 
   if (const auto problem = commandProblem(app, argc, argv)) {
     std::cerr << *problem << "\n";
@@ -115,3 +115,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace facet::cli

@@ -77,7 +77,7 @@ std::vector<std::filesystem::path> recipeFiles(
 
 // A station file given as a recipe (`facet recipe check station.yaml`): a mapping without steps
 // whose keys are the station's (camera, plc, ...) rather than a recipe's.
-bool isStationFile(const std::filesystem::path& file) {
+bool isStationFile(const std::filesystem::path& file, const config::StepKindRegistry& kinds) {
   if (std::filesystem::is_directory(file) || file.string().ends_with(config::kRecipeFileSuffix))
     return false;
   Diagnostics ignored;
@@ -86,17 +86,18 @@ bool isStationFile(const std::filesystem::path& file) {
   for (const auto& entry : yaml->root) {
     const std::string key = entry.first.Scalar();
     if (config::stationFormat().station.find(key) != nullptr &&
-        config::recipeFormat().recipe.find(key) == nullptr)
+        config::RecipeFormat(kinds).recipe.find(key) == nullptr)
       return true;
   }
   return false;
 }
 
-void check(Options opt) {
+void check(Options opt, const config::StepKindRegistry& kinds) {
   // A station file among the recipes is checked as the station, with the recipes it names.
   if (opt.station.empty()) {
-    const auto station = std::find_if(opt.files.begin(), opt.files.end(),
-                                      [](const std::string& f) { return isStationFile(f); });
+    const auto station =
+        std::find_if(opt.files.begin(), opt.files.end(),
+                     [&](const std::string& f) { return isStationFile(f, kinds); });
     if (station != opt.files.end()) {
       if (!opt.json)
         std::cerr << *station << ": a station file: checking it as the station, with its "
@@ -119,7 +120,7 @@ void check(Options opt) {
   nlohmann::json results = nlohmann::json::array();
   std::map<int, std::filesystem::path> ids;  // recipe ids are unique across the files checked
   for (const auto& file : files) {
-    auto loaded = config::loadRecipe(file, options);
+    auto loaded = config::loadRecipe(file, kinds, options);
     if (loaded.id > 0) {
       const auto [it, first] = ids.emplace(loaded.id, file);
       if (!first) {
@@ -170,7 +171,7 @@ void check(Options opt) {
                      " recipe file(s)" + (opt.station.empty() ? "" : " and the station file"));
 }
 
-void train(const Options& opt) {
+void train(const Options& opt, const config::StepKindRegistry& kinds) {
   Diagnostics all;
   std::optional<config::StationConfig> station;
   auto options = loadOptions(opt, all, station);
@@ -178,7 +179,7 @@ void train(const Options& opt) {
   if (all.hasErrors()) throw InputError("the station file has errors:\n" + all.text());
   nlohmann::json trainedJson = nlohmann::json::array();
   for (const auto& file : recipeFiles(opt, station)) {
-    const auto loaded = config::loadRecipe(file, options);
+    const auto loaded = config::loadRecipe(file, kinds, options);
     if (!loaded.recipe)
       throw InputError(file.string() + " has errors; nothing trained:\n" +
                        loaded.diagnostics.text());
@@ -202,7 +203,7 @@ void train(const Options& opt) {
 
 }  // namespace
 
-void addRecipeCommand(CLI::App& app) {
+void addRecipeCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
   auto* recipe = app.add_subcommand("recipe", "Check, train and describe recipe files");
   recipe->require_subcommand(1);
 
@@ -216,7 +217,7 @@ void addRecipeCommand(CLI::App& app) {
   checkCmd->add_option("--root", opt->root,
                        "Recipes folder paths must stay inside (default: the recipe's folder)");
   checkCmd->add_flag("--json", opt->json, "Print one JSON object");
-  checkCmd->callback([opt] { check(*opt); });
+  checkCmd->callback([opt, &kinds] { check(*opt, kinds); });
 
   auto* trainCmd = recipe->add_subcommand(
       "train", "Create the shape models a recipe needs, with a record of what they came from");
@@ -224,7 +225,7 @@ void addRecipeCommand(CLI::App& app) {
   trainCmd->add_option("--station", opt->station, "Station file");
   trainCmd->add_option("--root", opt->root, "Recipes folder");
   trainCmd->add_flag("--json", opt->json, "Print one JSON object");
-  trainCmd->callback([opt] { train(*opt); });
+  trainCmd->callback([opt, &kinds] { train(*opt, kinds); });
 
   auto kind = std::make_shared<std::string>("recipe");
   auto output = std::make_shared<std::string>();
@@ -233,9 +234,9 @@ void addRecipeCommand(CLI::App& app) {
   schemaCmd->add_option("kind", *kind, "recipe or station")
       ->check(CLI::IsMember({"recipe", "station"}));
   schemaCmd->add_option("--output,-o", *output, "Write to this file instead of stdout");
-  schemaCmd->callback([kind, output] {
+  schemaCmd->callback([kind, output, &kinds] {
     const auto schema =
-        *kind == "station" ? config::stationJsonSchema() : config::recipeJsonSchema();
+        *kind == "station" ? config::stationJsonSchema() : config::recipeJsonSchema(kinds);
     if (output->empty()) {
       std::cout << schema.dump(2) << "\n";
       return;

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <map>
 
-#include "config/recipe_format.hpp"
+#include "service/engine/builtin_steps.hpp"
 
 namespace facet::service {
 namespace {
@@ -43,9 +43,12 @@ void summarise(Capability& c) {
 NaturalBounds naturalBounds(const std::string& name, const std::string& unit) {
   NaturalBounds bounds;
   const std::string value = name.substr(name.rfind('.') + 1);
-  // The check tables of every step kind; a value name means the same quantity in each.
-  for (const config::ObjectSpec& checks : config::recipeFormat().checks) {
-    const config::FieldSpec* field = checks.find(value);
+  // The check tables of facet's step kinds; a value name means the same quantity in each.
+  static const config::StepKindRegistry kinds = builtinSteps();
+  for (const config::StepKind* kind : kinds.kinds()) {
+    const config::FieldSpec* checks = kind->format().object.find("checks");
+    if (checks == nullptr || checks->object == nullptr) continue;
+    const config::FieldSpec* field = checks->object->find(value);
     if (field == nullptr) continue;
     if (field->minimum) bounds.lower = *field->minimum;
     if (field->quantity == config::Quantity::Score) bounds.upper = 1.0;

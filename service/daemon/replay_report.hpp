@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::service {
 

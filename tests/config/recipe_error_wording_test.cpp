@@ -17,7 +17,7 @@ class RecipeErrorWording : public testing::Test {
   RecipeLoadResult load(const std::string& text, RecipeLoadOptions options = {}) {
     const auto file = scratch.write("test.recipe.yaml", text);
     if (!options.root) options.root = scratch.path();
-    return loadRecipe(file, options);
+    return loadRecipe(file, facetSteps(), options);
   }
 
   ScratchFolder scratch;

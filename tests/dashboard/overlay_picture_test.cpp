@@ -4,8 +4,8 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "service/daemon/label_placement.hpp"
-#include "service/daemon/overlay.hpp"
+#include "service/engine/label_placement.hpp"
+#include "service/engine/overlay.hpp"
 #include "service/daemon/part_banner.hpp"
 
 namespace facet::service {

@@ -1,4 +1,4 @@
-#include "service/daemon/label_placement.hpp"
+#include "service/engine/label_placement.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,11 +1,11 @@
-#include "service/daemon/overlay.hpp"
+#include "service/engine/overlay.hpp"
 
 #include <algorithm>
 #include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
-#include "service/daemon/label_placement.hpp"
+#include "service/engine/label_placement.hpp"
 
 namespace facet::service {
 namespace {
