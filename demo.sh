@@ -4,6 +4,6 @@ set -euo pipefail
 cd "$(dirname "$0")"
 bash deploy/install-deps.sh
 build=${FACET_BUILD_DIR:-build/release}
-cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+bash deploy/configure-release.sh "$build"  # the same folder and flags as ./test.sh
 cmake --build "$build" -j2
 exec bash deploy/demo-run.sh "$build"

@@ -38,7 +38,7 @@ trap report_timings EXIT
 if [ "$run_release" = 1 ]; then
   start=$(date +%s)
   build=${FACET_BUILD_DIR:-build/release}
-  cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DFACET_WERROR=ON >/dev/null
+  bash deploy/configure-release.sh "$build"  # the same folder and flags as ./demo.sh
   cmake --build "$build" -j2
   ctest --test-dir "$build" --output-on-failure -j2 --timeout 900 "$@"
   phase_done release "$start"

@@ -84,6 +84,17 @@ GrabResult ReplayCamera::grab(std::chrono::milliseconds timeout) {
     }
     if (!health_.streaming) return {GrabStatus::NotStarted, {}, name() + ": stopped"};
     --pending_triggers_;
+    // The frame rate is the camera's limit in either mode: triggers faster than `fps` (a station
+    // that triggers itself without a PLC took ~100 parts a second at fps 5) wait for it.
+    if (settings_.fps > 0.0) {
+      const auto due = next_due_;
+      lock.unlock();
+      std::this_thread::sleep_until(due);
+      lock.lock();
+      const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(1.0 / settings_.fps));
+      next_due_ = std::max(due + period, std::chrono::steady_clock::now() - period);
+    }
   } else if (settings_.fps > 0.0) {
     if (next_due_ > deadline) {
       lock.unlock();

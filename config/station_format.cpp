@@ -77,7 +77,8 @@ StationFormat::StationFormat() {
        flag("loop", "Start again after the last file.", false),
        {.name = "fps",
         .type = F::Number,
-        .description = "Frames per second in free-run mode; 0 = as fast as grabbed.",
+        .description = "Frames per second: the rate in free_run, the highest rate with a "
+                       "software trigger; 0 = as fast as grabbed.",
         .minimum = 0.0,
         .defaultValue = 0.0},
        choice("trigger", "free_run or software.", {"free_run", "software"}, "free_run"),

@@ -39,7 +39,7 @@ for run in 1:bracket_registration 2:bracket_shape 3:fiducial_board 4:scan_offset
   parts=$(find "$folder" -maxdepth 1 \( -name '*.png' -o -name '*.csv' \) | wc -l)
   echo "== recipe $id over $folder ($parts recorded parts)"
   "$facetd" --config "$station" --recipe "$id" --replay "$folder" --max-parts "$parts" --print-parts \
-    2> >(grep -v "has no value" >&2) | cut -c1-220
+    2> >(grep -v "has no value" >&2)
 done
 
 kill $sim 2>/dev/null || true

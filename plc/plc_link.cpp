@@ -109,6 +109,7 @@ struct PlcLink::State {
   std::uint16_t heartbeat = 0;
   Clock::time_point nextHeartbeat;
   std::chrono::milliseconds backoff{0};
+  std::uint64_t failedConnects = 0;  // since the last connect
   std::map<std::string, std::uint64_t> exceptionCounts;
 
   // --- the I/O thread -------------------------------------------------------------------------
@@ -260,13 +261,23 @@ void PlcLink::State::connect() {
       std::lock_guard lock(mutex);
       waiting = queue.size();
     }
-    spdlog::warn("PLC: {}; retrying in {} ms ({} results waiting)", e.what(), backoff.count(),
-                 waiting);
+    ++failedConnects;
+    // Attempts 1, 2, 4, 8, ...: the retries stay frequent (a PLC that comes back is found
+    // within reconnectMax), the log does not fill up with the same line twice a second.
+    if ((failedConnects & (failedConnects - 1)) == 0) {
+      spdlog::warn(
+          "PLC: {}; retrying in {} ms, attempt {} ({} results waiting; next logged at "
+          "attempt {})",
+          e.what(), backoff.count(), failedConnects, waiting, 2 * failedConnects);
+    }
     std::unique_lock lock(mutex);
     wake.wait_for(lock, backoff, [&] { return stopping; });
     return;
   }
   backoff = std::chrono::milliseconds{0};
+  if (failedConnects > 0)
+    spdlog::info("PLC: reachable again after {} failed attempts", failedConnects);
+  failedConnects = 0;
   connected = true;
   {
     std::lock_guard lock(mutex);

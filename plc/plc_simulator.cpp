@@ -124,7 +124,9 @@ void PlcSimulator::State::scan() {
       // Trigger: raised on request or at the rate.
       if (triggerRequested.exchange(false)) raisePending = true;
       if (ratePeriod > SteadyClock::duration::zero() && now >= nextTrigger) {
-        raisePending = true;
+        // As a line's PLC does, the rate feeds parts only to a daemon that says it is ready:
+        // one still starting (or not connected) would only miss them ("trigger while busy").
+        if (!map.status.ready || tables.flag(map.status.ready)) raisePending = true;
         nextTrigger += ratePeriod;
       }
       // A polling daemon sees an edge only if the trigger stayed low for a few of its polls.

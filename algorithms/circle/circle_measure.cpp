@@ -139,6 +139,11 @@ CircleMeasurement failed(CircleMeasurement m, CircleFailure f, std::string messa
   return m;
 }
 
+// A number for a message: "600" or "0.0123", not std::to_string's "600.000000".
+std::string readable(double value) {
+  return cv::format("%.6g", value);
+}
+
 std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
   if (image.empty()) return "the image is empty";
   if (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U))
@@ -147,11 +152,11 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
   if (!std::isfinite(p.centre.x) || !std::isfinite(p.centre.y))
     return "the expected centre is not finite";
   if (!(p.radius > 0.0) || !std::isfinite(p.radius))
-    return "the nominal radius must be positive (got " + std::to_string(p.radius) + ")";
+    return "the nominal radius must be positive (got " + readable(p.radius) + ")";
   if (!(p.width > 0.0) || !std::isfinite(p.width))
-    return "the search width must be positive (got " + std::to_string(p.width) + ")";
+    return "the search width must be positive (got " + readable(p.width) + ")";
   if (p.radius + p.width > 1e5)
-    return "the annulus (radius + width = " + std::to_string(p.radius + p.width) +
+    return "the annulus (radius + width = " + readable(p.radius + p.width) +
            " px) is larger than any image";
   if (std::abs(p.centre.x) > 1e7 || std::abs(p.centre.y) > 1e7)
     return "the expected centre lies absurdly far outside the image";
@@ -320,10 +325,10 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
       detectAnnulusEdges(image, c0, rIn, rOut, params.cannyLow, params.cannyHigh);
   if (edges.annulusPixels == 0)
     return failed(m, CircleFailure::AnnulusOutsideImage,
-                  "the search annulus around (" + std::to_string(c0.x) + ", " +
-                      std::to_string(c0.y) + ") with radius " + std::to_string(params.radius) +
-                      " +- " + std::to_string(params.width) + " lies outside the " +
-                      std::to_string(image.cols) + "x" + std::to_string(image.rows) + " image");
+                  "the search annulus around (" + readable(c0.x) + ", " + readable(c0.y) +
+                      ") with radius " + readable(params.radius) + " +- " + readable(params.width) +
+                      " lies outside the " + std::to_string(image.cols) + "x" +
+                      std::to_string(image.rows) + " image");
 
   m.lowThreshold = edges.lowThreshold;
   m.highThreshold = edges.highThreshold;
@@ -441,12 +446,11 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
                       std::to_string(params.minInliers) + " required");
   if (m.coverageDeg < params.minCoverageDeg)
     return failed(m, CircleFailure::CoverageTooSmall,
-                  "the inliers cover " + std::to_string(m.coverageDeg) + " degrees, less than " +
-                      std::to_string(params.minCoverageDeg));
+                  "the inliers cover " + readable(m.coverageDeg) + " degrees, less than " +
+                      readable(params.minCoverageDeg));
   if (m.rms > params.maxRms)
-    return failed(
-        m, CircleFailure::FitTooPoor,
-        "the fit's rms " + std::to_string(m.rms) + " px exceeds " + std::to_string(params.maxRms));
+    return failed(m, CircleFailure::FitTooPoor,
+                  "the fit's rms " + readable(m.rms) + " px exceeds " + readable(params.maxRms));
 
   if (params.refineWithGreyValues) {
     auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints,

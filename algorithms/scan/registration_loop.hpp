@@ -11,7 +11,9 @@ namespace facet::scan {
 struct LoopSettings {
   bool dual = false;         // DCP rule (both ways) instead of the CP rule
   bool pointToLine = false;  // error metric
-  double tolerance = 1e-5;   // metres; stop when the rms changes less (with the gate settled)
+  // metres; > 0: also stop when the rms changes less (with the gate settled): the hand-over of
+  // a coarse phase, never a final result (ScanMatchParams::poseTolerance)
+  double residualTolerance = 0.0;
   int maxIterations = 100;
   double gate = 1.5;  // metres; gate of the first iteration
 };

@@ -48,8 +48,7 @@ ScanMatchResult matchIdcpBoc(const Scan& reference, const Scan& scan, const Scan
   }
   const LoopOutcome fine = runRegistration(
       fullSurface(reference, params), fullSurface(scan, params), start,
-      {true, pointToLine, params.residualTolerance, std::max(1, params.maxIterations - used), gate},
-      params);
+      {true, pointToLine, 0.0, std::max(1, params.maxIterations - used), gate}, params);
   return toResult(fine, used + fine.iterations);
 }
 
@@ -100,10 +99,9 @@ ScanMatchResult matchScans(const Scan& reference, const Scan& scan, const ScanPo
   const bool dual = params.method == ScanMatchMethod::Dcp;
   const bool pointToLine = params.method == ScanMatchMethod::IcpPointToLine ||
                            (dual && params.dualMetric == ScanMetric::PointToLine);
-  const LoopOutcome outcome = runRegistration(
-      fullSurface(reference, params), fullSurface(scan, params), initial,
-      {dual, pointToLine, params.residualTolerance, params.maxIterations, params.initialGate},
-      params);
+  const LoopOutcome outcome =
+      runRegistration(fullSurface(reference, params), fullSurface(scan, params), initial,
+                      {dual, pointToLine, 0.0, params.maxIterations, params.initialGate}, params);
   return toResult(outcome, outcome.iterations);
 }
 

@@ -1,11 +1,9 @@
 // facet circle: measures one circle in an image around a given centre and nominal radius.
 #include <chrono>
 #include <cmath>
-#include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "algorithms/circle/circle_measure.hpp"
 #include "service/cli/command_line.hpp"
@@ -30,15 +28,16 @@ cv::Point2d parseCentre(const std::string& text) {
   double x = 0, y = 0;
   char comma = 0;
   if (!(in >> x >> comma >> y) || comma != ',' || !(in >> std::ws).eof())
-    throw InputError("--center must be x,y in pixels (got \"" + text + "\")");
+    throw InputError("--centre/--center must be x,y in pixels (got \"" + text + "\")");
   return {x, y};
 }
 
+// The recipe's words (a hole is dark inside), and the edge's direction going outwards.
 CirclePolarity parsePolarity(const std::string& text) {
-  if (text == "dark_to_light") return CirclePolarity::DarkToLight;
-  if (text == "light_to_dark") return CirclePolarity::LightToDark;
+  if (text == "dark_inside" || text == "dark_to_light") return CirclePolarity::DarkToLight;
+  if (text == "light_inside" || text == "light_to_dark") return CirclePolarity::LightToDark;
   if (text == "any") return CirclePolarity::Any;
-  throw InputError("--polarity must be dark_to_light, light_to_dark or any (got \"" + text + "\")");
+  throw InputError("--polarity must be dark_inside, light_inside or any (got \"" + text + "\")");
 }
 
 void run(const CircleOptions& o) {
@@ -48,13 +47,7 @@ void run(const CircleOptions& o) {
   p.width = o.width;
   p.polarity = parsePolarity(o.polarity);
   p.minCoverageDeg = o.minCoverage;
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(o.image, ec))
-    throw InputError(o.image + ": no such image file");
-  // Grey, keeping 16-bit depth; colour images are converted to grey.
-  const cv::Mat image = cv::imread(o.image, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (image.empty())
-    throw InputError(o.image + ": cannot read the image (unknown format or corrupt)");
+  const cv::Mat image = readGreyImage(o.image);
 
   const auto t0 = std::chrono::steady_clock::now();
   const CircleMeasurement m = measureCircle(image, p);
@@ -83,15 +76,14 @@ void run(const CircleOptions& o) {
     if (!world.is_null()) out["world"] = world;
     printJson(out);
   } else {
-    std::cout << "centre (" << m.centre.x << ", " << m.centre.y << ") px, radius " << m.radius
-              << " px, diameter " << m.diameter << " px\nroundness " << m.roundness << " px, rms "
-              << m.rms << " px, " << m.inliers << " inliers covering " << m.coverageDeg << " deg, "
-              << ms << " ms\n"
-              << (m.greyRefined
-                      ? "refined on the grey values, blur " + std::to_string(m.blur) + " px"
-                      : std::string("from the edge points only (grey-value fit did not "
-                                    "converge)"))
-              << "\n";
+    std::cout << std::setprecision(6) << "centre (" << m.centre.x << ", " << m.centre.y
+              << ") px, radius " << m.radius << " px, diameter " << m.diameter << " px\nroundness "
+              << m.roundness << " px, rms " << m.rms << " px, " << m.inliers << " inliers covering "
+              << m.coverageDeg << " deg, " << ms << " ms\n"
+              << (m.greyRefined ? "refined on the grey values, blur "
+                                : "from the edge points only (grey-value fit did not converge)");
+    if (m.greyRefined) std::cout << m.blur << " px";
+    std::cout << "\n";
     if (!world.is_null())
       std::cout << "in the plane: centre (" << world["x_mm"].get<double>() << ", "
                 << world["y_mm"].get<double>() << ") mm, diameter "
@@ -108,11 +100,12 @@ void addCircleCommand(CLI::App& app) {
                                  "accuracy in an annulus around a given position");
   auto o = std::make_shared<CircleOptions>();
   cmd->add_option("--image", o->image, "8/16-bit image file")->required();
-  cmd->add_option("--center", o->centre, "expected centre x,y in pixels")->required();
+  cmd->add_option("--centre,--center", o->centre, "expected centre x,y in pixels")->required();
   cmd->add_option("--radius", o->radius, "nominal radius in pixels")->required();
   cmd->add_option("--width", o->width, "half-width of the search annulus in pixels (default 5)");
   cmd->add_option("--polarity", o->polarity,
-                  "dark_to_light (dark inside), light_to_dark (light inside) or any (default)");
+                  "dark_inside (a hole), light_inside or any (default); as in recipes "
+                  "(dark_to_light and light_to_dark are accepted too)");
   cmd->add_option("--min-coverage", o->minCoverage,
                   "minimum angular coverage of the rim in degrees (default 180)");
   cmd->add_option("--calibration", o->calibration,

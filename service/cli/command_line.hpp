@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
+#include <opencv2/core/mat.hpp>
 
 #include "config/step_kind.hpp"
 
@@ -29,6 +30,10 @@ struct MeasurementFailure : std::runtime_error {
 
 // Prints one JSON object on stdout, on one line.
 void printJson(const nlohmann::json& object);
+
+// The image file at `path` as one grey channel, 8 or 16 bits deep (colour is converted to grey).
+// Throws InputError naming the file: "no such file", unreadable, not an image, corrupt.
+cv::Mat readGreyImage(const std::string& path);
 
 // Every subcommand is added by a function of this shape, one file per subcommand.
 // The subcommand's callback does the work; `json` tells whether --json was given anywhere.

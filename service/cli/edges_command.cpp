@@ -4,8 +4,6 @@
 #include <optional>
 #include <sstream>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/image/grey_image.hpp"
 #include "service/cli/command_line.hpp"
@@ -31,23 +29,12 @@ cv::Rect parseRoi(const std::string& text) {
   return {v[0], v[1], v[2], v[3]};
 }
 
-// Grey image keeping 16-bit depth; colour is converted to grey.
-cv::Mat readGrey(const std::string& path) {
-  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (image.empty()) throw InputError(path + ": cannot read the image");
-  image = toGrey(image);
-  if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
-    throw InputError(path + ": expected an 8-bit or 16-bit grey or colour image, got " +
-                     cv::typeToString(image.type()));
-  return image;
-}
-
 void run(const EdgesOptions& o) {
   if (o.low.has_value() != o.high.has_value())
     throw InputError("--low and --high go together (or leave both out for automatic thresholds)");
   if (o.low && (*o.low < 0 || *o.high < *o.low))
     throw InputError("--low/--high must satisfy 0 <= low <= high");
-  const cv::Mat image = readGrey(o.image);
+  const cv::Mat image = readGreyImage(o.image);
   EdgeParams params;
   params.low = o.low;
   params.high = o.high;

@@ -1,9 +1,8 @@
 // facet match: finds a shape model in an image and prints the matches' poses.
 #include <chrono>
 #include <iostream>
+#include <numbers>
 #include <sstream>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
@@ -32,15 +31,71 @@ std::pair<double, double> parsePair(const std::string& text, const std::string& 
   return {a, b};
 }
 
+std::string number(double value) {
+  std::ostringstream out;
+  out << value;
+  return out.str();
+}
+
+// The search options, judged under the names the user typed (the search itself would name its
+// own parameters and blame the image).
+void checkSearchOptions(const FindParams& find) {
+  if (!(find.minScore > 0.0 && find.minScore <= 1.0))
+    throw InputError("--min-score must lie in (0, 1] (got " + number(find.minScore) + ")");
+  if (find.numMatches < 0)
+    throw InputError("--num-matches must be 0 (all) or more (got " +
+                     std::to_string(find.numMatches) + ")");
+  if (!(find.maxOverlap >= 0.0 && find.maxOverlap <= 1.0))
+    throw InputError("--max-overlap must lie in [0, 1] (got " + number(find.maxOverlap) + ")");
+  if (!(find.greediness >= 0.0 && find.greediness <= 1.0))
+    throw InputError("--greediness must lie in [0, 1] (got " + number(find.greediness) + ")");
+}
+
+constexpr double kTurn = 2.0 * std::numbers::pi;
+
+// The search never leaves the range the model was trained for: a requested range reaching
+// beyond it is cut, silently on the search's side. Says so, in the user's units.
+std::vector<std::string> rangeWarnings(const ShapeModel& model, const MatchOptions& o) {
+  std::vector<std::string> warnings;
+  const double tolerance = 1e-9;
+  if (!o.angleRange.empty() && model.angleExtent < kTurn - tolerance) {
+    const double a0 = o.find.angleStart, a1 = o.find.angleStart + o.find.angleExtent;
+    const double m0 = model.angleStart, m1 = model.angleStart + model.angleExtent;
+    bool inside = false, meets = false;
+    for (int k = -2; k <= 2; ++k) {
+      inside = inside || (a0 + k * kTurn >= m0 - tolerance && a1 + k * kTurn <= m1 + tolerance);
+      meets = meets || (a0 + k * kTurn <= m1 && a1 + k * kTurn >= m0);
+    }
+    const std::string trained = number(degrees(m0)) + "," + number(degrees(m1)) + " deg";
+    if (!inside)
+      warnings.push_back("--angle-range " + o.angleRange +
+                         (meets ? " is cut to the model's trained range " + trained
+                                : " lies outside the model's trained range " + trained +
+                                      ": no angle is searched") +
+                         " (train the model with a wider --angle-range to search more)");
+  }
+  if (!o.scaleRange.empty() && (o.find.scaleMin < model.scaleMin - tolerance ||
+                                o.find.scaleMax > model.scaleMax + tolerance)) {
+    const bool meets = o.find.scaleMin <= model.scaleMax && o.find.scaleMax >= model.scaleMin;
+    const std::string trained = number(model.scaleMin) + "," + number(model.scaleMax);
+    warnings.push_back(
+        "--scale-range " + o.scaleRange +
+        (meets ? " is cut to the model's trained range " + trained
+               : " lies outside the model's trained range " + trained + ": no scale is searched") +
+        " (train the model with a wider --scale-range to search more)");
+  }
+  return warnings;
+}
+
 void run(MatchOptions o) {
+  checkSearchOptions(o.find);
   ShapeModel model;
   try {
     model = loadShapeModel(o.model);
   } catch (const ShapeModelFileError& e) {
     throw InputError(e.what());
   }
-  const cv::Mat image = cv::imread(o.image, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (image.empty()) throw InputError(o.image + ": cannot read the image");
+  const cv::Mat image = readGreyImage(o.image);
 
   if (o.polarity == "use")
     o.find.polarity = Polarity::Use;
@@ -73,6 +128,8 @@ void run(MatchOptions o) {
     o.find.scaleMax = s1;
   }
 
+  const std::vector<std::string> warnings = rangeWarnings(model, o);
+
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<ShapeMatch> matches;
   try {
@@ -91,8 +148,9 @@ void run(MatchOptions o) {
                       {"angle", degrees(m.angle)},
                       {"scale", m.scale},
                       {"score", m.score}});
-    printJson({{"matches", list}, {"time_ms", ms}});
+    printJson({{"matches", list}, {"warnings", warnings}, {"time_ms", ms}});
   } else {
+    for (const auto& w : warnings) std::cerr << "facet: warning: " << w << "\n";
     std::cout << matches.size() << " match(es) in " << ms << " ms\n";
     for (const auto& m : matches)
       std::cout << "  x " << m.x << "  y " << m.y << "  angle " << degrees(m.angle)

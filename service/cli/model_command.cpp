@@ -3,8 +3,6 @@
 #include <sstream>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "algorithms/geometry/pose2d.hpp"
 #include "algorithms/shape/shape_model.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
@@ -47,8 +45,7 @@ std::vector<double> parseList(const std::string& text, std::size_t count,
 }
 
 void run(const ModelOptions& o) {
-  const cv::Mat image = cv::imread(o.image, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (image.empty()) throw InputError(o.image + ": cannot read the image");
+  const cv::Mat image = readGreyImage(o.image);
   ShapeModelParams p;
   if (!o.roi.empty()) {
     const auto r = parseList(o.roi, 4, "--roi");

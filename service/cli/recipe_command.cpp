@@ -1,13 +1,17 @@
 // facet recipe check | train | schema: validating, training and describing recipe files.
+#include <algorithm>
 #include <fstream>
 #include <iostream>
 #include <map>
 
 #include "config/json_schema.hpp"
+#include "config/recipe_format.hpp"
 #include "config/recipe_library.hpp"
 #include "config/recipe_loader.hpp"
 #include "config/recipe_training.hpp"
 #include "config/station_config.hpp"
+#include "config/station_format.hpp"
+#include "config/yaml_document.hpp"
 #include "service/cli/command_line.hpp"
 
 namespace facet::cli {
@@ -71,7 +75,37 @@ std::vector<std::filesystem::path> recipeFiles(
   return files;
 }
 
-void check(const Options& opt, const config::StepKindRegistry& kinds) {
+// A station file given as a recipe (`facet recipe check station.yaml`): a mapping without steps
+// whose keys are the station's (camera, plc, ...) rather than a recipe's.
+bool isStationFile(const std::filesystem::path& file, const config::StepKindRegistry& kinds) {
+  if (std::filesystem::is_directory(file) || file.string().ends_with(config::kRecipeFileSuffix))
+    return false;
+  Diagnostics ignored;
+  const auto yaml = config::readYamlFile(file, ignored);
+  if (!yaml || !yaml->root.IsMap() || yaml->root["steps"]) return false;
+  for (const auto& entry : yaml->root) {
+    const std::string key = entry.first.Scalar();
+    if (config::stationFormat().station.find(key) != nullptr &&
+        config::RecipeFormat(kinds).recipe.find(key) == nullptr)
+      return true;
+  }
+  return false;
+}
+
+void check(Options opt, const config::StepKindRegistry& kinds) {
+  // A station file among the recipes is checked as the station, with the recipes it names.
+  if (opt.station.empty()) {
+    const auto station =
+        std::find_if(opt.files.begin(), opt.files.end(),
+                     [&](const std::string& f) { return isStationFile(f, kinds); });
+    if (station != opt.files.end()) {
+      if (!opt.json)
+        std::cerr << *station << ": a station file: checking it as the station, with its "
+                  << "recipes (the same as `facet recipe check --station " << *station << "`)\n";
+      opt.station = *station;
+      opt.files.erase(station);
+    }
+  }
   Diagnostics all;
   std::optional<config::StationConfig> station;
   const auto options = loadOptions(opt, all, station);

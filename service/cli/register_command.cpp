@@ -3,8 +3,6 @@
 #include <chrono>
 #include <iostream>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "algorithms/registration/register_images.hpp"
 #include "service/cli/command_line.hpp"
 
@@ -19,13 +17,8 @@ struct RegisterOptions {
   bool noEscalation = false;
   int corners = RegistrationParams{}.corners.maxCorners;
   bool json = false;
+  bool pairs = false;
 };
-
-cv::Mat readImage(const std::string& path) {
-  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (image.empty()) throw InputError(path + ": cannot read the image");
-  return image;
-}
 
 void run(const RegisterOptions& o) {
   RegistrationParams p;
@@ -34,8 +27,8 @@ void run(const RegisterOptions& o) {
   p.affineRegions = o.affine;
   p.escalateToAffine = !o.noEscalation;
   p.corners.maxCorners = o.corners;
-  const cv::Mat ref = readImage(o.ref);
-  const cv::Mat image = readImage(o.image);
+  const cv::Mat ref = readGreyImage(o.ref);
+  const cv::Mat image = readGreyImage(o.image);
 
   const auto t0 = std::chrono::steady_clock::now();
   const RegistrationResult r = registerImages(ref, image, p);
@@ -48,16 +41,20 @@ void run(const RegisterOptions& o) {
   if (o.json) {
     nlohmann::json H = nlohmann::json::array();
     for (int k = 0; k < 9; ++k) H.push_back(r.H(k / 3, k % 3));
-    nlohmann::json jp = nlohmann::json::array();
-    for (const auto& q : pairs) jp.push_back({q[0], q[1], q[2], q[3]});
-    printJson({{"H", H},
-               {"matches", r.matches.size()},
-               {"inliers", r.inliers.size()},
-               {"global_inliers", r.globalInliers},
-               {"stage", r.stage},
-               {"escalated", r.escalated},
-               {"pairs", jp},
-               {"time_ms", ms}});
+    nlohmann::json out{{"H", H},
+                       {"matches", r.matches.size()},
+                       {"inliers", r.inliers.size()},
+                       {"global_inliers", r.globalInliers},
+                       {"stage", r.stage},
+                       {"escalated", r.escalated},
+                       {"time_ms", ms}};
+    // Thousands of pairs (over 100 KB) only when asked for: the summary is what a line needs.
+    if (o.pairs) {
+      nlohmann::json jp = nlohmann::json::array();
+      for (const auto& q : pairs) jp.push_back({q[0], q[1], q[2], q[3]});
+      out["pairs"] = std::move(jp);
+    }
+    printJson(out);
   } else {
     std::cout << "H (reference -> image):\n";
     for (int i = 0; i < 3; ++i)
@@ -85,7 +82,9 @@ void addRegisterCommand(CLI::App& app) {
   cmd->add_flag("--no-escalation", o->noEscalation,
                 "Plain Harris corners only: never escalate to Harris-Affine regions");
   cmd->add_option("--corners", o->corners, "Corner budget per image")->capture_default_str();
-  cmd->add_flag("--json", o->json, "Print one JSON object");
+  cmd->add_flag("--json", o->json, "Print one JSON object: H, matches, inliers, time_ms");
+  cmd->add_flag("--pairs", o->pairs,
+                "With --json, also the inlier pairs [x_ref, y_ref, x_image, y_image]");
   cmd->callback([o] { run(*o); });
 }
 

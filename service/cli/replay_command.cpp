@@ -16,6 +16,7 @@
 #include "config/recipe_loader.hpp"
 #include "config/station_config.hpp"
 #include "service/cli/command_line.hpp"
+#include "service/daemon/part_banner.hpp"
 #include "service/daemon/part_origin.hpp"
 #include "service/daemon/process_capability.hpp"
 #include "service/daemon/replay_report.hpp"
@@ -45,17 +46,17 @@ std::string utcNow() {
   return buf;
 }
 
-std::vector<unsigned char> thumbnail(const cv::Mat& image, const service::InspectionOutcome& o,
-                                     const std::string& banner, int width) {
+// The overlay picture of a failed part, full size and as a thumbnail of `width` pixels.
+void pictures(const cv::Mat& image, const service::InspectionOutcome& o, const std::string& banner,
+              int width, service::ReplayedPart& part) {
   cv::Mat picture =
       service::drawOverlay(image, o.overlay, banner, o.verdict == service::Verdict::Pass);
+  cv::imencode(".png", picture, part.overlayPng);
   if (picture.cols > width) {
     const double scale = static_cast<double>(width) / picture.cols;
     cv::resize(picture, picture, {}, scale, scale, cv::INTER_AREA);
   }
-  std::vector<unsigned char> png;
-  cv::imencode(".png", picture, png);
-  return png;
+  cv::imencode(".png", picture, part.thumbnailPng);
 }
 
 void runReplay(const ReplayOptions& opt, const config::StepKindRegistry& kinds) {
@@ -134,9 +135,9 @@ void runReplay(const ReplayOptions& opt, const config::StepKindRegistry& kinds) 
         service::inspectPart({.image = grab.frame.image, .scan = std::nullopt}, *recipe);
     service::recordOutcome(p, outcome);
     if (p.verdict != service::Verdict::Pass) {
-      std::string banner = std::string(service::verdictName(p.verdict)) + "  " + p.serial;
-      if (!p.failedChecks.empty()) banner += "  " + p.failedChecks.front();
-      part.thumbnailPng = thumbnail(grab.frame.image, outcome, banner, opt.thumbnailWidth);
+      pictures(grab.frame.image, outcome,
+               service::partBanner(p, p.serial.empty() ? p.source : p.serial), opt.thumbnailWidth,
+               part);
     }
     report.parts.push_back(std::move(part));
   }
@@ -164,6 +165,7 @@ void runReplay(const ReplayOptions& opt, const config::StepKindRegistry& kinds) 
           {"name", c.name}, {"unit", c.unit}, {"n", c.count}, {"mean", c.mean}, {"sigma", c.sigma}};
       j["cp"] = c.cp ? nlohmann::json(*c.cp) : nullptr;
       j["cpk"] = c.cpk ? nlohmann::json(*c.cpk) : nullptr;
+      j["index"] = c.index;  // Cpk, or Cpu / Cpl where a limit is a natural bound
       capability.push_back(j);
     }
     printJson({{"recipe", {{"id", loaded.recipe->id}, {"name", loaded.recipe->name}}},

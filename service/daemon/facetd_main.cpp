@@ -10,9 +10,10 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "service/daemon/calibration_check.hpp"
 #include "service/daemon/facetd_main.hpp"
 #include "service/daemon/http_server.hpp"
-#include "service/daemon/calibration_check.hpp"
+#include "service/daemon/part_banner.hpp"
 #include "service/daemon/station.hpp"
 #include "service/daemon/systemd_notifier.hpp"
 
@@ -21,20 +22,35 @@ namespace {
 using namespace facet;
 using namespace std::chrono_literals;
 
+// One line per part for --print-parts, never cut: the verdict, why (each failed check with its
+// value and band, or the error of a part that was not inspected), what the recording says the
+// part was (its sidecar's verdict and defect, flagged UNEXPECTED when the verdicts differ), then
+// every measured value, "(!)" marking a value outside its tolerance band, and the time.
 std::string partLine(const service::PartResult& p) {
   std::string line = "part " + std::to_string(p.partId) + "  recipe " + std::to_string(p.recipeId) +
-                     " " + p.recipeName + "  " + service::verdictName(p.verdict);
-  if (p.verdict == service::Verdict::Error) line += "  (" + p.error + ")";
-  for (const auto& m : p.verdict == service::Verdict::Error ? std::vector<service::Measurement>{}
-                                                            : p.measurements) {
-    char buf[96];
-    std::snprintf(buf, sizeof buf, "  %s=%.4g%s%s", m.name.c_str(), m.value,
-                  m.unit == "score" || m.unit == "count" ? "" : (" " + m.unit).c_str(),
-                  m.pass ? "" : "(!)");
-    line += buf;
+                     " " + p.recipeName + (p.serial.empty() ? "" : "  " + p.serial) + "  " +
+                     service::verdictName(p.verdict);
+  if (p.verdict == service::Verdict::Error) {
+    line += "  cause: " + p.error;
+  } else if (!p.failedChecks.empty()) {
+    line += "  cause:";
+    for (std::size_t i = 0; i < p.failedChecks.size(); ++i)
+      line += (i ? "; " : " ") + service::failedCheckText(p, p.failedChecks[i]);
   }
-  if (!p.expectedVerdict.empty() && p.expectedVerdict != service::verdictName(p.verdict))
-    line += "  UNEXPECTED (recorded as " + p.expectedVerdict + ")";
+  if (!p.expectedVerdict.empty()) {
+    line += "  recorded: " + p.expectedVerdict;
+    if (!p.recordedDefect.empty()) line += " (" + p.recordedDefect + ")";
+    if (p.expectedVerdict != service::verdictName(p.verdict)) line += "  UNEXPECTED";
+  }
+  if (p.verdict != service::Verdict::Error && !p.measurements.empty()) {
+    line += "  values:";
+    for (const auto& m : p.measurements) {
+      char value[32];
+      std::snprintf(value, sizeof value, "%.4g", m.value);
+      line += " " + m.name + "=" + value +
+              (m.unit == "score" || m.unit == "count" ? "" : " " + m.unit) + (m.pass ? "" : "(!)");
+    }
+  }
   char ms[32];
   std::snprintf(ms, sizeof ms, "  [%.1f ms]", p.inspectionMs);
   return line + ms;
@@ -82,7 +98,14 @@ int facet::service::runFacetd(int argc, char** argv, const config::StepKindRegis
       ->check(CLI::ExistingDirectory);
   app.add_option("--http-port-file", portFile, "Write the HTTP port here once listening");
   app.add_option("--log-level", logLevel, "trace, debug, info, warn, error");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // Bad arguments exit 1 like every other bad input (CLI11's own codes are 104-108).
+    std::cerr << "facetd: " << e.what() << " ('facetd --help' lists the options)\n";
+    return 1;
+  }
   spdlog::set_level(spdlog::level::from_str(logLevel));
   spdlog::set_pattern("%Y-%m-%dT%H:%M:%S.%e %^%l%$ facetd %v");
   if (printParts)
@@ -139,6 +162,13 @@ int facet::service::runFacetd(int argc, char** argv, const config::StepKindRegis
     while (!station.plcConnected() && std::chrono::steady_clock::now() < readyDeadline)
       std::this_thread::sleep_for(20ms);
     systemd.ready(station.plcConnected() ? "inspecting" : "inspecting; PLC not connected");
+    if (options.usePlc && station.config().hasPlc && !station.plcConnected())
+      spdlog::warn(
+          "PLC at {}:{} not reachable: parts wait for it. Is the PLC on and reachable? For a demo "
+          "start the simulator (facet plc-sim --map {} --key plc.register_map --port {}); to "
+          "inspect without a PLC run facetd with --no-plc",
+          station.config().plc.host, station.config().plc.port, configFile,
+          station.config().plc.port);
 
     const timespec tick{0, 200'000'000};
     auto lastChangeCheck = std::chrono::steady_clock::now();

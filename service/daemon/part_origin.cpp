@@ -13,6 +13,8 @@ void recordPartOrigin(PartResult& part, const config::Recipe* recipe, const Fram
   if (auto it = frame.metadata.find("serial"); it != frame.metadata.end()) part.serial = it->second;
   if (auto it = frame.metadata.find("expected_verdict"); it != frame.metadata.end())
     part.expectedVerdict = it->second;
+  if (auto it = frame.metadata.find("defect"); it != frame.metadata.end())
+    part.recordedDefect = it->second;
 }
 
 }  // namespace facet::service

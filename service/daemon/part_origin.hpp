@@ -1,7 +1,7 @@
 #pragma once
 // Where a part came from, as every publisher records it: the recipe that inspected it (id, name,
-// content hash), the frame (id, source) and the frame's sidecar (serial, expected verdict).
-// Shared by facetd's station and `facet replay` so that both store a part the same way.
+// content hash), the frame (id, source) and the frame's sidecar (serial, expected verdict, recorded
+// defect). Shared by facetd's station and `facet replay` so that both store a part the same way.
 
 #include "camera/camera.hpp"
 #include "config/recipe.hpp"

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <map>
 
+#include "service/engine/builtin_steps.hpp"
+
 namespace facet::service {
 namespace {
 
@@ -18,13 +20,42 @@ void summarise(Capability& c) {
     for (double v : c.values) squares += (v - c.mean) * (v - c.mean);
     c.sigma = std::sqrt(squares / static_cast<double>(c.count - 1));
   }
-  if (c.lower && c.upper && c.sigma > 0) {
+  if (!c.lower || !c.upper || !(c.sigma > 0)) return;
+  const NaturalBounds natural = naturalBounds(c.name, c.unit);
+  const bool lowerIsBound = natural.lower && *c.lower <= *natural.lower;
+  const bool upperIsBound = natural.upper && *c.upper >= *natural.upper;
+  if (lowerIsBound && upperIsBound) return;  // nothing the process can miss
+  if (lowerIsBound) {
+    c.index = "Cpu";
+    c.cpk = (*c.upper - c.mean) / (3 * c.sigma);
+  } else if (upperIsBound) {
+    c.index = "Cpl";
+    c.cpk = (c.mean - *c.lower) / (3 * c.sigma);
+  } else {
+    c.index = "Cpk";
     c.cp = (*c.upper - *c.lower) / (6 * c.sigma);
     c.cpk = std::min(*c.upper - c.mean, c.mean - *c.lower) / (3 * c.sigma);
   }
 }
 
 }  // namespace
+
+NaturalBounds naturalBounds(const std::string& name, const std::string& unit) {
+  NaturalBounds bounds;
+  const std::string value = name.substr(name.rfind('.') + 1);
+  // The check tables of facet's step kinds; a value name means the same quantity in each.
+  static const config::StepKindRegistry kinds = builtinSteps();
+  for (const config::StepKind* kind : kinds.kinds()) {
+    const config::FieldSpec* checks = kind->format().object.find("checks");
+    if (checks == nullptr || checks->object == nullptr) continue;
+    const config::FieldSpec* field = checks->object->find(value);
+    if (field == nullptr) continue;
+    if (field->minimum) bounds.lower = *field->minimum;
+    if (field->quantity == config::Quantity::Score) bounds.upper = 1.0;
+  }
+  if (unit == "score") bounds.upper = 1.0;
+  return bounds;
+}
 
 std::vector<Capability> processCapability(const std::vector<PartResult>& parts) {
   std::vector<Capability> out;

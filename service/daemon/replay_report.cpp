@@ -1,8 +1,10 @@
 #include "service/daemon/replay_report.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <map>
 
 #include "service/daemon/process_capability.hpp"
@@ -55,6 +57,23 @@ std::string base64(const std::vector<unsigned char>& bytes) {
     out += i + 2 < bytes.size() ? table[n & 63] : '=';
   }
   return out;
+}
+
+// A file:// link to a recorded image: absolute, with the characters a URL reserves escaped.
+std::string fileUrl(const std::string& path) {
+  std::error_code ec;
+  const std::string absolute = std::filesystem::absolute(path, ec).string();
+  std::string url = "file://";
+  for (const unsigned char c : absolute.empty() ? path : absolute) {
+    if (std::isalnum(c) || c == '/' || c == '.' || c == '-' || c == '_' || c == '~') {
+      url += static_cast<char>(c);
+    } else {
+      char buf[4];
+      std::snprintf(buf, sizeof buf, "%%%02X", c);
+      url += buf;
+    }
+  }
+  return url;
 }
 
 // The value range a chart shows: the data and the tolerance band, with a margin.
@@ -175,6 +194,10 @@ svg .series { fill: none; stroke: #3b78c4; stroke-width: 1.5; }
 svg .dot { fill: #3b78c4; } svg .dot.out { fill: #c62828; }
 .thumbs { display: flex; flex-wrap: wrap; gap: 1em; }
 figure { margin: 0; } figcaption { font-size: 0.9em; max-width: 320px; }
+a.enlarge { cursor: zoom-in; }
+.full { display: none; } .full:target { display: block; position: fixed; inset: 0; z-index: 9;
+  background: rgba(0, 0, 0, 0.85); padding: 2em; text-align: center; overflow: auto; }
+.full img { max-width: 100%; } .full a { color: #fff; display: block; margin-bottom: 0.5em; }
 .summary span { margin-right: 1.5em; }
 )css";
 
@@ -190,8 +213,10 @@ void verdictTable(const ReplayReport& r, std::ostream& out) {
     out << "<tr" << (verdictUnexpected(p) ? " class=\"mismatch\"" : "") << "><td class=\"n\">"
         << i + 1 << "</td><td>" << escape(file) << "</td><td>" << escape(p.serial)
         << "</td><td class=\"" << verdict << "\">" << verdict << "</td><td>"
-        << escape(p.expectedVerdict.empty() ? "–" : p.expectedVerdict) << "</td><td>" << escape(why)
-        << "</td><td class=\"n\">" << num(p.inspectionMs, 3) << "</td></tr>\n";
+        << escape(p.expectedVerdict.empty() ? "–" : p.expectedVerdict)
+        << (p.recordedDefect.empty() ? "" : " <small>(" + escape(p.recordedDefect) + ")</small>")
+        << "</td><td>" << escape(why) << "</td><td class=\"n\">" << num(p.inspectionMs, 3)
+        << "</td></tr>\n";
   }
   out << "</table>\n";
 }
@@ -199,19 +224,23 @@ void verdictTable(const ReplayReport& r, std::ostream& out) {
 void capabilityTable(const std::vector<Capability>& caps, std::ostream& out) {
   out << "<h2>Process capability</h2>\n<table id=\"capability\"><tr><th>value</th><th>unit</th>"
          "<th>n</th><th>mean</th><th>sigma</th><th>lower</th><th>upper</th><th>Cp</th>"
-         "<th>Cpk</th></tr>\n";
+         "<th>index</th><th>value</th></tr>\n";
   auto opt = [](const std::optional<double>& v) { return v ? num(*v) : std::string("–"); };
   for (const auto& c : caps) {
     const char* cls = !c.cpk ? "" : *c.cpk >= 1.33 ? "capable" : "incapable";
     out << "<tr><td>" << escape(c.name) << "</td><td>" << escape(c.unit) << "</td><td class=\"n\">"
         << c.count << "</td><td class=\"n\">" << num(c.mean, 6) << "</td><td class=\"n\">"
         << num(c.sigma, 3) << "</td><td class=\"n\">" << opt(c.lower) << "</td><td class=\"n\">"
-        << opt(c.upper) << "</td><td class=\"n\">" << opt(c.cp) << "</td><td class=\"n " << cls
-        << "\">" << opt(c.cpk) << "</td></tr>\n";
+        << opt(c.upper) << "</td><td class=\"n\">" << opt(c.cp) << "</td><td>"
+        << (c.index.empty() ? "–" : c.index) << "</td><td class=\"n " << cls << "\">" << opt(c.cpk)
+        << "</td></tr>\n";
   }
   out << "</table>\n<p>Cp = (upper &minus; lower) / 6&sigma;, Cpk = min(upper &minus; mean, mean "
-         "&minus; lower) / 3&sigma;; Cpk &ge; 1.33 is shown green. A value without a tolerance "
-         "has no Cp.</p>\n";
+         "&minus; lower) / 3&sigma;. Where a limit is the quantity's natural bound (a position "
+         "error or roundness cannot fall below 0, a score cannot exceed 1) the band is one-sided: "
+         "the index is Cpu = (upper &minus; mean) / 3&sigma; or Cpl = (mean &minus; lower) / "
+         "3&sigma;, without Cp. An index &ge; 1.33 is shown green. A value without a tolerance has "
+         "no index.</p>\n";
 }
 
 void timingTable(const ReplayReport& r, std::ostream& out) {
@@ -280,17 +309,27 @@ void writeReplayReport(const ReplayReport& r, std::ostream& out) {
     if (c.lower && c.upper) out << " tolerance " << num(*c.lower) << " … " << num(*c.upper);
     out << "</h3>\n<div class=\"charts\">" << histogramSvg(c) << trendSvg(c) << "</div></div>\n";
   }
-  out << "<h2>Failed parts</h2>\n<div class=\"thumbs\">\n";
+  out << "<h2 id=\"failed\">Failed parts</h2>\n<div class=\"thumbs\">\n";
   int shown = 0;
   for (const auto& part : r.parts) {
     const PartResult& p = part.result;
     if (p.verdict == Verdict::Pass || part.thumbnailPng.empty()) continue;
     std::string why = p.error;
     for (const auto& f : p.failedChecks) why += (why.empty() ? "" : ", ") + f;
-    out << "<figure><img class=\"thumb\" alt=\"" << escape(p.source)
-        << "\" src=\"data:image/png;base64," << base64(part.thumbnailPng) << "\"><figcaption>"
+    // The thumbnail is too small to read: it links to the full picture, shown in the page by
+    // CSS alone (:target) since the report has no script, or to the recorded file.
+    const std::string id = "full-" + std::to_string(shown + 1);
+    const std::string href = part.overlayPng.empty() ? fileUrl(p.source) : "#" + id;
+    out << "<figure><a class=\"enlarge\" href=\"" << escape(href)
+        << "\"><img class=\"thumb\" alt=\"" << escape(p.source) << "\" src=\"data:image/png;base64,"
+        << base64(part.thumbnailPng) << "\"></a><figcaption>"
         << escape(p.source.substr(p.source.find_last_of('/') + 1)) << " " << escape(p.serial)
-        << ": " << verdictName(p.verdict) << " — " << escape(why) << "</figcaption></figure>\n";
+        << ": " << verdictName(p.verdict) << " — " << escape(why) << " <a href=\""
+        << escape(fileUrl(p.source)) << "\">recorded image</a></figcaption></figure>\n";
+    if (!part.overlayPng.empty())
+      out << "<div class=\"full\" id=\"" << id << "\"><a href=\"#failed\">close</a><img alt=\""
+          << escape(p.source) << "\" src=\"data:image/png;base64," << base64(part.overlayPng)
+          << "\"></div>\n";
     ++shown;
   }
   if (!shown) out << "<p>none</p>\n";

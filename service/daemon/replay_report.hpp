@@ -2,7 +2,8 @@
 // The replay report: one self-contained HTML file (inline CSS and SVG, images as base64 PNG, no
 // script) that shows what a recipe did over a recorded folder: the verdict of every part beside
 // the verdict recorded in its sidecar, histograms and trends of every measured value against its
-// tolerance band, process capability, thumbnails of the failed parts and the time per step.
+// tolerance band, process capability, thumbnails of the failed parts (each a link to the full
+// picture) and the time per step.
 
 #include <ostream>
 #include <string>
@@ -15,6 +16,9 @@ namespace facet::service {
 struct ReplayedPart {
   PartResult result;
   std::vector<unsigned char> thumbnailPng;  // overlay picture, downscaled; empty = none
+  // The overlay picture at full size: a click on the thumbnail shows it in the page. Empty: the
+  // thumbnail links to the recorded image file instead.
+  std::vector<unsigned char> overlayPng;
 };
 
 struct ReplayReport {

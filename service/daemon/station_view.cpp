@@ -1,6 +1,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
 
+#include "service/daemon/part_banner.hpp"
 #include "service/daemon/station.hpp"
 
 // What a station shows over HTTP (StationView): health, metrics, recent and stored parts, the
@@ -12,9 +13,7 @@ void Station::showPart(PartResult part, const cv::Mat& image, const Overlay& ove
   if (!image.empty()) {
     last.image = image;
     last.overlay = overlay;
-    last.banner = "part " + std::to_string(part.partId) + "  " + verdictName(part.verdict);
-    if (!part.failedChecks.empty()) last.banner += "  " + part.failedChecks.front();
-    if (part.verdict == Verdict::Error) last.banner += "  " + part.error;
+    last.banner = partBanner(part, "part " + std::to_string(part.partId));
     last.pass = part.verdict == Verdict::Pass;
     if (archive_) archive_->archive(part, image, [&last] { return last.draw(); });
   }

@@ -1,6 +1,11 @@
 #include "service/engine/overlay.hpp"
 
+#include <algorithm>
+#include <sstream>
+
 #include <opencv2/imgproc.hpp>
+
+#include "service/engine/label_placement.hpp"
 
 namespace facet::service {
 namespace {
@@ -8,6 +13,74 @@ namespace {
 const cv::Scalar kPass{60, 200, 60};
 const cv::Scalar kFail{40, 40, 230};
 const cv::Scalar kSecondary{200, 160, 90};
+// Behind label text, so that it reads on any part; a hue a grey camera image never has.
+const cv::Scalar kLabelBacking{70, 30, 20};
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
+
+// `text` broken at spaces into lines no wider than `maxWidth` pixels (a single word may be wider).
+std::vector<std::string> wrap(const std::string& text, double scale, int maxWidth) {
+  std::vector<std::string> lines;
+  std::string line, word;
+  int unused = 0;
+  auto flush = [&] {
+    if (!line.empty()) lines.push_back(line);
+    line.clear();
+  };
+  std::istringstream words(text);
+  while (words >> word) {
+    const std::string longer = line.empty() ? word : line + " " + word;
+    if (!line.empty() && cv::getTextSize(longer, kFont, scale, 1, &unused).width > maxWidth)
+      flush(), line = word;
+    else
+      line = longer;
+  }
+  flush();
+  return lines;
+}
+
+// The largest font scale up to `scale` at which `text` is at most `width` pixels wide.
+double fittingScale(const std::string& text, double scale, int thickness, int width) {
+  int unused = 0;
+  const int natural = cv::getTextSize(text, kFont, scale, thickness, &unused).width;
+  return natural <= width ? scale : std::max(0.2, scale * width / natural);
+}
+
+struct LabelText {
+  std::vector<std::string> lines;
+  cv::Scalar colour;
+  cv::Point2d anchor;
+};
+
+// Labels in boxes that stay inside the picture and clear of each other (label_placement.hpp),
+// with a thin line back to the point when the box had to move away from it.
+void drawLabels(cv::Mat& out, const std::vector<LabelText>& labels, double scale, int top) {
+  int baseline = 0;
+  const int lineHeight = cv::getTextSize("Ag", kFont, scale, 1, &baseline).height + baseline + 2;
+  const int pad = 3;
+  std::vector<LabelRequest> requests;
+  for (const auto& label : labels) {
+    int width = 0;
+    for (const auto& line : label.lines)
+      width = std::max(width, cv::getTextSize(line, kFont, scale, 1, &baseline).width);
+    requests.push_back(
+        {label.anchor,
+         {width + 2 * pad, static_cast<int>(label.lines.size()) * lineHeight + 2 * pad}});
+  }
+  const std::vector<cv::Rect> boxes = placeLabels(out.size(), top, requests);
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const cv::Rect& box = boxes[i];
+    const cv::Point anchor(cvRound(labels[i].anchor.x), cvRound(labels[i].anchor.y));
+    const cv::Point nearest(std::clamp(anchor.x, box.x, box.x + box.width - 1),
+                            std::clamp(anchor.y, box.y, box.y + box.height - 1));
+    if (cv::norm(nearest - anchor) > 12)
+      cv::line(out, anchor, nearest, labels[i].colour, 1, cv::LINE_AA);
+    cv::rectangle(out, box, kLabelBacking, cv::FILLED);
+    for (std::size_t k = 0; k < labels[i].lines.size(); ++k)
+      cv::putText(out, labels[i].lines[k],
+                  {box.x + pad, box.y + pad + static_cast<int>(k + 1) * lineHeight - baseline - 2},
+                  kFont, scale, labels[i].colour, 1, cv::LINE_AA);
+  }
+}
 
 // Subpixel drawing: OpenCV's shift parameter takes fixed-point coordinates.
 constexpr int kShift = 4;
@@ -46,6 +119,8 @@ cv::Mat drawOverlay(const cv::Mat& image, const Overlay& overlay, const std::str
   else
     out = grey8.clone();
   const int thick = std::max(1, out.cols / 640);
+  const double labelScale = 0.4 * thick;
+  std::vector<LabelText> labels;  // drawn last, above every shape
   for (const auto& s : overlay.shapes) {
     const cv::Scalar colour = s.secondary ? kSecondary : (s.pass ? kPass : kFail);
     const int width = s.secondary ? 1 : thick;
@@ -74,16 +149,18 @@ cv::Mat drawOverlay(const cv::Mat& image, const Overlay& overlay, const std::str
         break;
       }
       case OverlayShape::Kind::Label:
-        cv::putText(out, s.text, cv::Point(cvRound(s.points[0].x), cvRound(s.points[0].y)),
-                    cv::FONT_HERSHEY_SIMPLEX, 0.4 * thick, colour, 1, cv::LINE_AA);
+        labels.push_back(
+            {wrap(s.text, labelScale, std::max(80, out.cols * 2 / 5)), colour, s.points[0]});
         break;
     }
   }
-  // Verdict banner across the top.
+  // Verdict banner across the top; its text shrinks to fit the width.
   const int h = 22 * thick;
+  drawLabels(out, labels, labelScale, h);
   cv::rectangle(out, {0, 0, out.cols, h}, pass ? kPass : kFail, cv::FILLED);
-  cv::putText(out, banner, {6, h - 7 * thick}, cv::FONT_HERSHEY_SIMPLEX, 0.5 * thick,
-              {255, 255, 255}, thick, cv::LINE_AA);
+  const double bannerScale = fittingScale(banner, 0.5 * thick, thick, out.cols - 12);
+  cv::putText(out, banner, {6, h - 7 * thick}, kFont, bannerScale, {255, 255, 255}, thick,
+              cv::LINE_AA);
   return out;
 }
 

@@ -48,6 +48,7 @@ struct PartResult {
   std::string source;           // image file or camera
   std::string serial;           // from the sidecar, when there is one
   std::string expectedVerdict;  // from the sidecar, when there is one (replay regression)
+  std::string recordedDefect;   // the sidecar's `defect`: what was wrong with a recorded part
   Verdict verdict = Verdict::Error;
   std::vector<std::string> failedChecks;  // measurement names (or step names) that failed
   std::string error;                      // why the verdict is Error

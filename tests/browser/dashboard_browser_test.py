@@ -18,15 +18,23 @@ import tempfile
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import overlay_labels  # noqa: E402
 import webdriver_client as wd  # noqa: E402
 
 TOKEN = 'browser-test-token-7f3a'
 
 
+BROKEN_RECIPE = 'broken.recipe.yaml'
+
+
 def station_config(source, work):
     """recipes/station.yaml with absolute paths, a free HTTP port, the test token and a quick
-    looping replay of the bracket_shape demo folder."""
-    recipes = os.path.join(source, 'recipes')
+    looping replay of the bracket_shape demo folder; its recipes folder is a copy with one
+    broken recipe added (a problem the page must show)."""
+    recipes = os.path.join(work, 'recipes')
+    shutil.copytree(os.path.join(source, 'recipes'), recipes)
+    open(os.path.join(recipes, BROKEN_RECIPE), 'w').write(
+        'schema_version: 1\nid: 99\nname: broken\nsteps:\n  - id: hole\n    kind: circel\n')
     text = open(os.path.join(recipes, 'station.yaml')).read()
     replacements = [
         (r'folder: demo/bracket_registration', 'folder: %s/demo/bracket_shape' % recipes),
@@ -116,6 +124,20 @@ def main():
         charts = browser.run('return document.querySelectorAll("#charts canvas").length')
         checks = len(wd.http('GET', base + '/api/summary')[1]['checks'])
         assert charts == checks, '%d trend charts for %d checks' % (charts, checks)
+        # Recipe problems are written on the page, not only in a tooltip.
+        problems = browser.run(
+            'const s = document.getElementById("recipe-problems");'
+            'return s.hidden || s.getBoundingClientRect().height === 0 ? "" : s.innerText;')
+        print('recipe problems on the page: %r' % problems)
+        assert BROKEN_RECIPE in problems and 'circel' in problems, problems
+
+        # The overlay's labels lie inside the picture, clear of the banner and of each other.
+        status, png = wd.http('GET', base + '/api/last.png')
+        assert status == 200, status
+        open(os.path.join(args.out, 'last-overlay.png'), 'wb').write(png)
+        boxes = overlay_labels.check_labels_inside(png, '/api/last.png')
+        print('overlay labels inside the picture and apart: %s' % boxes)
+
         badges = browser.run('return [...document.querySelectorAll("#health .badge")]'
                              '.map(b => b.textContent)')
         print('health badges: %s' % badges)

@@ -3,13 +3,15 @@
 Runs `facet replay --json` on recipes/demo/bracket_shape with recipe 2, checks the summary
 against the folder (one part per image, the sidecars' expected verdicts), then opens the
 report from disk: no console errors, one table row per image with every unexpected verdict
-highlighted, a thumbnail per failed part that decodes, charts for every measured value, and the
+highlighted, a thumbnail per failed part that decodes and opens its full picture (labels inside
+it and apart), charts for every measured value, and the
 histogram and trend of the first one not blank in the screenshot. The screenshot stays in the
 output folder.
 
 usage: replay_report_browser_test.py --facet BIN --source REPO --out DIR
 """
 import argparse
+import base64
 import glob
 import json
 import os
@@ -17,6 +19,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import overlay_labels  # noqa: E402
 import webdriver_client as wd  # noqa: E402
 
 
@@ -76,7 +79,7 @@ def main():
         assert not errors, 'console errors in the report: %s' % errors
         rows = browser.run('return [...document.querySelectorAll("#verdicts tr")].slice(1).map('
                            'r => ({file: r.cells[1].textContent, verdict: r.cells[3].textContent,'
-                           ' expected: r.cells[4].textContent,'
+                           ' expected: r.cells[4].firstChild.textContent.trim(),'
                            ' mismatch: r.classList.contains("mismatch")}))')
         assert len(rows) == len(images), (len(rows), len(images))
         mismatches = 0
@@ -89,6 +92,22 @@ def main():
         thumbs = browser.run('return [...document.querySelectorAll("img.thumb")]'
                              '.map(i => i.complete && i.naturalWidth > 0)')
         assert len(thumbs) == failed and all(thumbs), (thumbs, failed)
+        # Each thumbnail links to its full picture, shown in the page on a click; the labels of
+        # that picture lie inside it, clear of the banner and of each other.
+        links = browser.run('return [...document.querySelectorAll("img.thumb")]'
+                            '.map(i => i.parentElement.getAttribute("href"))')
+        assert links and all(h and h.startswith('#full-') for h in links), links
+        browser.click('a.enlarge')
+        full = browser.wait_for(
+            'const f = document.querySelector(".full:target img");'
+            'return f && f.complete && f.naturalWidth > 0 && f.getBoundingClientRect().width > 0 '
+            '? f.getAttribute("src") : "";', what='the full picture of the first failed part')
+        browser.screenshot(os.path.join(args.out, 'replay-report-full-picture.png'))
+        png = base64.b64decode(full.split(',', 1)[1])
+        boxes = overlay_labels.check_labels_inside(png, 'the first failed part\'s full picture')
+        print('full picture: labels inside and apart: %s' % boxes)
+        browser.run('window.location.hash = "#failed"')
+
         charts = browser.run('return document.querySelectorAll(".check").length')
         assert charts == len(summary['capability']), (charts, len(summary['capability']))
         caps = browser.run('return document.querySelectorAll("#capability tr").length - 1')

@@ -18,4 +18,11 @@ done
 out=$("$facet" recipe check "$file" 2>&1)
 grep -qF "$file:9:16: 'reference' path '../../../recipes/models/bracket_reference.png' leaves the recipes folder" <<<"$out" \
   || { echo "$out"; echo "missing: path escape"; exit 1; }
+# A station file given as a recipe is recognised and checked as the station, with its recipes.
+out=$("$facet" recipe check recipes/station.yaml 2>&1)
+rc=$?
+[ "$rc" -eq 0 ] || { echo "$out"; echo "station file as a recipe: expected exit code 0, got $rc"; exit 1; }
+grep -qF "recipes/station.yaml: a station file" <<<"$out" || { echo "$out"; echo "missing: station file note"; exit 1; }
+grep -qF "unknown key" <<<"$out" && { echo "$out"; echo "station keys reported as unknown recipe keys"; exit 1; }
+grep -qF "ok (recipe" <<<"$out" || { echo "$out"; echo "missing: the station's recipes checked"; exit 1; }
 echo "ok"

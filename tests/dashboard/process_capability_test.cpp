@@ -58,5 +58,53 @@ TEST(ProcessCapability, FailedMeasurementsAndSingleValues) {
   EXPECT_TRUE(processCapability({}).empty());
 }
 
+// A position error (true position) is bounded at 0: the band [0, 0.1] is one-sided. A good
+// process close to 0 is capable by its upper limit (Cpu), not "not capable" against the lower
+// limit 0 it can never cross.
+TEST(ProcessCapability, OneSidedIndexWhereALimitIsANaturalBound) {
+  // 0.01, 0.02, 0.03, 0.02, 0.02: mean 0.02, sample sigma sqrt(0.0002 / 4) = 0.00707107.
+  std::vector<PartResult> parts;
+  for (double v : {0.01, 0.02, 0.03, 0.02, 0.02}) {
+    PartResult p;
+    p.measurements.push_back({.name = "small_bore.position",
+                              .value = v,
+                              .unit = "mm",
+                              .nominal = 0.0,
+                              .tolMinus = 0.0,
+                              .tolPlus = 0.1,
+                              .checked = true});
+    p.measurements.push_back({.name = "part.score",
+                              .value = 0.9 + v,
+                              .unit = "score",
+                              .nominal = 1.0,
+                              .tolMinus = 0.2,
+                              .tolPlus = 0.0,
+                              .checked = true});
+    parts.push_back(p);
+  }
+  const auto caps = processCapability(parts);
+  ASSERT_EQ(caps.size(), 2u);
+  const Capability& position = caps[0];
+  const double sigma = std::sqrt(0.0002 / 4);
+  EXPECT_NEAR(position.sigma, sigma, 1e-12);
+  EXPECT_EQ(position.index, "Cpu");
+  ASSERT_TRUE(position.cpk.has_value());
+  EXPECT_NEAR(*position.cpk, (0.1 - 0.02) / (3 * sigma), 1e-9);  // 3.77, not 0.94
+  EXPECT_FALSE(position.cp.has_value()) << "no Cp for a one-sided band";
+  // A score cannot exceed 1: its upper limit 1 is a natural bound, the index is Cpl.
+  const Capability& score = caps[1];
+  EXPECT_EQ(score.index, "Cpl");
+  ASSERT_TRUE(score.cpk.has_value());
+  EXPECT_NEAR(*score.cpk, (0.92 - 0.8) / (3 * sigma), 1e-9);
+}
+
+TEST(ProcessCapability, TwoRealLimitsKeepCpk) {
+  const auto caps = processCapability({part(9.95, 0.9), part(10.05, 0.9)});
+  EXPECT_EQ(caps[0].index, "Cpk");
+  EXPECT_TRUE(caps[0].cp.has_value());
+  EXPECT_TRUE(naturalBounds("bore.diameter", "mm").lower.has_value());
+  EXPECT_FALSE(naturalBounds("part.x", "mm").lower.has_value());
+}
+
 }  // namespace
 }  // namespace facet::service

@@ -57,6 +57,31 @@ TEST(ReplayReport, TablesChartsAndThumbnails) {
   EXPECT_NE(html.find("<td>total</td>"), std::string::npos);
 }
 
+// A 320 px thumbnail is too small to read: each links to its full picture, shown in the page
+// (no script: a :target box), or to the recorded file when the report has no full picture.
+TEST(ReplayReport, ThumbnailsLinkToTheFullPicture) {
+  ReplayReport report;
+  report.parts = {replayed("b.png", Verdict::Fail, "fail", 10.3),
+                  replayed("c d.png", Verdict::Fail, "fail", 9.7)};
+  report.parts[0].overlayPng = {0x89, 'P', 'N', 'G', 1};
+  report.parts[0].result.recordedDefect = "big hole <1.2 mm>";
+  std::ostringstream out;
+  writeReplayReport(report, out);
+  const std::string html = out.str();
+  EXPECT_NE(html.find("<a class=\"enlarge\" href=\"#full-1\"><img class=\"thumb\""),
+            std::string::npos)
+      << html;
+  EXPECT_NE(html.find("<div class=\"full\" id=\"full-1\">"), std::string::npos);
+  EXPECT_NE(html.find("data:image/png;base64,iVBORwE="), std::string::npos);  // the full PNG
+  EXPECT_NE(html.find(".full:target"), std::string::npos);
+  // Without a full picture: the recorded file, its name escaped for a URL.
+  EXPECT_NE(html.find("<a class=\"enlarge\" href=\"file:///data/c%20d.png\">"), std::string::npos)
+      << html;
+  EXPECT_EQ(html.find("<script"), std::string::npos);
+  // The recording's defect beside its verdict.
+  EXPECT_NE(html.find("fail <small>(big hole &lt;1.2 mm&gt;)</small>"), std::string::npos);
+}
+
 TEST(ReplayReport, UnexpectedVerdictNeedsAnExpectation) {
   PartResult p;
   p.verdict = Verdict::Fail;

@@ -385,6 +385,41 @@ TEST(PlcLinkWithPymodbus, UnreachableAtStartQueuesThenDropsWithACount) {
   EXPECT_THAT(log.str(), HasSubstr("cannot connect to 127.0.0.1:" + std::to_string(port)));
 }
 
+// Nobody listens on the port: the first warning says what is wrong; later failures are
+// logged ever more rarely (attempts 1, 2, 4, 8, ...) while the link keeps retrying
+// at its pace (it logged every attempt, twice a second, forever).
+TEST(PlcLink, AnUnreachablePlcIsSaidOnceThenTheLogBacksOff) {
+  const RegisterMap map = fullMap();
+  const int port = test::freeTcpPort();
+  std::ostringstream log;
+  auto sink = std::make_shared<spdlog::sinks::ostream_sink_mt>(log);
+  auto previous = spdlog::default_logger();
+  spdlog::set_default_logger(std::make_shared<spdlog::logger>("plc-test", sink));
+  PlcSettings settings = fastSettings(port);
+  settings.reconnectInitial = 5ms;
+  settings.reconnectMax = 10ms;
+  {
+    PlcLink link(map, settings);
+    link.start();
+    std::this_thread::sleep_for(1500ms);  // about 100 attempts
+    link.stop();
+  }
+  spdlog::set_default_logger(previous);
+  const std::string text = log.str();
+  std::size_t warnings = 0;
+  for (auto at = text.find("cannot connect"); at != std::string::npos;
+       at = text.find("cannot connect", at + 1))
+    ++warnings;
+  EXPECT_GE(warnings, 3u) << text;
+  EXPECT_LE(warnings, 9u) << "logged at attempts 1, 2, 4, ..., 128 at most:\n" << text;
+  EXPECT_EQ(text.find("cannot connect to 127.0.0.1:" + std::to_string(port)),
+            text.find("cannot connect"));
+  const std::size_t firstAt = text.find("cannot connect");
+  ASSERT_NE(firstAt, std::string::npos) << text;
+  const std::string first = text.substr(firstAt, text.find('\n', firstAt) - firstAt);
+  EXPECT_THAT(first, HasSubstr("attempt 1"));
+}
+
 TEST(PlcLinkWithPymodbus, FreeRunWritesEveryResultWithTheNextCounter) {
   RegisterMap map = fullMap();
   map.control = {};

@@ -52,8 +52,13 @@ TEST(PlcSimulator, TriggersAtARateAndReadsEveryResult) {
   });
   PlcLink link(exampleMap(), settingsFor(sim.port(), HandshakeMode::Triggered));
   link.setActiveRecipe(3);
+  link.setReady(false);
   link.start();
   sim.start();
+  // Not ready: the rate raises nothing (a daemon still starting would only miss its triggers).
+  std::this_thread::sleep_for(200ms);
+  EXPECT_EQ(sim.stats().triggersRaised, 0u);
+  link.setReady(true);
   constexpr int kParts = 10;
   for (int i = 0; i < kParts; ++i) {
     const auto trigger = link.waitTrigger(5s);

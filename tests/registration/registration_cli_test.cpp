@@ -45,9 +45,20 @@ class RegisterCli : public ::testing::Test {
   cv::Matx33d truth_;
 };
 
-TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairs) {
+TEST_F(RegisterCli, PrintsASummaryByDefault) {
   const CliRun r =
       facet("register --ref " + ref_ + " --image " + image_ + " --model similarity --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j.at("H").size(), 9u);
+  EXPECT_GT(j.at("inliers").get<int>(), 10);
+  EXPECT_FALSE(j.contains("pairs")) << "pairs only with --pairs";
+  EXPECT_LT(r.out.size(), 1000u);
+}
+
+TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairsOnRequest) {
+  const CliRun r =
+      facet("register --ref " + ref_ + " --image " + image_ + " --model similarity --json --pairs");
   ASSERT_EQ(r.exitCode, 0) << r.err << r.out;
   const auto j = nlohmann::json::parse(r.out);
   ASSERT_EQ(j.at("H").size(), 9u);

@@ -107,5 +107,59 @@ TEST(ShapeCli, CreateThenMatchPrintsThePoseAsJson) {
   fs::remove_all(dir);
 }
 
+// A model trained for -10..10 degrees cannot find a part turned 30 degrees, whatever range the
+// search asks for: the cut is said on stderr and in the JSON, not left to a silent "0 matches".
+// Search options out of range are argument errors under the user's option names.
+TEST(ShapeCli, MatchSaysWhenTheModelCutsTheRequestedRange) {
+  const fs::path dir = fs::temp_directory_path() / "facet_shape_cli_range_test";
+  fs::create_directories(dir);
+  const std::string cli = FACET_CLI;
+  const fs::path err = dir / "stderr.txt";
+  ASSERT_TRUE(cv::imwrite((dir / "template.png").string(), testing::bracketTemplate()));
+  ASSERT_TRUE(
+      cv::imwrite((dir / "scene.png").string(),
+                  testing::bracketScene({480, 360}, {{240.3, 180.6, radians(30.0), 1.0}}, 4)));
+  const std::string model = (dir / "part.model").string();
+  ASSERT_EQ(run(cli + " model create --image " + (dir / "template.png").string() +
+                    " --angle-range -10,10 --out " + model,
+                err)
+                .exitCode,
+            0)
+      << readText(err);
+  const std::string match =
+      cli + " match --model " + model + " --image " + (dir / "scene.png").string();
+
+  const CliRun wide = run(match + " --angle-range -180,180 --json", err);
+  ASSERT_EQ(wide.exitCode, 0) << readText(err);
+  const auto j = nlohmann::json::parse(wide.out);
+  ASSERT_EQ(j.at("warnings").size(), 1u) << wide.out;
+  const std::string warning = j["warnings"][0].get<std::string>();
+  EXPECT_NE(warning.find("--angle-range"), std::string::npos) << warning;
+  EXPECT_NE(warning.find("-10,10"), std::string::npos) << warning;
+
+  const CliRun text = run(match + " --angle-range -180,180 --scale-range 0.9,1.1", err);
+  ASSERT_EQ(text.exitCode, 0) << readText(err);
+  EXPECT_NE(readText(err).find("warning: --angle-range -180,180 is cut"), std::string::npos)
+      << readText(err);
+  EXPECT_NE(readText(err).find("warning: --scale-range 0.9,1.1 is cut"), std::string::npos)
+      << readText(err);
+
+  // Inside the trained range: nothing to say.
+  const CliRun inside = run(match + " --angle-range -5,5 --json", err);
+  ASSERT_EQ(inside.exitCode, 0) << readText(err);
+  EXPECT_TRUE(nlohmann::json::parse(inside.out).at("warnings").empty()) << inside.out;
+
+  for (const std::string option : {"--min-score 1.5", "--min-score 0", "--max-overlap 2",
+                                   "--greediness -1", "--num-matches -3"}) {
+    const CliRun bad = run(match + " " + option, err);
+    EXPECT_EQ(bad.exitCode, 1) << option;
+    const std::string message = readText(err);
+    EXPECT_NE(message.find(option.substr(0, option.find(' '))), std::string::npos) << message;
+    EXPECT_EQ(message.find("findShapeModel"), std::string::npos) << message;
+    EXPECT_EQ(message.find("scene.png"), std::string::npos) << "not the image's fault: " << message;
+  }
+  fs::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace facet

@@ -36,6 +36,14 @@ function renderHealth(h) {
   badge($('health-recipe'), 'recipe ' + (recipe.id ?? '?') +
         (problems ? ' · ' + problems + ' problem(s)' : ''), problems ? 'warn' : 'ok');
   $('health-recipe').title = (recipe.problems || []).join('\n');
+  // On the page, not only in the badge's tooltip: a rejected recipe needs someone to act.
+  const list = (recipe.problems || []).map((text) => {
+    const item = document.createElement('li');
+    item.textContent = text;
+    return item;
+  });
+  $('recipe-problem-list').replaceChildren(...list);
+  $('recipe-problems').hidden = list.length === 0;
 }
 
 function renderCounts(counts) {

@@ -52,6 +52,16 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
   const std::string advice = "; run `facet recipe train " + in.recipeFile().string() + "`";
   const config::ModelStatus status =
       config::modelStatus(training.model, training.templateImage, parametersText(training));
+  auto resource = std::make_shared<ShapeModelResource>();
+  if (status.state != config::ModelState::Missing) {
+    // A file that is no model at all (or one of another facet version) is that, not "stale".
+    try {
+      resource->model = loadShapeModel(training.model);
+    } catch (const std::exception& e) {
+      in.error(key, what + "cannot be loaded: " + e.what() + advice);
+      return nullptr;
+    }
+  }
   switch (status.state) {
     case config::ModelState::Missing:
       in.error(key, what + status.detail + advice);
@@ -65,14 +75,7 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
     case config::ModelState::Fresh:
       break;
   }
-  auto resource = std::make_shared<ShapeModelResource>();
-  try {
-    // Also refuses a model written by another (incompatible) version of facet.
-    resource->model = loadShapeModel(training.model);
-  } catch (const std::exception& e) {
-    in.error(key, what + "cannot be loaded: " + e.what() + advice);
-    return nullptr;
-  }
+
   const cv::Point2d offset =
       training.region ? cv::Point2d(cvRound(training.region->x), cvRound(training.region->y))
                       : cv::Point2d();
