@@ -10,8 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include <opencv2/imgproc.hpp>
-
+#include "algorithms/image/grey_image.hpp"
 #include "camera/camera_settings.hpp"
 #include "camera/image_file_reader.hpp"
 #include "service/cli/command_line.hpp"
@@ -60,8 +59,7 @@ cv::Mat readGreyImage(const std::string& path) {
   }
   // The decoder's first line says it; the rest repeats it in the library's words.
   if (!content.ok()) throw InputError(content.error.substr(0, content.error.find('\n')));
-  if (content.image.channels() == 3) cv::cvtColor(content.image, content.image, cv::COLOR_BGR2GRAY);
-  return content.image;
+  return toGrey(content.image);
 }
 
 }  // namespace facet::cli
