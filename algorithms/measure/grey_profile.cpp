@@ -36,12 +36,13 @@ GreyProfile sample(const cv::Mat& image, const MeasuringPath& path, const GreyPr
   bool anyMissing = false;
   for (int i = 0; i < n; ++i) {
     const double s = start + i * prm.step;
+    const cv::Point2d origin = path.at(s, 0.0), across = path.acrossAt(s);
     double sum = 0;
     int count = 0;
     for (int k = 0; k < lines; ++k) {
       const double t = -path.width() / 2.0 + (k + 0.5) * path.width() / lines;
       double g = 0;
-      if (bilinear<T>(image, path.at(s, t), g)) sum += g, ++count;
+      if (bilinear<T>(image, origin + t * across, g)) sum += g, ++count;
     }
     anyMissing = anyMissing || count < lines;
     if (2 * count >= lines && count > 0) values[i] = sum * scale / count, inside[i] = 1;

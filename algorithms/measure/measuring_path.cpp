@@ -9,7 +9,9 @@ MeasuringPath::MeasuringPath(const MeasuringRect& rect)
     : centre_(rect.cx, rect.cy),
       length_(rect.length),
       width_(rect.width),
-      angle_(rect.angle * CV_PI / 180.0) {}
+      angle_(rect.angle * CV_PI / 180.0),
+      cos_(std::cos(angle_)),
+      sin_(std::sin(angle_)) {}
 
 MeasuringPath::MeasuringPath(const MeasuringArc& arc)
     : arc_(true),
@@ -21,19 +23,22 @@ MeasuringPath::MeasuringPath(const MeasuringArc& arc)
       sign_(arc.extent < 0 ? -1.0 : 1.0) {}
 
 cv::Point2d MeasuringPath::at(double s, double t) const {
-  if (!arc_) {
-    const double c = std::cos(angle_), sn = std::sin(angle_);
-    return {centre_.x + s * c + t * sn, centre_.y - s * sn + t * c};
-  }
+  if (!arc_) return {centre_.x + s * cos_ + t * sin_, centre_.y - s * sin_ + t * cos_};
   const double phi = angle_ + sign_ * s / radius_;
   const double r = radius_ + t;
   return {centre_.x + r * std::cos(phi), centre_.y - r * std::sin(phi)};
 }
 
 cv::Point2d MeasuringPath::axisAt(double s) const {
-  if (!arc_) return {std::cos(angle_), -std::sin(angle_)};
+  if (!arc_) return {cos_, -sin_};
   const double phi = angle_ + sign_ * s / radius_;
   return {-sign_ * std::sin(phi), -sign_ * std::cos(phi)};
+}
+
+cv::Point2d MeasuringPath::acrossAt(double s) const {
+  if (!arc_) return {sin_, cos_};
+  const double phi = angle_ + sign_ * s / radius_;
+  return {std::cos(phi), -std::sin(phi)};
 }
 
 cv::Rect2d MeasuringPath::bounds() const {

@@ -51,6 +51,7 @@ EdgeScene makeEdgeScene(std::uint64_t seed, BlurModel model, SceneNoise n) {
   EdgeScene es;
   es.rect = {31.5 + u(rng), 31.5 + u(rng), 40, 20, 360 * u(rng)};
   es.rising = u(rng) < 0.5;
+  es.contrast = light - dark;
   // The edge crosses the axis at `position`, its normal tilted up to 5 degrees off the axis.
   es.position = -6 + 12 * u(rng);
   const cv::Point2d d = axisOf(es.rect.angle);

@@ -26,6 +26,7 @@ struct EdgeScene {
   MeasuringRect rect;   // the caliper
   double position = 0;  // true signed position of the edge along the axis
   bool rising = true;
+  double contrast = 0;  // grey levels between the two sides
 };
 EdgeScene makeEdgeScene(std::uint64_t seed, BlurModel model, SceneNoise n = {});
 
