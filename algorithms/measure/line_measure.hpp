@@ -22,9 +22,11 @@ namespace facet {
 struct LineMeasureParams {
   EdgePolarity polarity = EdgePolarity::Any;
   double minAmplitude = 20.0;  // grey levels (8-bit scale)
-  double spacing = 1.0;        // pixels between the cross calipers along the axis
-  double stationWidth = 1.0;   // pixels each cross caliper averages along the axis
-  GreyProfileParams sampling;
+  double spacing = 2.0;        // pixels between the cross calipers along the axis
+  double stationWidth = 2.0;   // pixels each cross caliper averages along the axis
+  // Profile samples every 0.5 px across (the caliper's 0.25 px costs twice the time here, for
+  // the same noise: many points average the line).
+  GreyProfileParams sampling{.step = 0.5, .crossStep = 0.5};
   ProfileEdgeParams edges;
   LineFitParams fit;
 };

@@ -19,6 +19,9 @@ int main(int argc, char** argv) {
   addVersionCommand(app);
   addPlcSimCommand(app);
   addCircleCommand(app);
+  addCaliperCommand(app);
+  addLineCommand(app);
+  addBlobCommand(app);
   addScanMatchCommand(app);
   addResultsCommand(app);
   addEdgesCommand(app);
