@@ -44,6 +44,12 @@ void describe(const Moments& mo, cv::Point offset, Blob& b) {
   // A uniform ellipse of semi-axis r has variance r^2 / 4 along it.
   b.majorRadius = 2.0 * std::sqrt(std::max(0.0, mean + diff));
   b.minorRadius = 2.0 * std::sqrt(std::max(0.0, mean - diff));
+  // Grey weights spread the blob by the blur (each variance grows by sigma^2): scale the ellipse
+  // to the blob's area, which the blur conserves (exact for discs).
+  if (const double ellipseArea = CV_PI * b.majorRadius * b.minorRadius; ellipseArea > 0) {
+    const double k = std::sqrt(b.area / ellipseArea);
+    b.majorRadius *= k, b.minorRadius *= k;
+  }
   double a = -0.5 * std::atan2(2 * sxy, sxx - syy) * 180.0 / CV_PI;  // y down: negate
   if (a <= -90) a += 180;
   b.angle = a;

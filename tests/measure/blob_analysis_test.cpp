@@ -63,7 +63,9 @@ TEST(BlobAnalysis, FindsDarkBlobsWithEveryThresholdMode) {
     const BlobResult r = analyseBlobs(image, p);
     ASSERT_TRUE(r.ok()) << r.message;
     EXPECT_EQ(r.blobs.size(), 3u) << static_cast<int>(mode);
-    if (mode == BlobThreshold::RelativeToMedian) EXPECT_NEAR(r.threshold, 200 - 70, 3);
+    if (mode == BlobThreshold::RelativeToMedian) {
+      EXPECT_NEAR(r.threshold, 200 - 70, 3);
+    }
   }
 }
 

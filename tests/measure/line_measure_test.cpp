@@ -26,11 +26,12 @@ TEST(LineMeasure, GivesAngleAndPositionOfAStraightEdge) {
     const LineMeasurement m = measureLine(image, {c.x, c.y, 150, 16, angle + 0.5});
     ASSERT_TRUE(m.ok()) << angle << ": " << m.message;
     EXPECT_NEAR(std::remainder(m.angle - angle, 360.0), 0.0, 0.01) << angle;
-    EXPECT_NEAR(offset(m.p1, through, dir), 0.0, 0.02) << angle;
-    EXPECT_NEAR(offset(m.p2, through, dir), 0.0, 0.02) << angle;
+    // Noise 1 over 75 points of 150 px: the ends' offsets scatter about 0.01 px.
+    EXPECT_NEAR(offset(m.p1, through, dir), 0.0, 0.03) << angle;
+    EXPECT_NEAR(offset(m.p2, through, dir), 0.0, 0.03) << angle;
     EXPECT_NEAR(cv::norm(m.p2 - m.p1), 149, 2.0) << angle;
     EXPECT_GT((m.p2 - m.p1).dot(dir), 0) << angle;  // in axis order
-    EXPECT_GT(m.points, 70) << angle;  // one per 2 px
+    EXPECT_GT(m.points, 70) << angle;               // one per 2 px
     EXPECT_LT(m.rms, 0.05) << angle;
     EXPECT_LT(m.straightness, 0.2) << angle;
     EXPECT_FALSE(m.partial);
