@@ -79,6 +79,9 @@ int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds) {
   addVersionCommand(app);
   addPlcSimCommand(app);
   addCircleCommand(app);
+  addCaliperCommand(app);
+  addLineCommand(app);
+  addBlobCommand(app);
   addScanMatchCommand(app);
   addResultsCommand(app);
   addEdgesCommand(app);

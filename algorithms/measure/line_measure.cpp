@@ -1,0 +1,86 @@
+#include "algorithms/measure/line_measure.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace facet {
+namespace {
+
+LineMeasurement failed(MeasureFailure cause, std::string message, bool partial) {
+  LineMeasurement m;
+  m.failure = cause;
+  m.message = std::move(message);
+  m.partial = partial;
+  return m;
+}
+
+}  // namespace
+
+LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
+                            const LineMeasureParams& params) {
+  if (!(rect.length > 0) || !(rect.width > 0))
+    return failed(MeasureFailure::ZeroSize, "the line rectangle has zero length or width", false);
+  if (!(params.spacing > 0) || !(params.stationWidth > 0))
+    throw std::invalid_argument("line: spacing and station width must be positive");
+  const MeasuringPath along(rect);
+  ProfileEdgeParams ep = params.edges;
+  ep.minAmplitude = params.minAmplitude;
+
+  LineMeasurement m;
+  const int count = std::max(1, static_cast<int>(std::floor(rect.length / params.spacing)));
+  const double first = -(count - 1) * params.spacing / 2.0;
+  int contrasted = 0;
+  for (int k = 0; k < count; ++k) {
+    const cv::Point2d c = along.at(first + k * params.spacing, 0.0);
+    const MeasuringPath across(
+        MeasuringRect{c.x, c.y, rect.width, params.stationWidth, rect.angle - 90.0});
+    const GreyProfile profile = sampleGreyProfile(image, across, params.sampling);
+    if (profile.values.size() < 6) {
+      m.partial = true;
+      continue;
+    }
+    ++m.stations;
+    m.partial = m.partial || profile.partial;
+    const auto [lo, hi] = std::minmax_element(profile.values.begin(), profile.values.end());
+    if (*hi - *lo >= params.minAmplitude) ++contrasted;
+    const ProfileEdge* best = nullptr;
+    const std::vector<ProfileEdge> edges = findProfileEdges(profile, ep);
+    for (const ProfileEdge& e : edges) {
+      const bool wanted = params.polarity == EdgePolarity::Any ||
+                          (params.polarity == EdgePolarity::Rising) == (e.amplitude > 0);
+      if (wanted && (!best || std::abs(e.amplitude) > std::abs(best->amplitude))) best = &e;
+    }
+    if (best) m.edgePoints.push_back(across.at(best->position, 0.0));
+  }
+  if (m.stations == 0)
+    return failed(MeasureFailure::OutsideImage, "the line rectangle lies outside the image", true);
+  if (contrasted == 0)
+    return failed(MeasureFailure::NoContrast, "no contrast in the line rectangle", m.partial);
+  if (m.edgePoints.size() < 3)
+    return failed(MeasureFailure::TooFewPoints,
+                  "only " + std::to_string(m.edgePoints.size()) +
+                      " edge points of the requested polarity and amplitude",
+                  m.partial);
+  const auto fit = fitLineRobust(m.edgePoints, params.fit);
+  if (!fit)
+    return failed(MeasureFailure::TooFewPoints, "the edge points do not form a line", m.partial);
+
+  // Orient the line along the rectangle's axis and take the inliers' extent on it.
+  cv::Point2d dir = fit->direction;
+  const cv::Point2d axis = along.axisAt(0.0);
+  if (dir.dot(axis) < 0) dir = -dir;
+  double t0 = 1e300, t1 = -1e300;
+  for (int i : fit->inliers) {
+    const double t = (m.edgePoints[i] - fit->point).dot(dir);
+    t0 = std::min(t0, t), t1 = std::max(t1, t);
+  }
+  m.p1 = fit->point + t0 * dir;
+  m.p2 = fit->point + t1 * dir;
+  m.angle = std::atan2(-dir.y, dir.x) * 180.0 / CV_PI;
+  m.rms = fit->rms;
+  m.straightness = fit->straightness;
+  m.points = static_cast<int>(fit->inliers.size());
+  return m;
+}
+
+}  // namespace facet

@@ -1,0 +1,45 @@
+#pragma once
+// Subpixel step edges in a grey profile.
+//
+// A straight edge crossing a caliper is a step blurred by the lens and integrated over the
+// pixel -- or blurred on the pixel grid after integration, as a digital filter does. Under both
+// image formations the profile across the edge is point-symmetric about the edge position e:
+// P(e + u) - m = -(P(e - u) - m) with m the mid level (the blur kernel and the pixel aperture are
+// both symmetric). The estimator uses only that symmetry, not a fitted shape:
+//
+//  1. candidates are extrema of the profile's Gaussian derivative (sigma `smoothing`);
+//  2. each edge is fitted with a blurred step a + b Phi((s - e) / w) over its window (up to
+//     `window` either side, never past the midpoint to a neighbouring edge, whose own fitted step
+//     is subtracted first so that bars a few pixels wide keep both edges unbiased); this gives
+//     the levels (a, b) and a first e;
+//  3. e is then moved until the profile's area above and below the mid level m = a + b/2 balances
+//     over [e - R, e + R] (R = `areaHalfWidth`): for a point-symmetric profile that balance point
+//     is exactly e for any R, whatever the blur's shape, so the model's shape (an erf standing in
+//     for erf convolved with the pixel's footprint) cannot bias the position. The area uses the
+//     exact integral of the linearly interpolated samples.
+
+#include <vector>
+
+#include "algorithms/measure/grey_profile.hpp"
+
+namespace facet {
+
+struct ProfileEdgeParams {
+  double smoothing = 1.0;           // pixels: sigma of the derivative that finds candidates
+  double minAmplitude = 20.0;       // grey levels (8-bit scale): smallest |step| kept
+  double window = 4.0;              // pixels either side of an edge in its step fit
+  double areaHalfWidth = 1.5;       // pixels either side in the symmetric-area refinement
+  bool symmetricRefinement = true;  // step 3 above; off reports the step fit's e
+};
+
+struct ProfileEdge {
+  double position = 0;   // axis position, pixels (as GreyProfile::positionAt)
+  double amplitude = 0;  // signed grey step along the axis: > 0 dark to light (rising)
+  double blur = 0;       // fitted step width w, pixels (blur sigma with the pixel's footprint)
+};
+
+// Every edge of either polarity with |amplitude| >= minAmplitude, sorted by position.
+std::vector<ProfileEdge> findProfileEdges(const GreyProfile& profile,
+                                          const ProfileEdgeParams& params = {});
+
+}  // namespace facet
