@@ -41,5 +41,6 @@ void addMatchCommand(CLI::App& app);
 void addRegisterCommand(CLI::App& app);
 void addRecipeCommand(CLI::App& app);
 void addReplayCommand(CLI::App& app);
+void addValidateCommand(CLI::App& app);
 
 }  // namespace facet::cli

@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   addRegisterCommand(app);
   addRecipeCommand(app);
   addReplayCommand(app);
+  addValidateCommand(app);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
