@@ -37,8 +37,12 @@ class SectionReader {
     if (!n || !n.IsScalar() || n.Scalar().empty()) return {};
     const auto p = (base_ / n.Scalar()).lexically_normal();
     std::error_code ec;
-    if (!std::filesystem::is_regular_file(p, ec)) error(n, "'" + std::string(key) + "' file '" +
-                                                               n.Scalar() + "' does not exist");
+    if (!std::filesystem::is_regular_file(p, ec)) {
+      // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on "'" + std::string(key).
+      std::string message = "'";
+      message.append(key).append("' file '").append(n.Scalar()).append("' does not exist");
+      error(n, std::move(message));
+    }
     return p;
   }
   // The outbox folder: created by the sink, so only its parent must exist.

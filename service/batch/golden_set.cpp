@@ -34,7 +34,7 @@ std::vector<GoldenMismatch> compareWithGolden(const PartResult& part,
   if (verdict == sidecar.end())
     mismatch("verdict", "(no expected_verdict in the sidecar)", got(part));
   else if (verdict->second != "pass" && verdict->second != "fail")
-    mismatch("verdict", "'" + verdict->second + "' (must be pass or fail)", got(part));
+    mismatch("verdict", fmt::format("'{}' (must be pass or fail)", verdict->second), got(part));
   else if (verdict->second != verdictName(part.verdict))
     mismatch("verdict", verdict->second, got(part));
 
