@@ -5,7 +5,7 @@
 // station's name, the time in microseconds and each checked value's limits.
 //
 // Example (abridged):
-//   {"station": "line3-cam1", "part_id": 412, "time": "2026-11-24T21:03:07.125Z",
+//   {"station": "line3-cam1", "part_id": 412, "time": "2026-11-29T21:03:07.125Z",
 //    "time_us": 1795986187125331, "recipe_id": 1, "recipe": "flange", "recipe_version": "9c1e..",
 //    "verdict": "fail", "failed_checks": ["bore.diameter"], "error": "",
 //    "values": {"bore.diameter": {"value": 12.07, "unit": "mm", "pass": false, "nominal": 12.0,

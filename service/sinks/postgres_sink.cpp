@@ -103,7 +103,7 @@ bool ok(const Result& r) {
 }
 
 constexpr const char* kInsertPart =
-    "INSERT INTO parts VALUES ($1, $2, $3, to_timestamp($3::double precision / 1000000), $4, $5, "
+    "INSERT INTO parts VALUES ($1, $2, $3, to_timestamp($3::bigint / 1000000.0::float8), $4, $5, "
     "$6, $7, $8, $9, $10, $11, $12, $13, $14, $15) ON CONFLICT DO NOTHING";
 constexpr const char* kInsertValue =
     "INSERT INTO measurements VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)";

@@ -63,7 +63,7 @@ TEST(MqttPublisher, ResultCarriesStationRecipeValuesAndLimitsAndStatusIsRetained
   EXPECT_EQ(message["verdict"], "fail");
   EXPECT_EQ(message["failed_checks"], nlohmann::json::array({"bore.diameter"}));
   EXPECT_EQ(message["time_us"], 1795986187125331LL + 7000);
-  EXPECT_EQ(message["time"], "2026-11-30T21:03:07.132Z");
+  EXPECT_EQ(message["time"], "2026-11-29T21:03:07.132Z");
   const auto& d = message["values"]["bore.diameter"];
   EXPECT_EQ(d["unit"], "mm");
   EXPECT_DOUBLE_EQ(d["value"].get<double>(), 12.07);

@@ -54,7 +54,7 @@ TEST(PostgresSink, WritesTheResultsStoreTablesWithTheStation) {
             std::to_string(1795986187125331LL + 1000));
   EXPECT_EQ(db.query("SELECT to_char(time_utc AT TIME ZONE 'UTC', 'YYYY-MM-DD HH24:MI:SS.US') "
                      "FROM parts WHERE part_id = 1"),
-            "2026-11-30 21:03:07.126331");
+            "2026-11-29 21:03:07.126331");
 
   // The same parts again (as after a COMMIT whose answer was lost): nothing is written twice.
   for (std::uint64_t i = 1; i <= 10; ++i) sink.submit(samplePart(i));
