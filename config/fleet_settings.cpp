@@ -97,7 +97,8 @@ MqttSettings readMqttSettings(const YAML::Node& node, const std::filesystem::pat
     s.keyFile = r.existingFile(tls, "key_file");
     s.tlsInsecure = tls["insecure"] ? readBoolean(tls["insecure"]).value_or(false) : false;
     if (s.certFile.empty() != s.keyFile.empty())
-      r.error(tls, "tls needs both 'cert_file' and 'key_file' for a client certificate, or neither");
+      r.error(tls,
+              "tls needs both 'cert_file' and 'key_file' for a client certificate, or neither");
   }
   s.port = static_cast<int>(r.integer("port", s.caFile.empty() ? 1883 : 8883));
   if (!s.password.empty() && s.username.empty())
@@ -115,9 +116,9 @@ MqttSettings readMqttSettings(const YAML::Node& node, const std::filesystem::pat
          return levels;
        }())
     if (!validTopicLevel(level)) {
-      r.error(node["topic_prefix"] ? node["topic_prefix"] : node,
-              "'topic_prefix' '" + s.topicPrefix +
-                  "' is not a topic: no empty level, no '+' or '#'");
+      r.error(
+          node["topic_prefix"] ? node["topic_prefix"] : node,
+          "'topic_prefix' '" + s.topicPrefix + "' is not a topic: no empty level, no '+' or '#'");
       break;
     }
   s.outbox = r.outbox("mqtt-outbox");

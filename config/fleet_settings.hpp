@@ -24,9 +24,9 @@ struct MqttSettings {
   bool enabled = false;  // the station file has an mqtt section
   std::string host = "127.0.0.1";
   int port = 1883;
-  std::string clientId;              // default: "facet-<station>"
+  std::string clientId;               // default: "facet-<station>"
   std::string topicPrefix = "facet";  // topics <prefix>/<station>/result and .../status
-  std::string username;              // empty: no user name
+  std::string username;               // empty: no user name
   std::string password;
   int keepaliveS = 30;
   int reconnectMaxMs = 5000;

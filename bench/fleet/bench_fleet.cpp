@@ -85,7 +85,8 @@ config::StationConfig exampleStation(const fs::path& dir, int plcPort) {
   replace("/tmp/facet-demo-archive", (dir / "archive").string());
   replace("port: 8080", "port: 0");
   replace("fps: 5", "fps: 0");
-  const fs::path file = kSource / "recipes" / ("bench-fleet-" + std::to_string(::getpid()) + ".yaml");
+  const fs::path file =
+      kSource / "recipes" / ("bench-fleet-" + std::to_string(::getpid()) + ".yaml");
   std::ofstream(file) << text;
   auto loaded = config::loadStationConfig(file);
   fs::remove(file);
@@ -95,7 +96,7 @@ config::StationConfig exampleStation(const fs::path& dir, int plcPort) {
 
 enum class Sinks { None, Delivering, PeersDown };
 const char* name(Sinks s) {
-  return s == Sinks::None ? "no sinks (baseline)"
+  return s == Sinks::None         ? "no sinks (baseline)"
          : s == Sinks::Delivering ? "MQTT + PostgreSQL, peers up"
                                   : "MQTT + PostgreSQL, peers down";
 }
@@ -176,8 +177,8 @@ struct ReplayRate {
 // `shards` threads each taking its shard.
 ReplayRate replayRate(const std::string& recipeName, int passes, int shards) {
   const auto station = config::loadStationConfig(kSource / "recipes/station.yaml").station;
-  const auto loaded =
-      config::loadRecipe(kSource / "recipes" / (recipeName + ".recipe.yaml"), station->recipeLoadOptions());
+  const auto loaded = config::loadRecipe(kSource / "recipes" / (recipeName + ".recipe.yaml"),
+                                         station->recipeLoadOptions());
   if (!loaded.recipe) throw std::runtime_error(loaded.diagnostics.text());
   auto recipe = std::make_shared<const config::Recipe>(*loaded.recipe);
   const service::RecipeInspection inspection(recipe, station->calibration.mmPerPixel);
@@ -189,7 +190,8 @@ ReplayRate replayRate(const std::string& recipeName, int passes, int shards) {
   const auto all = service::listShare(folder, "", scans, {});
   double cpu0 = cpuSeconds(CLOCK_PROCESS_CPUTIME_ID);
   for (int p = 0; p < passes; ++p)
-    for (const auto& part : all) (void)service::inspectRecordedPart(inspection, part, sidecars, scans);
+    for (const auto& part : all)
+      (void)service::inspectRecordedPart(inspection, part, sidecars, scans);
   r.images = static_cast<int>(all.size()) * passes;
   r.batchPerCpuS = r.images / (cpuSeconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0);
 
@@ -250,9 +252,10 @@ int main(int argc, char** argv) {
   const fs::path dir = fs::temp_directory_path() / ("bench_fleet_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const unsigned cores = std::thread::hardware_concurrency();
-  std::printf("bench_fleet%s: %u cores, load average at start %s (a shared machine: absolute "
-              "times vary with the load; compare rows of one run)\n\n",
-              smoke ? " --smoke" : "", cores, loadAverage().c_str());
+  std::printf(
+      "bench_fleet%s: %u cores, load average at start %s (a shared machine: absolute "
+      "times vary with the load; compare rows of one run)\n\n",
+      smoke ? " --smoke" : "", cores, loadAverage().c_str());
   try {
     sinks_test::MosquittoBroker broker(dir.string());
     broker.start();
@@ -271,9 +274,10 @@ int main(int argc, char** argv) {
         if (s == Sinks::Delivering) delivered += d;
         if (s == Sinks::PeersDown) broker.start(), db.start();
       }
-    std::printf("PLC path: trigger raised -> result registers read, one part at a time, %d parts "
-                "per row in %d alternating blocks\n\n",
-                rounds * triggers, rounds);
+    std::printf(
+        "PLC path: trigger raised -> result registers read, one part at a time, %d parts "
+        "per row in %d alternating blocks\n\n",
+        rounds * triggers, rounds);
     std::printf("| sinks                          |  p50 ms |  p99 ms | p50 ratio | p99 ratio |\n");
     std::printf("|--------------------------------|---------|---------|-----------|-----------|\n");
     const double base50 = percentile(latency[Sinks::None], 0.5);
@@ -283,9 +287,10 @@ int main(int argc, char** argv) {
       std::printf("| %-30s | %7.2f | %7.2f | %9.2f | %9.2f |\n", name(s), p50, p99, p50 / base50,
                   p99 / base99);
     }
-    std::printf("\nresults confirmed by broker + database in the peers-up runs: %llu of %d "
-                "(MQTT and PostgreSQL each count a part; warm-up parts included)\n\n",
-                static_cast<unsigned long long>(delivered), 2 * rounds * (triggers + 5));
+    std::printf(
+        "\nresults confirmed by broker + database in the peers-up runs: %llu of %d "
+        "(MQTT and PostgreSQL each count a part; warm-up parts included)\n\n",
+        static_cast<unsigned long long>(delivered), 2 * rounds * (triggers + 5));
   } catch (const std::exception& e) {
     std::printf("sinks: FAILED: %s\n", e.what());
     fs::remove_all(dir);
@@ -293,14 +298,17 @@ int main(int argc, char** argv) {
   }
 
   const int shards = static_cast<int>(std::max(2u, cores));
-  std::printf("Re-inspection of the recorded folders (images per CPU-second = per core; %d shard "
-              "threads at once for the last column)\n\n",
-              shards);
-  std::printf("| recipe                | images | batch img/cpu-s | report-path img/cpu-s "
-              "(baseline) | ratio | %d shards img/s |\n",
-              shards);
-  std::printf("|-----------------------|--------|-----------------|------------------------------"
-              "-|-------|----------------|\n");
+  std::printf(
+      "Re-inspection of the recorded folders (images per CPU-second = per core; %d shard "
+      "threads at once for the last column)\n\n",
+      shards);
+  std::printf(
+      "| recipe                | images | batch img/cpu-s | report-path img/cpu-s "
+      "(baseline) | ratio | %d shards img/s |\n",
+      shards);
+  std::printf(
+      "|-----------------------|--------|-----------------|------------------------------"
+      "-|-------|----------------|\n");
   for (const char* recipe :
        {"bracket_registration", "bracket_shape", "fiducial_board", "scan_offset"}) {
     const auto r = replayRate(recipe, smoke ? 1 : 5, shards);

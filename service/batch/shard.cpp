@@ -53,8 +53,8 @@ std::optional<Shard> shardFromEnvironment() {
     throw std::invalid_argument(
         "JOB_COMPLETION_INDEX is set but JOB_COMPLETIONS is not (set it to the Job's completions)");
   const std::string text = std::string(index) + "/" + count;
-  return checked(wholeNumber(index, "JOB_COMPLETION_INDEX"),
-                 wholeNumber(count, "JOB_COMPLETIONS"), text);
+  return checked(wholeNumber(index, "JOB_COMPLETION_INDEX"), wholeNumber(count, "JOB_COMPLETIONS"),
+                 text);
 }
 
 }  // namespace facet::service

@@ -16,7 +16,8 @@ PreparedRecipe prepareRecipe(const std::string& recipeFile, const std::string& s
     loadOptions = station.station->recipeLoadOptions();
     if (mmPerPixel <= 0) mmPerPixel = station.station->calibration.mmPerPixel;
   }
-  if (mmPerPixel <= 0) throw InputError("give --station (for its calibration) or --mm-per-pixel > 0");
+  if (mmPerPixel <= 0)
+    throw InputError("give --station (for its calibration) or --mm-per-pixel > 0");
   const auto loaded = config::loadRecipe(recipeFile, loadOptions);
   if (!loaded.recipe)
     throw InputError(loaded.diagnostics.text() + recipeFile + ": recipe has errors");
@@ -24,8 +25,7 @@ PreparedRecipe prepareRecipe(const std::string& recipeFile, const std::string& s
   prepared.recipe = std::make_shared<const config::Recipe>(*loaded.recipe);
   prepared.mmPerPixel = mmPerPixel;
   try {
-    prepared.inspection =
-        std::make_unique<service::RecipeInspection>(prepared.recipe, mmPerPixel);
+    prepared.inspection = std::make_unique<service::RecipeInspection>(prepared.recipe, mmPerPixel);
   } catch (const service::InspectionSetupError& e) {
     throw InputError(recipeFile + ": " + e.what());
   }

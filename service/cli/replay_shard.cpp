@@ -45,8 +45,7 @@ void runShardedReplay(const ShardedReplayOptions& opt) {
   std::map<std::string, int> counts{{"pass", 0}, {"fail", 0}, {"error", 0}};
   const auto t0 = std::chrono::steady_clock::now();
   for (const auto& part : share) {
-    const auto result =
-        service::inspectRecordedPart(*prepared.inspection, part, sidecars, scans);
+    const auto result = service::inspectRecordedPart(*prepared.inspection, part, sidecars, scans);
     store->store(result);
     ++counts[service::verdictName(result.verdict)];
   }
@@ -62,10 +61,9 @@ void runShardedReplay(const ShardedReplayOptions& opt) {
                {"results", opt.resultsFile}});
     return;
   }
-  std::cout << "shard " << shard.text() << ": " << share.size() << " parts, pass "
-            << counts["pass"] << ", fail " << counts["fail"] << ", error " << counts["error"]
-            << " in " << seconds << " s (" << rate << " images/s)\nresults: " << opt.resultsFile
-            << "\n";
+  std::cout << "shard " << shard.text() << ": " << share.size() << " parts, pass " << counts["pass"]
+            << ", fail " << counts["fail"] << ", error " << counts["error"] << " in " << seconds
+            << " s (" << rate << " images/s)\nresults: " << opt.resultsFile << "\n";
 }
 
 }  // namespace facet::cli

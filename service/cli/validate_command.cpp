@@ -79,9 +79,10 @@ void runValidate(const ValidateOptions& opt) {
                       {"check", m.check},
                       {"expected", m.expected},
                       {"got", m.got}});
-    printJson({{"recipe", {{"id", prepared.recipe->id},
-                           {"name", prepared.recipe->name},
-                           {"version", prepared.recipe->contentHash}}},
+    printJson({{"recipe",
+                {{"id", prepared.recipe->id},
+                 {"name", prepared.recipe->name},
+                 {"version", prepared.recipe->contentHash}}},
                {"golden", opt.goldenFolder},
                {"parts", parts.size()},
                {"matching", matching},

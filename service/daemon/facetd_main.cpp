@@ -136,9 +136,9 @@ int main(int argc, char** argv) {
     const auto& httpConfig = station.config().http;
     service::FleetStationView view(station, *fleet, station.metrics());
     service::HttpServer http(view, {.bindAddress = httpConfig.bind,
-                                       .port = httpConfig.port,
-                                       .token = httpConfig.token,
-                                       .dashboardDir = {}});
+                                    .port = httpConfig.port,
+                                    .token = httpConfig.token,
+                                    .dashboardDir = {}});
     http.start();
     spdlog::info("http listening on {}:{}", httpConfig.bind, http.port());
     if (!portFile.empty()) std::ofstream(portFile) << http.port() << "\n";

@@ -39,8 +39,8 @@ bool FleetPublishers::degraded() const {
 }
 
 void FleetPublishers::updateMetrics(MetricsRegistry& metrics) const {
-  for (const SinkStatus& s : {mqtt_ ? mqtt_->status() : SinkStatus{},
-                              postgres_ ? postgres_->status() : SinkStatus{}}) {
+  for (const SinkStatus& s :
+       {mqtt_ ? mqtt_->status() : SinkStatus{}, postgres_ ? postgres_->status() : SinkStatus{}}) {
     if (s.name.empty()) continue;
     const std::string label = "sink=\"" + s.name + "\"";
     metrics.gauge("facet_sink_connected", "1 while the sink reaches its peer", label)
@@ -49,8 +49,7 @@ void FleetPublishers::updateMetrics(MetricsRegistry& metrics) const {
         .set(static_cast<double>(s.outbox.pending));
     metrics.gauge("facet_sink_delivered", "Results the peer confirmed since start", label)
         .set(static_cast<double>(s.delivered));
-    metrics.gauge("facet_sink_dropped", "Oldest results dropped because the outbox was full",
-                  label)
+    metrics.gauge("facet_sink_dropped", "Oldest results dropped because the outbox was full", label)
         .set(static_cast<double>(s.outbox.dropped));
     metrics.gauge("facet_sink_write_errors", "Results the outbox could not write", label)
         .set(static_cast<double>(s.outbox.writeErrors));

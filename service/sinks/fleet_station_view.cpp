@@ -4,7 +4,7 @@ namespace facet::service {
 
 nlohmann::json FleetStationView::health() const {
   nlohmann::json h = station_.health();
-  for (const auto& [sink, state] : fleet_.health().items()) h[sink] = state;
+  h.update(fleet_.health());  // adds "mqtt" and "postgres"
   // A sink that cannot deliver degrades the station (parts are still inspected and buffered);
   // it never makes it "down".
   if (fleet_.degraded() && h.value("status", "") == "ok") h["status"] = "degraded";

@@ -43,7 +43,8 @@ MqttPublisher::MqttPublisher(config::MqttSettings settings, std::string station)
   status_.peer = settings_.host + ":" + std::to_string(settings_.port);
   status_.lastError = "not connected yet";
   mosq_ = mosquitto_new(settings_.clientId.c_str(), true, this);
-  if (!mosq_) throw std::runtime_error("mqtt: cannot create a client: " + errorText(MOSQ_ERR_ERRNO));
+  if (!mosq_)
+    throw std::runtime_error("mqtt: cannot create a client: " + errorText(MOSQ_ERR_ERRNO));
   mosquitto_int_option(mosq_, MOSQ_OPT_PROTOCOL_VERSION, MQTT_PROTOCOL_V311);
   const std::string statusTopic = this->statusTopic();
   mosquitto_will_set(mosq_, statusTopic.c_str(), static_cast<int>(std::strlen(kOffline)), kOffline,
@@ -52,10 +53,10 @@ MqttPublisher::MqttPublisher(config::MqttSettings settings, std::string station)
     mosquitto_username_pw_set(mosq_, settings_.username.c_str(),
                               settings_.password.empty() ? nullptr : settings_.password.c_str());
   if (!settings_.caFile.empty()) {
-    const int rc = mosquitto_tls_set(
-        mosq_, settings_.caFile.c_str(), nullptr,
-        settings_.certFile.empty() ? nullptr : settings_.certFile.c_str(),
-        settings_.keyFile.empty() ? nullptr : settings_.keyFile.c_str(), nullptr);
+    const int rc =
+        mosquitto_tls_set(mosq_, settings_.caFile.c_str(), nullptr,
+                          settings_.certFile.empty() ? nullptr : settings_.certFile.c_str(),
+                          settings_.keyFile.empty() ? nullptr : settings_.keyFile.c_str(), nullptr);
     if (rc != MOSQ_ERR_SUCCESS) {
       mosquitto_destroy(mosq_);
       throw std::runtime_error("mqtt tls: " + errorText(rc));
@@ -145,8 +146,8 @@ void MqttPublisher::run() {
     inFlight_.reset();  // sent again after reconnecting: at least once
     setError(why);
     nextAttempt = Clock::now() + backoff;
-    backoff = std::min<std::chrono::milliseconds>(backoff * 2,
-                                                  std::chrono::milliseconds(settings_.reconnectMaxMs));
+    backoff = std::min<std::chrono::milliseconds>(
+        backoff * 2, std::chrono::milliseconds(settings_.reconnectMaxMs));
   };
   while (true) {
     if (stopping_) {
@@ -177,8 +178,9 @@ void MqttPublisher::run() {
       if (!next.empty()) {
         int mid = 0;
         const auto& payload = next.front().payload;
-        const int rc = mosquitto_publish(mosq_, &mid, resultTopic().c_str(),
-                                         static_cast<int>(payload.size()), payload.data(), 1, false);
+        const int rc =
+            mosquitto_publish(mosq_, &mid, resultTopic().c_str(), static_cast<int>(payload.size()),
+                              payload.data(), 1, false);
         if (rc == MOSQ_ERR_SUCCESS)
           inFlight_ = InFlight{mid, next.front().seq};
         else if (rc == MOSQ_ERR_PAYLOAD_SIZE) {
@@ -195,8 +197,9 @@ void MqttPublisher::run() {
         std::lock_guard lock(statusMutex_);
         why = status_.lastError;  // a refusal explains itself better than "connection lost"
       }
-      lose(!isConnected() && why.starts_with("broker refused") ? why
-                                                                : "connection lost: " + errorText(rc));
+      lose(!isConnected() && why.starts_with("broker refused")
+               ? why
+               : "connection lost: " + errorText(rc));
       continue;
     }
     if (!isConnected() && Clock::now() - attemptStarted > kConnackTimeout) {

@@ -29,7 +29,8 @@ Outbox::Outbox(std::filesystem::path folder, std::uint64_t quotaBytes, std::stri
     : folder_(std::move(folder)), quotaBytes_(quotaBytes), name_(std::move(name)) {
   std::error_code ec;
   std::filesystem::create_directories(folder_, ec);
-  if (ec) throw std::runtime_error(folder_.string() + ": cannot create the outbox: " + ec.message());
+  if (ec)
+    throw std::runtime_error(folder_.string() + ": cannot create the outbox: " + ec.message());
   std::vector<Entry> found;
   for (const auto& entry : std::filesystem::directory_iterator(folder_, ec)) {
     if (entry.path().extension() == ".tmp") {
@@ -41,7 +42,8 @@ Outbox::Outbox(std::filesystem::path folder, std::uint64_t quotaBytes, std::stri
       found.push_back({*seq, static_cast<std::uint64_t>(entry.file_size(ec))});
   }
   if (ec) throw std::runtime_error(folder_.string() + ": cannot list the outbox: " + ec.message());
-  std::sort(found.begin(), found.end(), [](const Entry& a, const Entry& b) { return a.seq < b.seq; });
+  std::sort(found.begin(), found.end(),
+            [](const Entry& a, const Entry& b) { return a.seq < b.seq; });
   for (const auto& e : found) {
     entries_.push_back(e);
     stats_.bytes += e.bytes;

@@ -24,12 +24,12 @@ struct OutboxRecord {
 };
 
 struct OutboxStats {
-  std::uint64_t pending = 0;       // records waiting
-  std::uint64_t bytes = 0;         // their size on disk
-  std::uint64_t appended = 0;      // since start
-  std::uint64_t dropped = 0;       // oldest records deleted because the quota was full
-  std::uint64_t writeErrors = 0;   // records that could not be written (counted, logged)
-  std::uint64_t recovered = 0;     // records found in the folder at start
+  std::uint64_t pending = 0;      // records waiting
+  std::uint64_t bytes = 0;        // their size on disk
+  std::uint64_t appended = 0;     // since start
+  std::uint64_t dropped = 0;      // oldest records deleted because the quota was full
+  std::uint64_t writeErrors = 0;  // records that could not be written (counted, logged)
+  std::uint64_t recovered = 0;    // records found in the folder at start
 };
 
 class Outbox {

@@ -90,7 +90,8 @@ std::optional<std::string> number(const std::optional<double>& v) {
 }
 
 // PQexecParams with every parameter as text; nullopt is SQL NULL.
-Result execute(pg_conn* conn, const char* sql, const std::vector<std::optional<std::string>>& params) {
+Result execute(pg_conn* conn, const char* sql,
+               const std::vector<std::optional<std::string>>& params) {
   std::vector<const char*> values;
   for (const auto& p : params) values.push_back(p ? p->c_str() : nullptr);
   return Result(PQexecParams(conn, sql, static_cast<int>(values.size()), nullptr, values.data(),
@@ -199,8 +200,7 @@ bool PostgresSink::connect() {
   status_.connected = true;
   status_.lastError.clear();
   ++status_.connects;
-  spdlog::info("postgres {}: connected; {} results waiting", status_.peer,
-               outbox_.stats().pending);
+  spdlog::info("postgres {}: connected; {} results waiting", status_.peer, outbox_.stats().pending);
   return true;
 }
 
@@ -226,12 +226,11 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
     const std::string partId = std::to_string(p.partId);
     const std::string timeUs = std::to_string(
         std::chrono::duration_cast<std::chrono::microseconds>(p.time.time_since_epoch()).count());
-    const Result part = execute(
-        conn_, kInsertPart,
-        {station, partId, timeUs, std::to_string(p.recipeId), p.recipeName, p.recipeVersion,
-         std::to_string(p.frameId), p.source, p.serial, p.expectedVerdict,
-         std::string(verdictName(p.verdict)), failed, p.error, fmt::format("{}", p.inspectionMs),
-         timings.dump()});
+    const Result part = execute(conn_, kInsertPart,
+                                {station, partId, timeUs, std::to_string(p.recipeId), p.recipeName,
+                                 p.recipeVersion, std::to_string(p.frameId), p.source, p.serial,
+                                 p.expectedVerdict, std::string(verdictName(p.verdict)), failed,
+                                 p.error, fmt::format("{}", p.inspectionMs), timings.dump()});
     if (!ok(part)) {
       spdlog::error("postgres: part {}: {}", p.partId, trimmed(PQerrorMessage(conn_)));
       rollback();

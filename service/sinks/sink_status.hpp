@@ -11,12 +11,12 @@
 namespace facet::service {
 
 struct SinkStatus {
-  std::string name;        // "mqtt", "postgres"
-  std::string peer;        // broker host:port, or the database's host/port/dbname
+  std::string name;  // "mqtt", "postgres"
+  std::string peer;  // broker host:port, or the database's host/port/dbname
   bool connected = false;
-  std::string lastError;   // why it is not connected (empty while connected)
-  std::uint64_t delivered = 0;   // parts the peer confirmed since start
-  std::uint64_t connects = 0;    // successful connections since start
+  std::string lastError;        // why it is not connected (empty while connected)
+  std::uint64_t delivered = 0;  // parts the peer confirmed since start
+  std::uint64_t connects = 0;   // successful connections since start
   OutboxStats outbox;
 
   // Not connected: results wait in the outbox; the station still inspects and answers the PLC.

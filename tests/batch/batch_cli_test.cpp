@@ -45,15 +45,15 @@ std::vector<std::string> rows(const std::string& file) {
 }
 
 std::vector<std::string> replayArgs(const std::string& results) {
-  return {FACET_CLI, "replay",  "--recipe", kRecipe,   "--images", kImages,
+  return {FACET_CLI,   "replay", "--recipe",  kRecipe, "--images", kImages,
           "--station", kStation, "--results", results, "--json"};
 }
 
 TEST(ReplayShards, ThreeShardsAsProcessesGiveExactlyTheRowsOfOneRun) {
   daemon_test::TempDir dir;
-  const auto whole = runFacet("replay --recipe " + kRecipe + " --images " + kImages +
-                              " --station " + kStation + " --results " + (dir / "whole.db") +
-                              " --json");
+  const auto whole =
+      runFacet("replay --recipe " + kRecipe + " --images " + kImages + " --station " + kStation +
+               " --results " + (dir / "whole.db") + " --json");
   ASSERT_EQ(whole.exitCode, 0) << whole.err;
   const auto summary = nlohmann::json::parse(whole.out);
   EXPECT_EQ(summary["shard"], "0/1");
@@ -101,8 +101,8 @@ TEST(ReplayShards, BadShardIsAClearError) {
 
 TEST(Validate, RecordedFolderPassesAndAChangedExpectationFailsWithATable) {
   daemon_test::TempDir dir;
-  const auto ok = runFacet("validate --recipe " + kRecipe + " --golden " + kImages +
-                           " --station " + kStation);
+  const auto ok =
+      runFacet("validate --recipe " + kRecipe + " --golden " + kImages + " --station " + kStation);
   ASSERT_EQ(ok.exitCode, 0) << ok.out << ok.err;
   EXPECT_NE(ok.out.find(" 0 not"), std::string::npos) << ok.out;
 

@@ -71,7 +71,8 @@ TEST_F(FleetSections, TlsChangesTheDefaultPortAndNeedsItsFiles) {
   EXPECT_EQ(r.station->mqtt.caFile, scratch.path() / "ca.pem");
   const auto missing = load("mqtt:\n  tls:\n    ca_file: none.pem\n    cert_file: ca.pem\n");
   EXPECT_FALSE(missing.station.has_value());
-  EXPECT_TRUE(hasDiagnostic(missing.diagnostics, 14, 14, "'ca_file' file 'none.pem' does not exist"))
+  EXPECT_TRUE(
+      hasDiagnostic(missing.diagnostics, 14, 14, "'ca_file' file 'none.pem' does not exist"))
       << missing.diagnostics.text();
   EXPECT_TRUE(hasDiagnostic(missing.diagnostics, 14, 5, "both 'cert_file' and 'key_file'"))
       << missing.diagnostics.text();

@@ -28,14 +28,14 @@ std::string writeStation(const daemon_test::TempDir& dir, int brokerPort,
   f << "schema_version: 1\nname: cam1\ncamera:\n  backend: replay\n  replay:\n"
     << "    folder: " << kSource << "/recipes/demo/bracket_registration\n"
     << "    glob: \"*.png\"\n    loop: true\n    fps: 20\n    trigger: software\n"
-    << "    colour: mono\nrecipes: " << kSource << "/recipes\nresults:\n  database: "
-    << (dir / "results.db") << "\nhttp:\n  port: 0\ncalibration:\n  file: " << kSource
-    << "/recipes/calibration.yaml\n"
+    << "    colour: mono\nrecipes: " << kSource
+    << "/recipes\nresults:\n  database: " << (dir / "results.db")
+    << "\nhttp:\n  port: 0\ncalibration:\n  file: " << kSource << "/recipes/calibration.yaml\n"
     << "mqtt:\n  port: " << brokerPort << "\n  keepalive_s: 5\n  reconnect_max_ms: 500\n"
     << "  outbox: " << (dir / "mqtt-outbox") << "\n"
-    << "postgres:\n  connection: \"" << db.connection() << "\"\n  password: "
-    << PostgresCluster::kPassword << "\n  reconnect_max_ms: 500\n  outbox: "
-    << (dir / "pg-outbox") << "\n";
+    << "postgres:\n  connection: \"" << db.connection()
+    << "\"\n  password: " << PostgresCluster::kPassword
+    << "\n  reconnect_max_ms: 500\n  outbox: " << (dir / "pg-outbox") << "\n";
   return dir / "station.yaml";
 }
 

@@ -5,6 +5,9 @@
 #include <sys/socket.h>
 #include <unistd.h>
 
+#include <csignal>
+
+#include <filesystem>
 #include <fstream>
 #include <stdexcept>
 #include <thread>
@@ -33,10 +36,14 @@ MosquittoBroker::MosquittoBroker(std::string folder,
                                  std::vector<std::pair<std::string, std::string>> passwords)
     : folder_(std::move(folder)), port_(plc::test::freeTcpPort()) {
   std::ofstream conf(folder_ + "/mosquitto.conf");
-  conf << "listener " << port_ << " 127.0.0.1\n"
-       << "persistence true\npersistence_location " << folder_ << "/\n"
-       // Saved after every change: a killed broker loses no session and no queued message.
-       << "autosave_interval 1\nautosave_on_changes true\n"
+  conf << "listener " << port_
+       << " 127.0.0.1\n"
+       // Persistent sessions survive a restart. The database is written when the test asks
+       // (saveSessions()) and at a clean stop, not periodically: a killed broker comes back with
+       // the state of the last save. (Saving after every change would make a killed broker
+       // replay its own stale in-flight messages to subscribers, which then see repeats that
+       // no publisher sent: QoS 1 from a crashed broker is at least once.)
+       << "persistence true\npersistence_location " << folder_ << "/\nautosave_interval 0\n"
        << "log_dest file " << folder_ << "/mosquitto.log\n";
   // As root mosquitto would switch to its own user, which cannot write the test's folder.
   if (::geteuid() == 0) conf << "user root\n";
@@ -46,8 +53,8 @@ MosquittoBroker::MosquittoBroker(std::string folder,
     conf << "allow_anonymous false\npassword_file " << folder_ << "/passwords\n";
     std::ofstream(folder_ + "/passwords").close();
     for (const auto& [user, password] : passwords) {
-      const std::string cmd = "mosquitto_passwd -b " + folder_ + "/passwords " + user + " " +
-                              password + " 2>/dev/null";
+      const std::string cmd =
+          "mosquitto_passwd -b " + folder_ + "/passwords " + user + " " + password + " 2>/dev/null";
       if (std::system(cmd.c_str()) != 0) throw std::runtime_error("mosquitto_passwd failed");
     }
   }
@@ -73,6 +80,21 @@ void MosquittoBroker::start() {
   }
   throw std::runtime_error("mosquitto did not start on port " + std::to_string(port_) + "\n" +
                            process_->outputTail());
+}
+
+void MosquittoBroker::saveSessions() {
+  if (!process_) return;
+  const auto db = std::filesystem::path(folder_) / "mosquitto.db";
+  std::error_code ec;
+  const auto before = std::filesystem::last_write_time(db, ec);
+  process_->signal(SIGUSR1);  // mosquitto writes its persistence database
+  const auto until = std::chrono::steady_clock::now() + 5s;
+  while (std::chrono::steady_clock::now() < until) {
+    const auto now = std::filesystem::last_write_time(db, ec);
+    if (!ec && now != before) return;
+    std::this_thread::sleep_for(10ms);
+  }
+  throw std::runtime_error("mosquitto did not write " + db.string());
 }
 
 void MosquittoBroker::kill() {

@@ -20,10 +20,13 @@ namespace facet::sinks_test {
 class MosquittoBroker {
  public:
   // `passwords`: user -> password; empty = anonymous clients allowed.
-  MosquittoBroker(std::string folder, std::vector<std::pair<std::string, std::string>> passwords = {});
+  MosquittoBroker(std::string folder,
+                  std::vector<std::pair<std::string, std::string>> passwords = {});
   ~MosquittoBroker();
   // Starts the broker and waits until it accepts connections; throws when it does not.
   void start();
+  // Writes the broker's sessions to disk now (SIGUSR1): a killed broker restarts from here.
+  void saveSessions();
   void kill();  // SIGKILL: no goodbye, no final save
   void stop();  // SIGTERM
   [[nodiscard]] int port() const { return port_; }

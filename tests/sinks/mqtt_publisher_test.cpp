@@ -1,6 +1,7 @@
 // MqttPublisher against Debian's mosquitto broker, started by the test on 127.0.0.1.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <thread>
 
@@ -85,13 +86,17 @@ TEST(MqttPublisher, ResultCarriesStationRecipeValuesAndLimitsAndStatusIsRetained
 }
 
 // The run: 1,000 parts, the broker killed (SIGKILL) and restarted twice while they are
-// produced; a subscriber must see every part id exactly once and in order.
-TEST(MqttPublisher, BrokerKilledTwiceDuringThousandPartsLosesAndRepeatsNothing) {
+// produced; a subscriber must see every part id, in order, none lost; the only repeat allowed
+// is QoS 1's: the message in flight at the kill, once per outage.
+TEST(MqttPublisher, BrokerKilledTwiceDuringThousandPartsLosesNothingAndKeepsOrder) {
   daemon_test::TempDir dir;
   MosquittoBroker broker(dir.path());
   broker.start();
   MqttSubscriber subscriber("test-line", broker.port(), "facet/cam1/result");
   ASSERT_TRUE(subscriber.waitSubscribed(5s));
+  // The subscriber's persistent session is on disk: the killed broker comes back with it, and
+  // keeps for it what is published before it has reconnected.
+  broker.saveSessions();
   MqttPublisher publisher(settingsFor(broker, dir.path()), "cam1");
   publisher.start();
   ASSERT_TRUE(waitUntil([&] { return publisher.status().connected; }, 10s));
@@ -100,13 +105,20 @@ TEST(MqttPublisher, BrokerKilledTwiceDuringThousandPartsLosesAndRepeatsNothing) 
   struct Outage {
     int killAt, restartAt;
     std::uint64_t bufferedAtRestart = 0;
-    double recoverMs = 0;
+    double recoverMs = -1;  // -1: still catching up when the run went on
   };
   std::vector<Outage> outages{{250, 400}, {600, 750}};
   std::optional<std::chrono::steady_clock::time_point> restartedAt;
   Outage* recovering = nullptr;
-  double maxSubmitUs = 0;
+  std::vector<double> submitUs;
   for (int i = 1; i <= kParts; ++i) {
+    // Caught up: everything buffered during the outage has been confirmed by the broker.
+    if (recovering && publisher.status().outbox.pending == 0) {
+      recovering->recoverMs =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - *restartedAt)
+              .count();
+      recovering = nullptr;
+    }
     for (auto& o : outages) {
       if (i == o.killAt) broker.kill();
       if (i == o.restartAt) {
@@ -118,35 +130,48 @@ TEST(MqttPublisher, BrokerKilledTwiceDuringThousandPartsLosesAndRepeatsNothing) 
     }
     const auto t0 = std::chrono::steady_clock::now();
     publisher.submit(samplePart(static_cast<std::uint64_t>(i)));
-    maxSubmitUs = std::max(
-        maxSubmitUs,
+    submitUs.push_back(
         std::chrono::duration<double, std::micro>(std::chrono::steady_clock::now() - t0).count());
-    if (recovering && publisher.status().outbox.pending == 0) {
-      recovering->recoverMs = std::chrono::duration<double, std::milli>(
-                                  std::chrono::steady_clock::now() - *restartedAt)
-                                  .count();
-      recovering = nullptr;
-    }
     std::this_thread::sleep_for(2ms);
   }
   ASSERT_TRUE(subscriber.waitFor([](const auto& m) { return partIds(m).size() >= kParts; }, 60s))
       << "received " << partIds(subscriber.messages()).size() << " of " << kParts;
   std::this_thread::sleep_for(500ms);  // a duplicate would arrive now
+  // QoS 1 is at least once: the one message in flight when the broker died (sent, forwarded,
+  // its PUBACK lost with the broker) is sent again after the restart; nothing else may repeat.
+  // Every part arrives, first arrivals in order, and a repeat is the previous message again.
   const auto ids = partIds(subscriber.messages());
-  ASSERT_EQ(ids.size(), static_cast<std::size_t>(kParts));
-  for (int i = 0; i < kParts; ++i) ASSERT_EQ(ids[i], static_cast<std::uint64_t>(i + 1));
+  std::vector<std::uint64_t> first;
+  std::size_t repeats = 0;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (!first.empty() && ids[i] <= first.back()) {
+      ++repeats;
+      EXPECT_EQ(ids[i], first.back()) << "a repeat that is not the message in flight, at " << i;
+      continue;
+    }
+    first.push_back(ids[i]);
+  }
+  ASSERT_EQ(first.size(), static_cast<std::size_t>(kParts));
+  for (int i = 0; i < kParts; ++i) ASSERT_EQ(first[i], static_cast<std::uint64_t>(i + 1));
+  EXPECT_LE(repeats, outages.size());
+  std::printf("%zu parts arrived exactly once, %zu twice (in flight when the broker was killed)\n",
+              kParts - repeats, repeats);
   const auto status = publisher.status();
   EXPECT_EQ(status.outbox.dropped, 0u);
   EXPECT_EQ(status.outbox.pending, 0u);
   EXPECT_GE(status.connects, 3u);
   for (const auto& o : outages) {
     EXPECT_GT(o.bufferedAtRestart, 0u);
-    std::printf("outage parts %d-%d: %llu parts buffered on disk, all delivered %.0f ms after the "
-                "broker restarted\n",
-                o.killAt, o.restartAt, static_cast<unsigned long long>(o.bufferedAtRestart),
-                o.recoverMs);
+    std::printf("outage parts %d-%d: %llu parts buffered on disk; %s\n", o.killAt, o.restartAt,
+                static_cast<unsigned long long>(o.bufferedAtRestart),
+                o.recoverMs < 0 ? "still catching up when the next outage began"
+                                : ("caught up " + std::to_string(static_cast<int>(o.recoverMs)) +
+                                   " ms after the broker restarted")
+                                      .c_str());
   }
-  std::printf("submit() took at most %.0f us per part\n", maxSubmitUs);
+  std::sort(submitUs.begin(), submitUs.end());
+  std::printf("submit() per part: median %.0f us, p99 %.0f us, max %.0f us\n",
+              submitUs[submitUs.size() / 2], submitUs[submitUs.size() * 99 / 100], submitUs.back());
 }
 
 TEST(MqttPublisher, BrokerDownAtStartBuffersAndDeliversInOrderOnceItIsUp) {
@@ -162,9 +187,12 @@ TEST(MqttPublisher, BrokerDownAtStartBuffersAndDeliversInOrderOnceItIsUp) {
   MqttPublisher publisher(settingsFor(broker, dir.path()), "cam1");
   publisher.start();
   for (std::uint64_t i = 1; i <= 20; ++i) publisher.submit(samplePart(i));
-  ASSERT_TRUE(waitUntil([&] { return !publisher.status().lastError.empty() &&
-                                     publisher.status().lastError != "not connected yet"; },
-                        5s));
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        return !publisher.status().lastError.empty() &&
+               publisher.status().lastError != "not connected yet";
+      },
+      5s));
   const auto down = publisher.status();
   EXPECT_TRUE(down.degraded());
   EXPECT_NE(down.lastError.find("refused"), std::string::npos) << down.lastError;
@@ -188,8 +216,8 @@ TEST(MqttPublisher, WrongPasswordIsAClearErrorAndKeepsTheResults) {
   MqttPublisher publisher(settings, "cam1");
   publisher.start();
   publisher.submit(samplePart(1));
-  ASSERT_TRUE(waitUntil([&] { return publisher.status().lastError.starts_with("broker refused"); },
-                        10s))
+  ASSERT_TRUE(
+      waitUntil([&] { return publisher.status().lastError.starts_with("broker refused"); }, 10s))
       << publisher.status().lastError;
   const auto s = publisher.status();
   EXPECT_TRUE(s.degraded());

@@ -4,6 +4,8 @@
 #include <pwd.h>
 #include <unistd.h>
 
+#include <csignal>
+
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -36,7 +38,8 @@ void run(const std::vector<std::string>& argv, const std::string& log) {
   const auto rc = p.wait(120s);
   if (rc != 0) {
     std::ifstream in(log);
-    throw std::runtime_error(argv[0] + " failed:\n" + std::string(std::istreambuf_iterator<char>(in), {}));
+    throw std::runtime_error(argv[0] + " failed:\n" +
+                             std::string(std::istreambuf_iterator<char>(in), {}));
   }
 }
 
@@ -53,9 +56,7 @@ std::vector<std::string> PostgresCluster::asServerUser(std::vector<std::string> 
 PostgresCluster::PostgresCluster(const std::string& folder)
     : folder_(folder + "/pg"), bin_(serverBinaries()), port_(plc::test::freeTcpPort()) {
   std::filesystem::create_directories(folder_);
-  {
-    std::ofstream(folder_ + "/admin-password") << kAdminPassword << "\n";
-  }
+  { std::ofstream(folder_ + "/admin-password") << kAdminPassword << "\n"; }
   if (::geteuid() == 0) {
     const passwd* pw = ::getpwnam("postgres");
     if (!pw)
@@ -73,7 +74,7 @@ PostgresCluster::PostgresCluster(const std::string& folder)
   const std::string admin = "host=127.0.0.1 port=" + std::to_string(port_) +
                             " user=admin dbname=postgres password=" + kAdminPassword;
   PGconn* c = PQconnectdb(admin.c_str());
-  for (const std::string sql :
+  for (const std::string& sql :
        {std::string("CREATE ROLE station LOGIN PASSWORD '") + kPassword + "'",
         std::string("CREATE DATABASE facet OWNER station")}) {
     PGresult* r = PQexec(c, sql.c_str());

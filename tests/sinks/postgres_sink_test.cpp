@@ -104,11 +104,12 @@ TEST(PostgresSink, ServerKilledTwiceAndStationRestartedLoseAndRepeatNothing) {
   EXPECT_GT(buffered1, 0u);
   EXPECT_GT(recovered, 0u);
   EXPECT_GT(buffered2, recovered);
-  std::printf("outage 1 (parts 250-400): %llu parts buffered, all written after the restart\n"
-              "outage 2 (parts 600-800, facetd's sink restarted at 700): %llu taken over from "
-              "disk, %llu buffered at the server's restart, all written\n",
-              static_cast<unsigned long long>(buffered1), static_cast<unsigned long long>(recovered),
-              static_cast<unsigned long long>(buffered2));
+  std::printf(
+      "outage 1 (parts 250-400): %llu parts buffered, all written after the restart\n"
+      "outage 2 (parts 600-800, facetd's sink restarted at 700): %llu taken over from "
+      "disk, %llu buffered at the server's restart, all written\n",
+      static_cast<unsigned long long>(buffered1), static_cast<unsigned long long>(recovered),
+      static_cast<unsigned long long>(buffered2));
 }
 
 TEST(PostgresSink, WrongPasswordIsAClearErrorAndKeepsTheResults) {
@@ -119,8 +120,8 @@ TEST(PostgresSink, WrongPasswordIsAClearErrorAndKeepsTheResults) {
   PostgresSink sink(settings, "cam1");
   sink.start();
   sink.submit(samplePart(1));
-  ASSERT_TRUE(waitUntil(
-      [&] { return sink.status().lastError.find("password") != std::string::npos; }, 20s))
+  ASSERT_TRUE(
+      waitUntil([&] { return sink.status().lastError.find("password") != std::string::npos; }, 20s))
       << sink.status().lastError;
   const auto s = sink.status();
   EXPECT_TRUE(s.degraded());
