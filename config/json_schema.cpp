@@ -138,8 +138,8 @@ nlohmann::json jsonSchema(const ObjectSpec& root, const std::vector<StepKindSpec
   return head;
 }
 
-nlohmann::json recipeJsonSchema() {
-  const RecipeFormat& f = recipeFormat();
+nlohmann::json recipeJsonSchema(const StepKindRegistry& kinds) {
+  const RecipeFormat f(kinds);
   return jsonSchema(f.recipe, f.steps, "https://facet.invalid/schema/recipe.schema.json");
 }
 

@@ -9,13 +9,15 @@
 #include <nlohmann/json.hpp>
 
 #include "config/field_spec.hpp"
+#include "config/step_kind.hpp"
 
 namespace facet::config {
 
 nlohmann::json jsonSchema(const ObjectSpec& root, const std::vector<StepKindSpec>& stepKinds,
                           const std::string& id);
 
-nlohmann::json recipeJsonSchema();   // recipes/recipe.schema.json
+// recipes/recipe.schema.json for the step kinds of `kinds`.
+nlohmann::json recipeJsonSchema(const StepKindRegistry& kinds);
 nlohmann::json stationJsonSchema();  // recipes/station.schema.json
 
 }  // namespace facet::config

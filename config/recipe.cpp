@@ -22,24 +22,6 @@ std::vector<std::pair<const Check*, const Step*>> Recipe::plcOutputs() const {
   return out;
 }
 
-std::string_view toString(StepKind kind) {
-  switch (kind) {
-    case StepKind::Align:
-      return "align";
-    case StepKind::Fiducials:
-      return "fiducials";
-    case StepKind::Shape:
-      return "shape";
-    case StepKind::Circle:
-      return "circle";
-    case StepKind::Distance:
-      return "distance";
-    case StepKind::ScanAlign:
-      return "scan_align";
-  }
-  return "?";
-}
-
 std::string_view toString(Unit unit) {
   switch (unit) {
     case Unit::Millimetre:
@@ -50,18 +32,6 @@ std::string_view toString(Unit unit) {
       return "px";
     case Unit::None:
       return "";
-  }
-  return "?";
-}
-
-std::string_view toString(CirclePolarity polarity) {
-  switch (polarity) {
-    case CirclePolarity::DarkInside:
-      return "dark_inside";
-    case CirclePolarity::LightInside:
-      return "light_inside";
-    case CirclePolarity::Any:
-      return "any";
   }
   return "?";
 }

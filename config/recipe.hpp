@@ -28,16 +28,17 @@
 //   and y checks are millimetres, angle degrees.
 
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <string>
 #include <string_view>
-#include <variant>
 #include <vector>
 
 #include <opencv2/core/types.hpp>
 
 #include "config/diagnostic.hpp"
 #include "config/field_spec.hpp"
+#include "config/step_kind.hpp"
 #include "plc/register_map.hpp"
 
 namespace facet::config {
@@ -75,91 +76,27 @@ struct Check {
   }
 };
 
-// Grey values of a round feature compared to its surroundings.
-enum class CirclePolarity { DarkInside, LightInside, Any };
-
-struct AngleRange {
-  double low = -180.0;  // degrees
-  double high = 180.0;
-};
-
-// `align`: finds the part and gives the pose that later steps' positions follow.
-struct AlignStep {
-  enum class Method { Registration, Shape };
-  Method method = Method::Registration;
-  std::filesystem::path reference;             // reference image (registration) or template (shape)
-  std::optional<cv::Rect2d> region;            // part of the reference used; empty = all of it
-  std::optional<std::filesystem::path> model;  // trained shape model (method shape)
-  std::optional<cv::Rect2d> searchRegion;      // where to search in the live image; empty = all
-  double minScore = 0.7;                       // 0..1
-  AngleRange angleRange;
-};
-
-// `fiducials`: finds round marks near their nominal positions; reports shift and rotation.
-struct FiducialsStep {
-  std::optional<std::string> relativeTo;  // id of an earlier pose step
-  std::vector<cv::Point2d> marks;         // nominal mark centres, pixels; at least 2
-  double markDiameter = 1.0;              // mm
-  double searchRadius = 1.0;              // mm around each nominal centre
-  CirclePolarity polarity = CirclePolarity::Any;
-};
-
-// `shape`: finds a trained shape model and checks count and pose.
-struct ShapeStep {
-  std::optional<std::string> relativeTo;
-  std::filesystem::path templateImage;  // the image the model is trained from
-  std::optional<cv::Rect2d> region;     // part of the template; empty = all of it
-  std::filesystem::path model;          // trained model file, written by `facet recipe train`
-  std::optional<cv::Rect2d> searchRegion;
-  double minScore = 0.7;
-  int numMatches = 1;
-  AngleRange angleRange;
-  double maxOverlap = 0.5;
-};
-
-// `circle`: measures a circle in an annulus around its nominal position.
-struct CircleStep {
-  std::optional<std::string> relativeTo;
-  cv::Point2d centre;          // pixels of the relative_to step's reference image
-  double nominalDiameter = 0;  // mm
-  double searchWidth = 0;      // mm, width of the annulus searched around the nominal circle
-  CirclePolarity polarity = CirclePolarity::Any;
-};
-
-// `distance`: a distance or angle between the results of two earlier steps.
-struct DistanceStep {
-  enum class Measure { CentreToCentre, PointToLine, Angle };
-  Measure measure = Measure::CentreToCentre;
-  std::string from;  // step id: a point (or a line for Angle)
-  std::string to;    // step id: a point (CentreToCentre) or a line (PointToLine, Angle)
-};
-
-// `scan_align`: registers a live 2D range scan to a reference scan; reports the pose offset.
-struct ScanAlignStep {
-  enum class Method { Icp, Dcp, Idcp };
-  std::filesystem::path reference;  // CSV scan, rows "x,y" in metres
-  Method method = Method::Dcp;
-  int maxIterations = 50;
-  double maxDistance = 5.0;  // mm, correspondences farther apart are ignored
-};
-
-enum class StepKind { Align, Fiducials, Shape, Circle, Distance, ScanAlign };
-
-using StepParams =
-    std::variant<AlignStep, FiducialsStep, ShapeStep, CircleStep, DistanceStep, ScanAlignStep>;
-
+// One step of a recipe: the keys every step has, and its kind's own parameters and resources.
 struct Step {
-  std::string id;    // unique within the recipe
-  std::string name;  // for people; defaults to the id
-  StepKind kind = StepKind::Align;
-  StepParams params;
-  std::vector<Check> checks;  // in file order
+  std::string id;                                  // unique within the recipe
+  std::string name;                                // for people; defaults to the id
+  const StepKind* kind = nullptr;                  // from the registry the recipe was read with
+  std::shared_ptr<const StepParams> params;        // the kind's keys, as read (never null)
+  std::shared_ptr<const StepResources> resources;  // what the kind prepared (null: needs none)
+  std::vector<std::string> inputs;                 // ids of the earlier steps whose results it uses
+  std::vector<Check> checks;                       // in file order
   SourceLocation where;
 
+  [[nodiscard]] std::string_view kindName() const { return kind->name(); }
   [[nodiscard]] const Check* check(std::string_view checkName) const;
-  template <class T>
-  [[nodiscard]] const T& as() const {
-    return std::get<T>(params);
+  // The kind's own parameters and resources; a wrong type is a programming error (bad_cast).
+  template <class P>
+  [[nodiscard]] const P& as() const {
+    return dynamic_cast<const P&>(*params);
+  }
+  template <class R>
+  [[nodiscard]] const R& resourcesAs() const {
+    return dynamic_cast<const R&>(*resources);
   }
 };
 
@@ -183,8 +120,6 @@ struct Recipe {
   [[nodiscard]] std::vector<std::pair<const Check*, const Step*>> plcOutputs() const;
 };
 
-std::string_view toString(StepKind kind);
 std::string_view toString(Unit unit);
-std::string_view toString(CirclePolarity polarity);
 
 }  // namespace facet::config

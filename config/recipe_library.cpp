@@ -7,7 +7,8 @@
 
 namespace facet::config {
 
-RecipeLibrary::RecipeLibrary(RecipeLoadOptions options) : options_(std::move(options)) {
+RecipeLibrary::RecipeLibrary(const StepKindRegistry& kinds, RecipeLoadOptions options)
+    : kinds_(kinds), options_(std::move(options)) {
   root_ = std::filesystem::absolute(options_.root.value_or(".")).lexically_normal();
   options_.root = root_;
 }
@@ -63,7 +64,7 @@ ReloadReport RecipeLibrary::reload() {
       // A file that lost an id to another one is read again: the other one may be gone.
       if (same && !it->second.lostIdClaim) continue;
     }
-    RecipeLoadResult result = loadRecipe(file, options_);
+    RecipeLoadResult result = loadRecipe(file, kinds_, options_);
     Entry& entry = entries[file];
     entry.stamps.clear();
     for (const auto& f : result.files) entry.stamps[f] = stamp(f);

@@ -35,8 +35,9 @@ struct ReloadReport {
 
 class RecipeLibrary {
  public:
-  // `options.root` is the recipes folder (required).
-  explicit RecipeLibrary(RecipeLoadOptions options);
+  // `options.root` is the recipes folder (required); recipes may use the step kinds of `kinds`,
+  // which must outlive the library.
+  RecipeLibrary(const StepKindRegistry& kinds, RecipeLoadOptions options);
 
   // Reads new and changed recipe files (and those whose images or models changed). Files that
   // did not change since the last reload are not read again.
@@ -75,6 +76,7 @@ class RecipeLibrary {
   static FileStamp stamp(const std::filesystem::path& file);
   std::vector<std::filesystem::path> recipeFiles() const;
 
+  const StepKindRegistry& kinds_;
   RecipeLoadOptions options_;
   std::filesystem::path root_;
   std::mutex reloadMutex_;                          // one reload at a time

@@ -10,6 +10,7 @@
 
 #include "config/diagnostic.hpp"
 #include "config/recipe.hpp"
+#include "config/step_kind.hpp"
 
 namespace facet::config {
 
@@ -45,7 +46,8 @@ struct RecipeLoadResult {
   SourceLocation idWhere;
 };
 
-RecipeLoadResult loadRecipe(const std::filesystem::path& file,
+// Reads, validates and prepares (step_kind.hpp) the recipe; its steps are of the kinds in `kinds`.
+RecipeLoadResult loadRecipe(const std::filesystem::path& file, const StepKindRegistry& kinds,
                             const RecipeLoadOptions& options = {});
 
 // Reports every pair of overlapping register uses once, at the later non-reserved one, and uses

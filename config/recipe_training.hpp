@@ -1,10 +1,9 @@
 #pragma once
-// `facet recipe train`: creates the shape models a recipe needs (its `align` steps with method
-// shape and its `shape` steps) from their template images, writes them where the recipe says,
-// and records beside each model what it was trained from (training_record.hpp), so that a
-// model gone stale is noticed when the recipe is loaded.
-//
-// Registration references and reference scans are used as they are and need no training.
+// `facet recipe train`: every step whose kind has a model (shape models of `align` with method
+// shape and of `shape`) trains it from its template image, writes it where the recipe says, and
+// records beside it what it was trained from (training_record.hpp), so that a model gone stale
+// is noticed when the recipe is loaded. Registration references and reference scans are used as
+// they are and need no training.
 
 #include <filesystem>
 #include <stdexcept>
@@ -14,13 +13,6 @@
 #include "config/recipe.hpp"
 
 namespace facet::config {
-
-struct TrainedModel {
-  std::string stepId;
-  std::filesystem::path model;  // absolute
-  int numLevels = 0;            // pyramid levels of the model
-  std::size_t points = 0;       // model points on level 0
-};
 
 // Bad template (no edges, unreadable) or unwritable model file; what() names the step and file.
 struct TrainingError : std::runtime_error {

@@ -7,8 +7,6 @@
 #include <nlohmann/json.hpp>
 
 #include "config/content_hash.hpp"
-#include "config/recipe.hpp"
-#include "config/yaml_validation.hpp"
 
 namespace facet::config {
 namespace {
@@ -20,28 +18,10 @@ bool isFile(const std::filesystem::path& p) {
   return std::filesystem::is_regular_file(p, ec);
 }
 
-std::string rectText(const std::optional<cv::Rect2d>& r) {
-  if (!r) return "all";
-  return formatNumber(r->x) + "," + formatNumber(r->y) + "," + formatNumber(r->width) + "," +
-         formatNumber(r->height);
-}
-
-std::string rangeText(const AngleRange& a) {
-  return formatNumber(a.low) + "," + formatNumber(a.high);
-}
-
 }  // namespace
 
 std::filesystem::path trainingRecordPath(const std::filesystem::path& model) {
   return model.string() + ".train.json";
-}
-
-std::string trainingParameters(const Step& step) {
-  if (const auto* a = std::get_if<AlignStep>(&step.params))
-    return "shape;region=" + rectText(a->region) + ";angle=" + rangeText(a->angleRange);
-  if (const auto* s = std::get_if<ShapeStep>(&step.params))
-    return "shape;region=" + rectText(s->region) + ";angle=" + rangeText(s->angleRange);
-  return {};
 }
 
 ModelStatus modelStatus(const std::filesystem::path& model, const std::filesystem::path& source,

@@ -10,8 +10,6 @@
 
 namespace facet::config {
 
-struct Step;
-
 enum class ModelState {
   Missing,    // no model file
   Untracked,  // a model file without a readable training record
@@ -26,9 +24,7 @@ struct ModelStatus {
 
 std::filesystem::path trainingRecordPath(const std::filesystem::path& model);
 
-// The training parameters of an align (method shape) or shape step, as canonical text.
-std::string trainingParameters(const Step& step);
-
+// `parameters`: the training parameters as canonical text (what changes the model when changed).
 ModelStatus modelStatus(const std::filesystem::path& model, const std::filesystem::path& source,
                         const std::string& parameters);
 

@@ -75,6 +75,32 @@ std::optional<bool> readBoolean(const YAML::Node& node) {
   return std::nullopt;
 }
 
+std::optional<cv::Point2d> readPoint(const YAML::Node& node) {
+  if (!node || !node.IsSequence() || node.size() != 2) return std::nullopt;
+  const auto x = readNumber(node[0]), y = readNumber(node[1]);
+  if (!x || !y) return std::nullopt;
+  return cv::Point2d(*x, *y);
+}
+
+std::optional<cv::Rect2d> readRect(const YAML::Node& node) {
+  if (!node || !node.IsSequence() || node.size() != 4) return std::nullopt;
+  double v[4];
+  for (std::size_t i = 0; i < 4; ++i) {
+    const auto x = readNumber(node[i]);
+    if (!x) return std::nullopt;
+    v[i] = *x;
+  }
+  if (v[2] <= 0 || v[3] <= 0) return std::nullopt;
+  return cv::Rect2d(v[0], v[1], v[2], v[3]);
+}
+
+std::optional<std::pair<double, double>> readRange(const YAML::Node& node) {
+  if (!node || !node.IsSequence() || node.size() != 2) return std::nullopt;
+  const auto low = readNumber(node[0]), high = readNumber(node[1]);
+  if (!low || !high) return std::nullopt;
+  return std::pair{*low, *high};
+}
+
 std::optional<std::string> readString(const YAML::Node& node) {
   if (!node || !node.IsScalar()) return std::nullopt;
   return node.Scalar();

@@ -8,6 +8,7 @@
 #include <string>
 
 #include <yaml-cpp/yaml.h>
+#include <opencv2/core/types.hpp>
 
 #include "config/diagnostic.hpp"
 
@@ -30,6 +31,10 @@ std::optional<long long> readInteger(const YAML::Node& node);
 std::optional<double> readNumber(const YAML::Node& node);
 std::optional<bool> readBoolean(const YAML::Node& node);
 std::optional<std::string> readString(const YAML::Node& node);  // any scalar
+// [x, y]; [x, y, width, height] with width, height > 0; [low, high].
+std::optional<cv::Point2d> readPoint(const YAML::Node& node);
+std::optional<cv::Rect2d> readRect(const YAML::Node& node);
+std::optional<std::pair<double, double>> readRange(const YAML::Node& node);
 
 // How a node looks, for "must be a number, not <describe>" messages.
 std::string describe(const YAML::Node& node);

@@ -48,6 +48,7 @@
 #include "config/station_config.hpp"
 #include "plc/plc_simulator.hpp"
 #include "service/daemon/station.hpp"
+#include "service/engine/builtin_steps.hpp"
 
 namespace {
 
@@ -159,6 +160,11 @@ fs::path writeStation(const fs::path& dir, const fs::path& frames, int plcPort,
     << "\n  quota_mb: 20\n  keep: fail\nhttp:\n  bind: 127.0.0.1\n  port: 0\n"
     << "calibration:\n  file: " << (kSource / "recipes/calibration.yaml").string() << "\n";
   return dir / "station.yaml";
+}
+
+const config::StepKindRegistry& facetSteps() {
+  static const config::StepKindRegistry kinds = service::builtinSteps();
+  return kinds;
 }
 
 config::StationConfig loadStation(const fs::path& file) {
@@ -295,7 +301,7 @@ Latency measureLatency(const fs::path& dir, const fs::path& frames, const std::s
     std::lock_guard lock(mutex);
     addSteps(p, out.split);
   };
-  service::Station s(station, options);
+  service::Station s(station, facetSteps(), options);
   s.start();
   double cpu0 = 0;
   std::map<std::string, std::pair<double, double>> afterWarmUp;
@@ -354,7 +360,7 @@ FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, const std::s
       out.rss.push_back(rssKb());
     }
   };
-  service::Station s(station, options);
+  service::Station s(station, facetSteps(), options);
   s.start();
   const auto t0 = Clock::now();
   const double cpu0 = cpuSeconds();

@@ -36,6 +36,8 @@
 #include "service/batch/batch_replay.hpp"
 #include "service/daemon/part_origin.hpp"
 #include "service/daemon/station.hpp"
+#include "service/engine/builtin_steps.hpp"
+#include "service/engine/inspect_part.hpp"
 #include "service/sinks/fleet_publishers.hpp"
 #include "tests/sinks/mosquitto_broker.hpp"
 #include "tests/sinks/postgres_cluster.hpp"
@@ -136,8 +138,9 @@ std::vector<double> latencyRun(const fs::path& dir, Sinks sinks, const Peers& pe
   service::StationOptions options;
   options.onPart = [&](const service::PartResult& p) { fleet.submit(p); };
   std::vector<double> ms;
+  const auto kinds = service::builtinSteps();  // the station keeps a reference
   {
-    service::Station s(station, options);
+    service::Station s(station, kinds, options);
     s.start();
     for (int i = -5; i < triggers; ++i) {  // 5 warm-up parts while the PLC link connects
       std::unique_lock lock(mutex);
@@ -177,12 +180,13 @@ struct ReplayRate {
 // `shards` threads each taking its shard.
 ReplayRate replayRate(const std::string& recipeName, int passes, int shards) {
   const auto station = config::loadStationConfig(kSource / "recipes/station.yaml").station;
-  const auto loaded = config::loadRecipe(kSource / "recipes" / (recipeName + ".recipe.yaml"),
+  const auto kinds = service::builtinSteps();
+  const auto loaded = config::loadRecipe(kSource / "recipes" / (recipeName + ".recipe.yaml"), kinds,
                                          station->recipeLoadOptions());
   if (!loaded.recipe) throw std::runtime_error(loaded.diagnostics.text());
   auto recipe = std::make_shared<const config::Recipe>(*loaded.recipe);
-  const service::RecipeInspection inspection(recipe, station->calibration.mmPerPixel);
-  const bool scans = service::scanRecipe(*recipe);
+  const auto prepared = service::prepareRecipe(recipe, station->calibration);
+  const bool scans = service::scanRecipe(*prepared);
   const fs::path folder = kSource / "recipes/demo" / recipeName;
   const auto sidecars = SidecarMetadata::loadFolder(folder);
   ReplayRate r{recipeName};
@@ -191,7 +195,7 @@ ReplayRate replayRate(const std::string& recipeName, int passes, int shards) {
   double cpu0 = cpuSeconds(CLOCK_PROCESS_CPUTIME_ID);
   for (int p = 0; p < passes; ++p)
     for (const auto& part : all)
-      (void)service::inspectRecordedPart(inspection, part, sidecars, scans);
+      (void)service::inspectRecordedPart(*prepared, part, sidecars, scans);
   r.images = static_cast<int>(all.size()) * passes;
   r.batchPerCpuS = r.images / (cpuSeconds(CLOCK_PROCESS_CPUTIME_ID) - cpu0);
 
@@ -213,7 +217,8 @@ ReplayRate replayRate(const std::string& recipeName, int passes, int shards) {
         if (grab.status == GrabStatus::EndOfStream || !grab.ok()) break;
         service::PartResult part;
         service::recordPartOrigin(part, recipe.get(), grab.frame);
-        service::recordOutcome(part, inspection.inspect({.image = grab.frame.image, .scan = {}}));
+        service::recordOutcome(
+            part, service::inspectPart({.image = grab.frame.image, .scan = {}}, *prepared));
         ++n;
       }
       camera->stop();
@@ -229,7 +234,7 @@ ReplayRate replayRate(const std::string& recipeName, int passes, int shards) {
       const auto share = service::listShare(folder, "", scans, {s, shards});
       for (int p = 0; p < passes; ++p)
         for (const auto& part : share)
-          (void)service::inspectRecordedPart(inspection, part, sidecars, scans);
+          (void)service::inspectRecordedPart(*prepared, part, sidecars, scans);
     });
   for (auto& t : threads) t.join();
   r.shardsPerS = r.images / std::chrono::duration<double>(Clock::now() - t0).count();

@@ -37,13 +37,7 @@ std::vector<RecordedPart> listShare(const std::filesystem::path& folder, const s
   return share;
 }
 
-bool scanRecipe(const config::Recipe& recipe) {
-  return !recipe.steps.empty() &&
-         std::all_of(recipe.steps.begin(), recipe.steps.end(),
-                     [](const auto& s) { return s.kind == config::StepKind::ScanAlign; });
-}
-
-PartResult inspectRecordedPart(const RecipeInspection& inspection, const RecordedPart& part,
+PartResult inspectRecordedPart(const PreparedRecipe& recipe, const RecordedPart& part,
                                const SidecarMetadata& sidecars, bool scan) {
   PartResult p;
   p.partId = part.partId;
@@ -53,8 +47,8 @@ PartResult inspectRecordedPart(const RecipeInspection& inspection, const Recorde
   frame.source = part.file.string();
   std::string sidecarError;
   frame.metadata = sidecars.forImage(part.file, &sidecarError);
-  recordPartOrigin(p, &inspection.recipe(), frame);
-  InspectionInput input;
+  recordPartOrigin(p, &recipe.recipe(), frame);
+  PartInput input;
   try {
     if (scan) {
       input.scan = scan::readScanCsvFile(part.file.string());
@@ -72,7 +66,7 @@ PartResult inspectRecordedPart(const RecipeInspection& inspection, const Recorde
     p.error = "not inspected: " + part.file.string() + ": " + e.what();
     return p;
   }
-  recordOutcome(p, inspection.inspect(input));
+  recordOutcome(p, inspectPart(input, recipe));
   return p;
 }
 

@@ -13,8 +13,8 @@
 
 #include "camera/sidecar_metadata.hpp"
 #include "service/batch/shard.hpp"
-#include "service/daemon/inspection.hpp"
-#include "service/daemon/part_result.hpp"
+#include "service/engine/inspect_part.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::service {
 
@@ -29,12 +29,14 @@ struct RecordedPart {
 std::vector<RecordedPart> listShare(const std::filesystem::path& folder, const std::string& glob,
                                     bool scans, const Shard& shard);
 
-// True when every step of the recipe works on range scans (no image needed).
-bool scanRecipe(const config::Recipe& recipe);
+// True when no step of the recipe needs the camera image: its recorded parts are range scans.
+inline bool scanRecipe(const PreparedRecipe& recipe) {
+  return !recipe.needsImage;
+}
 
 // Reads and inspects one recorded part. Never throws: a file that cannot be read is a part with
 // Verdict::Error naming the cause (never a good part).
-PartResult inspectRecordedPart(const RecipeInspection& inspection, const RecordedPart& part,
+PartResult inspectRecordedPart(const PreparedRecipe& recipe, const RecordedPart& part,
                                const SidecarMetadata& sidecars, bool scan);
 
 }  // namespace facet::service

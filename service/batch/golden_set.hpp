@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "camera/sidecar_metadata.hpp"
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::service {
 

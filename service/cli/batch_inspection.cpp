@@ -6,30 +6,30 @@
 
 namespace facet::cli {
 
-PreparedRecipe prepareRecipe(const std::string& recipeFile, const std::string& stationFile,
-                             double mmPerPixel) {
+std::shared_ptr<const service::PreparedRecipe> loadRecipeForBatch(
+    const std::string& recipeFile, const std::string& stationFile, double mmPerPixel,
+    const config::StepKindRegistry& kinds) {
   config::RecipeLoadOptions loadOptions;
+  config::Calibration calibration;
   if (!stationFile.empty()) {
     const auto station = config::loadStationConfig(stationFile);
     if (!station.station)
       throw InputError(station.diagnostics.text() + stationFile + ": station config has errors");
     loadOptions = station.station->recipeLoadOptions();
-    if (mmPerPixel <= 0) mmPerPixel = station.station->calibration.mmPerPixel;
+    calibration = station.station->calibration;
   }
-  if (mmPerPixel <= 0)
+  if (mmPerPixel > 0) calibration.mmPerPixel = mmPerPixel;
+  if (calibration.mmPerPixel <= 0)
     throw InputError("give --station (for its calibration) or --mm-per-pixel > 0");
-  const auto loaded = config::loadRecipe(recipeFile, loadOptions);
+  const auto loaded = config::loadRecipe(recipeFile, kinds, loadOptions);
   if (!loaded.recipe)
     throw InputError(loaded.diagnostics.text() + recipeFile + ": recipe has errors");
-  PreparedRecipe prepared;
-  prepared.recipe = std::make_shared<const config::Recipe>(*loaded.recipe);
-  prepared.mmPerPixel = mmPerPixel;
   try {
-    prepared.inspection = std::make_unique<service::RecipeInspection>(prepared.recipe, mmPerPixel);
+    return service::prepareRecipe(std::make_shared<const config::Recipe>(*loaded.recipe),
+                                  calibration);
   } catch (const service::InspectionSetupError& e) {
     throw InputError(recipeFile + ": " + e.what());
   }
-  return prepared;
 }
 
 }  // namespace facet::cli

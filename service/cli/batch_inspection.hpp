@@ -6,19 +6,14 @@
 #include <memory>
 #include <string>
 
-#include "config/recipe.hpp"
-#include "service/daemon/inspection.hpp"
+#include "config/step_kind.hpp"
+#include "service/engine/inspect_part.hpp"
 
 namespace facet::cli {
 
-struct PreparedRecipe {
-  std::shared_ptr<const config::Recipe> recipe;
-  std::unique_ptr<service::RecipeInspection> inspection;
-  double mmPerPixel = 0;
-};
-
 // Throws InputError naming the file when the station, the recipe or its resources are bad.
-PreparedRecipe prepareRecipe(const std::string& recipeFile, const std::string& stationFile,
-                             double mmPerPixel);
+std::shared_ptr<const service::PreparedRecipe> loadRecipeForBatch(
+    const std::string& recipeFile, const std::string& stationFile, double mmPerPixel,
+    const config::StepKindRegistry& kinds);
 
 }  // namespace facet::cli

@@ -13,6 +13,8 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "config/step_kind.hpp"
+
 namespace facet::cli {
 
 struct InputError : std::runtime_error {
@@ -39,8 +41,10 @@ void addEdgesCommand(CLI::App& app);
 void addModelCommand(CLI::App& app);
 void addMatchCommand(CLI::App& app);
 void addRegisterCommand(CLI::App& app);
-void addRecipeCommand(CLI::App& app);
-void addReplayCommand(CLI::App& app);
-void addValidateCommand(CLI::App& app);
+void addRecipeCommand(CLI::App& app, const config::StepKindRegistry& kinds);
+// The whole program (main.cpp), for the step kinds its recipes may use.
+int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds);
+void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds);
+void addValidateCommand(CLI::App& app, const config::StepKindRegistry& kinds);
 
 }  // namespace facet::cli

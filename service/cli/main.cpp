@@ -1,5 +1,7 @@
 // facet: the command-line tool. Runs facet's algorithms one image at a time, trains models,
 // checks recipes and replays folders. See command_line.hpp for the output conventions.
+// runFacet() is the whole program for a set of step kinds; facet_main.cpp runs it with facet's
+// own (a test adds a kind of its own).
 #include <iostream>
 
 #include "service/cli/command_line.hpp"
@@ -10,10 +12,7 @@ void printJson(const nlohmann::json& object) {
   std::cout << object.dump() << std::endl;
 }
 
-}  // namespace facet::cli
-
-int main(int argc, char** argv) {
-  using namespace facet::cli;
+int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds) {
   CLI::App app{"facet: machine-vision inspection tool", "facet"};
   app.require_subcommand(1);
   addVersionCommand(app);
@@ -25,9 +24,9 @@ int main(int argc, char** argv) {
   addModelCommand(app);
   addMatchCommand(app);
   addRegisterCommand(app);
-  addRecipeCommand(app);
-  addReplayCommand(app);
-  addValidateCommand(app);
+  addRecipeCommand(app, kinds);
+  addReplayCommand(app, kinds);
+  addValidateCommand(app, kinds);
 
   bool jsonWanted = false;
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
@@ -47,3 +46,5 @@ int main(int argc, char** argv) {
   }
   return 0;
 }
+
+}  // namespace facet::cli

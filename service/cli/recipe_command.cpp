@@ -71,7 +71,7 @@ std::vector<std::filesystem::path> recipeFiles(
   return files;
 }
 
-void check(const Options& opt) {
+void check(const Options& opt, const config::StepKindRegistry& kinds) {
   Diagnostics all;
   std::optional<config::StationConfig> station;
   const auto options = loadOptions(opt, all, station);
@@ -86,7 +86,7 @@ void check(const Options& opt) {
   nlohmann::json results = nlohmann::json::array();
   std::map<int, std::filesystem::path> ids;  // recipe ids are unique across the files checked
   for (const auto& file : files) {
-    auto loaded = config::loadRecipe(file, options);
+    auto loaded = config::loadRecipe(file, kinds, options);
     if (loaded.id > 0) {
       const auto [it, first] = ids.emplace(loaded.id, file);
       if (!first) {
@@ -137,7 +137,7 @@ void check(const Options& opt) {
                      " recipe file(s)" + (opt.station.empty() ? "" : " and the station file"));
 }
 
-void train(const Options& opt) {
+void train(const Options& opt, const config::StepKindRegistry& kinds) {
   Diagnostics all;
   std::optional<config::StationConfig> station;
   auto options = loadOptions(opt, all, station);
@@ -145,7 +145,7 @@ void train(const Options& opt) {
   if (all.hasErrors()) throw InputError("the station file has errors:\n" + all.text());
   nlohmann::json trainedJson = nlohmann::json::array();
   for (const auto& file : recipeFiles(opt, station)) {
-    const auto loaded = config::loadRecipe(file, options);
+    const auto loaded = config::loadRecipe(file, kinds, options);
     if (!loaded.recipe)
       throw InputError(file.string() + " has errors; nothing trained:\n" +
                        loaded.diagnostics.text());
@@ -169,7 +169,7 @@ void train(const Options& opt) {
 
 }  // namespace
 
-void addRecipeCommand(CLI::App& app) {
+void addRecipeCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
   auto* recipe = app.add_subcommand("recipe", "Check, train and describe recipe files");
   recipe->require_subcommand(1);
 
@@ -183,7 +183,7 @@ void addRecipeCommand(CLI::App& app) {
   checkCmd->add_option("--root", opt->root,
                        "Recipes folder paths must stay inside (default: the recipe's folder)");
   checkCmd->add_flag("--json", opt->json, "Print one JSON object");
-  checkCmd->callback([opt] { check(*opt); });
+  checkCmd->callback([opt, &kinds] { check(*opt, kinds); });
 
   auto* trainCmd = recipe->add_subcommand(
       "train", "Create the shape models a recipe needs, with a record of what they came from");
@@ -191,7 +191,7 @@ void addRecipeCommand(CLI::App& app) {
   trainCmd->add_option("--station", opt->station, "Station file");
   trainCmd->add_option("--root", opt->root, "Recipes folder");
   trainCmd->add_flag("--json", opt->json, "Print one JSON object");
-  trainCmd->callback([opt] { train(*opt); });
+  trainCmd->callback([opt, &kinds] { train(*opt, kinds); });
 
   auto kind = std::make_shared<std::string>("recipe");
   auto output = std::make_shared<std::string>();
@@ -200,9 +200,9 @@ void addRecipeCommand(CLI::App& app) {
   schemaCmd->add_option("kind", *kind, "recipe or station")
       ->check(CLI::IsMember({"recipe", "station"}));
   schemaCmd->add_option("--output,-o", *output, "Write to this file instead of stdout");
-  schemaCmd->callback([kind, output] {
+  schemaCmd->callback([kind, output, &kinds] {
     const auto schema =
-        *kind == "station" ? config::stationJsonSchema() : config::recipeJsonSchema();
+        *kind == "station" ? config::stationJsonSchema() : config::recipeJsonSchema(kinds);
     if (output->empty()) {
       std::cout << schema.dump(2) << "\n";
       return;

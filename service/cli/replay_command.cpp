@@ -17,11 +17,11 @@
 #include "config/station_config.hpp"
 #include "service/cli/command_line.hpp"
 #include "service/cli/replay_shard.hpp"
-#include "service/daemon/inspection.hpp"
-#include "service/daemon/overlay.hpp"
 #include "service/daemon/part_origin.hpp"
 #include "service/daemon/process_capability.hpp"
 #include "service/daemon/replay_report.hpp"
+#include "service/engine/inspect_part.hpp"
+#include "service/engine/overlay.hpp"
 
 namespace facet::cli {
 namespace {
@@ -61,12 +61,13 @@ std::vector<unsigned char> thumbnail(const cv::Mat& image, const service::Inspec
   return png;
 }
 
-void runReplay(const ReplayOptions& opt) {
+void runReplay(const ReplayOptions& opt, const config::StepKindRegistry& kinds) {
   // The camera module logs through spdlog, whose default logger writes to stdout: keep stdout
   // for the one JSON object.
   spdlog::set_default_logger(spdlog::stderr_color_mt("facet-replay"));
   // Calibration and recipe root come from the station when one is given.
   config::RecipeLoadOptions loadOptions;
+  config::Calibration calibration;
   double mmPerPixel = opt.mmPerPixel;
   if (!opt.stationFile.empty()) {
     const auto station = config::loadStationConfig(opt.stationFile);
@@ -74,17 +75,19 @@ void runReplay(const ReplayOptions& opt) {
       throw InputError(station.diagnostics.text() + opt.stationFile +
                        ": station config has errors");
     loadOptions = station.station->recipeLoadOptions();
+    calibration = station.station->calibration;
     if (mmPerPixel <= 0) mmPerPixel = station.station->calibration.mmPerPixel;
   }
   if (mmPerPixel <= 0)
     throw InputError("replay: give --station (for its calibration) or --mm-per-pixel > 0");
-  const auto loaded = config::loadRecipe(opt.recipeFile, loadOptions);
+  calibration.mmPerPixel = mmPerPixel;
+  const auto loaded = config::loadRecipe(opt.recipeFile, kinds, loadOptions);
   if (!loaded.recipe)
     throw InputError(loaded.diagnostics.text() + opt.recipeFile + ": recipe has errors");
-  std::unique_ptr<service::RecipeInspection> inspection;
+  std::shared_ptr<const service::PreparedRecipe> recipe;
   try {
-    inspection = std::make_unique<service::RecipeInspection>(
-        std::make_shared<const config::Recipe>(*loaded.recipe), mmPerPixel);
+    recipe =
+        service::prepareRecipe(std::make_shared<const config::Recipe>(*loaded.recipe), calibration);
   } catch (const service::InspectionSetupError& e) {
     throw InputError(opt.recipeFile + ": " + e.what());
   }
@@ -130,7 +133,8 @@ void runReplay(const ReplayOptions& opt) {
       report.parts.push_back(std::move(part));
       continue;
     }
-    const auto outcome = inspection->inspect({.image = grab.frame.image, .scan = std::nullopt});
+    const auto outcome =
+        service::inspectPart({.image = grab.frame.image, .scan = std::nullopt}, *recipe);
     service::recordOutcome(p, outcome);
     if (p.verdict != service::Verdict::Pass) {
       std::string banner = std::string(service::verdictName(p.verdict)) + "  " + p.serial;
@@ -180,7 +184,7 @@ void runReplay(const ReplayOptions& opt) {
 
 }  // namespace
 
-void addReplayCommand(CLI::App& app) {
+void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
   auto opt = std::make_shared<ReplayOptions>();
   auto* cmd =
       app.add_subcommand("replay", "Run a recipe over a recorded folder and write an HTML report");
@@ -202,7 +206,7 @@ void addReplayCommand(CLI::App& app) {
   cmd->add_option("--thumbnail-width", opt->thumbnailWidth, "Width of failed-part thumbnails, px")
       ->check(CLI::Range(32, 4096));
   cmd->add_flag("--json", opt->json, "Print a summary as one JSON object");
-  cmd->callback([opt] {
+  cmd->callback([opt, &kinds] {
     if (!opt->resultsFile.empty() || !opt->shard.empty()) {
       if (opt->resultsFile.empty()) throw InputError("replay --shard: give --results FILE.db");
       if (!opt->reportFile.empty())
@@ -214,11 +218,12 @@ void addReplayCommand(CLI::App& app) {
                         .glob = opt->glob,
                         .shard = opt->shard,
                         .resultsFile = opt->resultsFile,
-                        .json = opt->json});
+                        .json = opt->json},
+                       kinds);
       return;
     }
     if (opt->reportFile.empty()) throw InputError("replay: give --report FILE.html or --results");
-    runReplay(*opt);
+    runReplay(*opt, kinds);
   });
 }
 

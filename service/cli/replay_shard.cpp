@@ -14,7 +14,7 @@
 
 namespace facet::cli {
 
-void runShardedReplay(const ShardedReplayOptions& opt) {
+void runShardedReplay(const ShardedReplayOptions& opt, const config::StepKindRegistry& kinds) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("facet-replay-shard"));
   service::Shard shard;
   try {
@@ -25,8 +25,8 @@ void runShardedReplay(const ShardedReplayOptions& opt) {
   } catch (const std::invalid_argument& e) {
     throw InputError(std::string("--shard: ") + e.what());
   }
-  const auto prepared = prepareRecipe(opt.recipeFile, opt.stationFile, opt.mmPerPixel);
-  const bool scans = service::scanRecipe(*prepared.recipe);
+  const auto recipe = loadRecipeForBatch(opt.recipeFile, opt.stationFile, opt.mmPerPixel, kinds);
+  const bool scans = service::scanRecipe(*recipe);
   std::vector<service::RecordedPart> share;
   try {
     share = service::listShare(opt.imagesFolder, opt.glob, scans, shard);
@@ -45,7 +45,7 @@ void runShardedReplay(const ShardedReplayOptions& opt) {
   std::map<std::string, int> counts{{"pass", 0}, {"fail", 0}, {"error", 0}};
   const auto t0 = std::chrono::steady_clock::now();
   for (const auto& part : share) {
-    const auto result = service::inspectRecordedPart(*prepared.inspection, part, sidecars, scans);
+    const auto result = service::inspectRecordedPart(*recipe, part, sidecars, scans);
     store->store(result);
     ++counts[service::verdictName(result.verdict)];
   }

@@ -5,6 +5,8 @@
 
 #include <string>
 
+#include "config/step_kind.hpp"
+
 namespace facet::cli {
 
 struct ShardedReplayOptions {
@@ -18,6 +20,6 @@ struct ShardedReplayOptions {
   bool json = false;
 };
 
-void runShardedReplay(const ShardedReplayOptions& options);
+void runShardedReplay(const ShardedReplayOptions& options, const config::StepKindRegistry& kinds);
 
 }  // namespace facet::cli

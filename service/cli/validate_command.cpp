@@ -45,10 +45,10 @@ void printTable(const std::vector<service::GoldenMismatch>& rows) {
   for (const auto& r : rows) line({r.file, r.serial, r.check, r.expected, r.got});
 }
 
-void runValidate(const ValidateOptions& opt) {
+void runValidate(const ValidateOptions& opt, const config::StepKindRegistry& kinds) {
   spdlog::set_default_logger(spdlog::stderr_color_mt("facet-validate"));
-  const auto prepared = prepareRecipe(opt.recipeFile, opt.stationFile, opt.mmPerPixel);
-  const bool scans = service::scanRecipe(*prepared.recipe);
+  const auto prepared = loadRecipeForBatch(opt.recipeFile, opt.stationFile, opt.mmPerPixel, kinds);
+  const bool scans = service::scanRecipe(*prepared);
   std::vector<service::RecordedPart> parts;
   SidecarMetadata sidecars;
   try {
@@ -63,14 +63,14 @@ void runValidate(const ValidateOptions& opt) {
   std::vector<service::GoldenMismatch> mismatches;
   std::size_t matching = 0;
   for (const auto& part : parts) {
-    const auto result = service::inspectRecordedPart(*prepared.inspection, part, sidecars, scans);
+    const auto result = service::inspectRecordedPart(*prepared, part, sidecars, scans);
     const auto found = service::compareWithGolden(result, sidecars.forImage(part.file));
     matching += found.empty() ? 1 : 0;
     mismatches.insert(mismatches.end(), found.begin(), found.end());
   }
-  const std::string title = "recipe " + std::to_string(prepared.recipe->id) + " " +
-                            prepared.recipe->name + " (version " +
-                            prepared.recipe->contentHash.substr(0, 12) + ")";
+  const std::string title = "recipe " + std::to_string(prepared->recipe().id) + " " +
+                            prepared->recipe().name + " (version " +
+                            prepared->recipe().contentHash.substr(0, 12) + ")";
   if (opt.json) {
     nlohmann::json rows = nlohmann::json::array();
     for (const auto& m : mismatches)
@@ -80,9 +80,9 @@ void runValidate(const ValidateOptions& opt) {
                       {"expected", m.expected},
                       {"got", m.got}});
     printJson({{"recipe",
-                {{"id", prepared.recipe->id},
-                 {"name", prepared.recipe->name},
-                 {"version", prepared.recipe->contentHash}}},
+                {{"id", prepared->recipe().id},
+                 {"name", prepared->recipe().name},
+                 {"version", prepared->recipe().contentHash}}},
                {"golden", opt.goldenFolder},
                {"parts", parts.size()},
                {"matching", matching},
@@ -98,7 +98,7 @@ void runValidate(const ValidateOptions& opt) {
 
 }  // namespace
 
-void addValidateCommand(CLI::App& app) {
+void addValidateCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
   auto opt = std::make_shared<ValidateOptions>();
   auto* cmd = app.add_subcommand(
       "validate",
@@ -115,7 +115,7 @@ void addValidateCommand(CLI::App& app) {
                   "Calibration when no station is given (overrides the station's)");
   cmd->add_option("--glob", opt->glob, "File-name pattern in the folder (default: every image)");
   cmd->add_flag("--json", opt->json, "Print the result as one JSON object");
-  cmd->callback([opt] { runValidate(*opt); });
+  cmd->callback([opt, &kinds] { runValidate(*opt, kinds); });
 }
 
 }  // namespace facet::cli

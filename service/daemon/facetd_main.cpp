@@ -1,6 +1,7 @@
 // facetd: the inspection daemon. See station.hpp for the stages and http_server.hpp for the
 // HTTP endpoints. Signals: SIGHUP reloads the recipes; SIGTERM/SIGINT finish the parts in
-// progress, flush the results and exit 0.
+// progress, flush the results and exit 0. runFacetd() is the whole program for a set of step
+// kinds; facetd.cpp runs it with facet's own (a test adds a kind of its own).
 #include <csignal>
 #include <fstream>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include <spdlog/spdlog.h>
 #include <CLI/CLI.hpp>
 
+#include "service/daemon/facetd_main.hpp"
 #include "service/daemon/http_server.hpp"
 #include "service/daemon/station.hpp"
 #include "service/daemon/systemd_notifier.hpp"
@@ -59,7 +61,7 @@ void useReplay(config::StationConfig& station, const std::filesystem::path& fold
 
 }  // namespace
 
-int main(int argc, char** argv) {
+int facet::service::runFacetd(int argc, char** argv, const config::StepKindRegistry& kinds) {
   CLI::App app{"facetd: the facet inspection daemon", "facetd"};
   std::string configFile, logLevel = "info", portFile, replayFolder;
   std::optional<int> recipe;
@@ -132,7 +134,7 @@ int main(int argc, char** argv) {
     };
   }
   try {
-    service::Station station(stationConfig, options);
+    service::Station station(stationConfig, kinds, options);
     const auto& httpConfig = station.config().http;
     service::FleetStationView view(station, *fleet, station.metrics());
     service::HttpServer http(view, {.bindAddress = httpConfig.bind,

@@ -13,7 +13,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::service {
 

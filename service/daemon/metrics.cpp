@@ -125,4 +125,9 @@ std::string MetricsRegistry::exposition() const {
   return out.str();
 }
 
+Histogram& stageLatency(MetricsRegistry& metrics, const std::string& stage) {
+  return metrics.histogram("facet_stage_ms", "Latency per stage", latencyBucketsMs(),
+                           "stage=\"" + stage + "\"");
+}
+
 }  // namespace facet::service

@@ -75,4 +75,8 @@ class MetricsRegistry {
   std::map<std::string, Family> families_;
 };
 
+// The latency histogram of one stage of facetd's pipeline (trigger, grab, inspect, plc_write,
+// publish, total), in milliseconds.
+Histogram& stageLatency(MetricsRegistry& metrics, const std::string& stage);
+
 }  // namespace facet::service

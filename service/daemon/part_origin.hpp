@@ -5,7 +5,7 @@
 
 #include "camera/camera.hpp"
 #include "config/recipe.hpp"
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::service {
 

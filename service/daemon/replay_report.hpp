@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::service {
 

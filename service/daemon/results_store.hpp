@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 struct sqlite3;
 struct sqlite3_stmt;

@@ -1,10 +1,11 @@
 #pragma once
 // Station: one running facetd. Three stages run concurrently, joined by bounded queues:
 //
-//   acquisition  waits for a trigger (PLC) or free-runs, grabs a frame, picks the recipe for the
-//                part (only here, so a switch happens between two parts, never during one)
-//   inspection   runs the recipe on the frame (RecipeInspection)
-//   publishing   PLC registers, results store, image archive, metrics, last result for HTTP
+//   acquisition  waits for a trigger (PLC) or free-runs, grabs a frame, has the recipe selector
+//                choose the part's recipe (only here, so a switch happens between two parts)
+//   inspection   runs the recipe on the frame (inspectPart, service/engine/)
+//   publishing   PLC registers (PlcPublisher), results store, image archive, metrics, last
+//                result for HTTP (station_view.cpp)
 //
 // Every part that was triggered or grabbed gets a result: a frame that could not be grabbed,
 // was incomplete, was a replay file that could not be read, or was dropped because inspection
@@ -26,16 +27,16 @@
 
 #include "camera/camera.hpp"
 #include "camera/scan_source.hpp"
-#include "config/recipe_library.hpp"
 #include "config/station_config.hpp"
-#include "plc/plc_link.hpp"
 #include "service/daemon/bounded_queue.hpp"
 #include "service/daemon/image_archive.hpp"
-#include "service/daemon/inspection.hpp"
 #include "service/daemon/metrics.hpp"
 #include "service/daemon/part_error.hpp"
+#include "service/daemon/plc_publisher.hpp"
+#include "service/daemon/recipe_selector.hpp"
 #include "service/daemon/results_store.hpp"
 #include "service/daemon/station_view.hpp"
+#include "service/engine/inspect_part.hpp"
 
 namespace facet::service {
 
@@ -56,8 +57,10 @@ class Station : public StationView {
  public:
   // Opens the results store, loads the recipes and prepares camera, PLC and archive. Throws
   // std::runtime_error with a clear message when the station cannot run at all (no usable
-  // recipe, store not writable, camera backend unknown).
-  Station(config::StationConfig config, StationOptions options);
+  // recipe, store not writable, camera backend unknown). Recipes may use the step kinds of
+  // `kinds`, which must outlive the station.
+  Station(config::StationConfig config, const config::StepKindRegistry& kinds,
+          StationOptions options);
   ~Station() override;
   Station(const Station&) = delete;
   Station& operator=(const Station&) = delete;
@@ -72,14 +75,14 @@ class Station : public StationView {
   // True once every stage has run out of work (maxParts reached, end of stream, or stop).
   [[nodiscard]] bool drained() const { return drained_.load(); }
   // Re-reads the recipes folder; a broken recipe is rejected and the one in use stays.
-  config::ReloadReport reloadRecipes();
-  [[nodiscard]] bool recipesChangedOnDisk() const { return library_.changedOnDisk(); }
+  config::ReloadReport reloadRecipes() { return recipes_.reload(); }
+  [[nodiscard]] bool recipesChangedOnDisk() const { return recipes_.changedOnDisk(); }
   // Liveness of the acquisition and inspection loops (for the systemd watchdog).
   [[nodiscard]] bool loopsAlive(std::chrono::milliseconds within) const;
   // Whether the PLC link is connected (true when the station runs without a PLC).
-  [[nodiscard]] bool plcConnected() const { return !plc_ || plc_->stats().connected; }
+  [[nodiscard]] bool plcConnected() const { return !plc_ || plc_->link().stats().connected; }
 
-  // StationView
+  // StationView (station_view.cpp)
   [[nodiscard]] nlohmann::json health() const override;
   [[nodiscard]] std::string metricsText() const override;
   [[nodiscard]] std::vector<PartResult> recentParts(std::size_t count) const override;
@@ -94,27 +97,44 @@ class Station : public StationView {
   [[nodiscard]] MetricsRegistry& metrics() { return metrics_; }
 
  private:
-  struct Job;
+  // One part on its way through the stages.
+  struct Job {
+    std::uint64_t partId = 0;
+    Frame frame;
+    std::optional<plc::TriggerEvent> trigger;
+    std::optional<scan::Scan> scan;                    // scan recipes
+    std::shared_ptr<const PreparedRecipe> inspection;  // the recipe chosen for the part
+    std::chrono::steady_clock::time_point acquiredAt;
+    std::chrono::steady_clock::time_point inspectedAt;
+    PartResult result;
+    PartError error = PartError::None;  // set for a part that was not inspected
+    Overlay overlay;
+  };
+  // The three stages.
   void acquisitionLoop();
   void inspectionLoop();
   void publishingLoop();
+  // Acquisition: numbers a part the acquisition took and chooses its recipe (once, with its
+  // frame's sidecar when the frame is in the job, or the trigger).
+  void takePart(Job& job);
+  // Acquisition's one exit for a part that gets no inspection: taken, and published as
+  // Verdict::Error with its cause, in its turn.
+  void notInspected(std::unique_ptr<Job> job, PartError code, const std::string& cause);
+  // The same for a part already taken (one the inspection queue dropped).
+  void publishNotInspected(std::unique_ptr<Job> job, PartError code, const std::string& cause);
+  // A scan recipe's part: the next recorded scan instead of a camera frame. False at the end.
+  bool acquireScan(Job& job);
+  // Publishing: PLC, results store, archive, metrics, what HTTP shows.
   void publishPart(Job& job);
+  // What HTTP shows of a published part: counts, recent parts, the last picture (and the
+  // archive, which keeps the pictures of failed parts). In station_view.cpp.
+  void showPart(PartResult part, const cv::Mat& image, const Overlay& overlay);
   // Deletes parts the station file's retention no longer keeps, at most `limit` (0 = all): all
   // at start, then periodically between parts in slices of kRetentionSlice. Returns how many.
   std::int64_t applyRetention(std::int64_t limit);
   static constexpr std::chrono::seconds kRetentionPeriod{60};
   // About 10 ms of deleting here: a result waiting behind it is not held up longer than that.
   static constexpr std::int64_t kRetentionSlice = 500;
-  std::shared_ptr<const RecipeInspection> inspectionFor(int recipeId, std::string* error);
-  std::shared_ptr<const RecipeInspection> recipeForPart(const Frame* frame,
-                                                        const plc::TriggerEvent* trigger);
-  // Numbers a part the acquisition took and picks its recipe (from its frame's sidecar, once the
-  // frame is in the job, or the trigger): every trigger answered, every frame taken, once.
-  void takePart(Job& job);
-  void publishNotInspected(Job job, PartError code, const std::string& cause);
-  // A scan recipe's part: the next recorded scan instead of a camera frame. False at the end.
-  bool acquireScan(Job& job);
-  void publish(PartResult part, const cv::Mat& image, const Overlay& overlay);
 
   config::StationConfig config_;
   StationOptions options_;
@@ -122,16 +142,10 @@ class Station : public StationView {
   std::unique_ptr<ResultsStore> store_;
   mutable std::mutex storeMutex_;  // SQLite connection shared by publishing and HTTP readers
   std::unique_ptr<ImageArchive> archive_;
-  config::RecipeLibrary library_;
+  RecipeSelector recipes_;
   std::unique_ptr<Camera> camera_;
   std::unique_ptr<ScanSource> scans_;  // recorded range scans for scan recipes (may be null)
-  std::unique_ptr<plc::PlcLink> plc_;
-
-  mutable std::mutex recipeMutex_;
-  std::map<int, std::shared_ptr<const RecipeInspection>> inspections_;  // prepared recipes by id
-  std::map<int, std::string> recipeErrors_;                             // setup errors by id
-  std::shared_ptr<const RecipeInspection> active_;
-  std::optional<int> requestedRecipe_;  // from HTTP, applied before the next part
+  std::unique_ptr<PlcPublisher> plc_;
 
   BoundedQueue<std::unique_ptr<Job>> inspectQueue_;
   BoundedQueue<std::unique_ptr<Job>> publishQueue_;

@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::service {
 

@@ -11,7 +11,7 @@
 
 #include "config/station_config.hpp"
 #include "service/daemon/metrics.hpp"
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 #include "service/sinks/mqtt_publisher.hpp"
 #include "service/sinks/postgres_sink.hpp"
 

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "config/fleet_settings.hpp"
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 #include "service/sinks/outbox.hpp"
 #include "service/sinks/sink_status.hpp"
 

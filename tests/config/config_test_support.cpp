@@ -1,5 +1,7 @@
 #include "tests/config/config_test_support.hpp"
 
+#include "service/engine/builtin_steps.hpp"
+
 #include <atomic>
 #include <fstream>
 
@@ -9,6 +11,11 @@
 #include <opencv2/imgproc.hpp>
 
 namespace facet::config::test {
+
+const StepKindRegistry& facetSteps() {
+  static const StepKindRegistry kinds = service::builtinSteps();
+  return kinds;
+}
 
 ScratchFolder::ScratchFolder() {
   static std::atomic<int> counter{0};

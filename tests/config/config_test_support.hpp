@@ -8,8 +8,12 @@
 #include <gtest/gtest.h>
 
 #include "config/diagnostic.hpp"
+#include "config/step_kind.hpp"
 
 namespace facet::config::test {
+
+// facet's step kinds, as facetd and `facet` read recipes with them.
+const StepKindRegistry& facetSteps();
 
 class ScratchFolder {
  public:

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "config/recipe_library.hpp"
+#include "service/engine/steps/circle_step.hpp"
 #include "tests/config/config_test_support.hpp"
 
 namespace facet::config::test {
@@ -28,7 +29,7 @@ class Library : public testing::Test {
   RecipeLibrary make() {
     RecipeLoadOptions options;
     options.root = scratch.path();
-    return RecipeLibrary(options);
+    return RecipeLibrary(facetSteps(), options);
   }
 
   // Rewrites a file so that its modification time surely differs.
@@ -81,8 +82,8 @@ TEST_F(Library, BrokenFileKeepsTheLastGoodVersion) {
   const auto fixed = library.reload();
   EXPECT_EQ(fixed.loaded, std::vector<int>{1});
   EXPECT_NE(library.find(1), inUse);
-  EXPECT_DOUBLE_EQ(library.find(1)->steps[1].as<CircleStep>().nominalDiameter, 1.2);
-  EXPECT_DOUBLE_EQ(inUse->steps[1].as<CircleStep>().nominalDiameter, 1.0);
+  EXPECT_DOUBLE_EQ(library.find(1)->steps[1].as<service::CircleParams>().nominalDiameter, 1.2);
+  EXPECT_DOUBLE_EQ(inUse->steps[1].as<service::CircleParams>().nominalDiameter, 1.0);
   EXPECT_FALSE(library.problems().hasErrors());
 }
 
@@ -126,7 +127,7 @@ TEST_F(Library, AFileReplacedWithTheSameSizeAndModificationTimeIsReloaded) {
   auto library = make();
   library.reload();
   ASSERT_NE(library.find(1), nullptr);
-  const double before = library.find(1)->steps.at(1).as<CircleStep>().nominalDiameter;
+  const double before = library.find(1)->steps.at(1).as<service::CircleParams>().nominalDiameter;
 
   std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a later status-change time
   scratch.write("a.recipe.yaml", recipeText(1, "A", 1.3));
@@ -138,7 +139,7 @@ TEST_F(Library, AFileReplacedWithTheSameSizeAndModificationTimeIsReloaded) {
   const auto report = library.reload();
   EXPECT_EQ(report.loaded, (std::vector<int>{1}));
   EXPECT_DOUBLE_EQ(before, 1.1);
-  EXPECT_DOUBLE_EQ(library.find(1)->steps.at(1).as<CircleStep>().nominalDiameter, 1.3);
+  EXPECT_DOUBLE_EQ(library.find(1)->steps.at(1).as<service::CircleParams>().nominalDiameter, 1.3);
 }
 
 TEST_F(Library, AChangedImageReloadsTheRecipe) {

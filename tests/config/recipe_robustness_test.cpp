@@ -60,7 +60,7 @@ TEST(RecipeRobustness, MutatedExamplesNeverThrowAndPointIntoTheFile) {
       const std::string text = mutate(lines, rng);
       const auto file = scratch.write("m.recipe.yaml", text);
       RecipeLoadResult r;
-      ASSERT_NO_THROW(r = loadRecipe(file, {})) << text;
+      ASSERT_NO_THROW(r = loadRecipe(file, facetSteps(), {})) << text;
       EXPECT_EQ(r.recipe.has_value(), !r.diagnostics.hasErrors());
       if (!r.recipe) ++rejected;
       for (const auto& d : r.diagnostics.items()) {

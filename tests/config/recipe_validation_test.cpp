@@ -1,10 +1,14 @@
 // Recipe validation: every kind of problem is reported with its exact line and column, all of
 // them in one run, and a recipe with an error is never returned.
+#include <fstream>
+
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "config/recipe_loader.hpp"
 #include "config/recipe_training.hpp"
 #include "config/training_record.hpp"
+#include "service/engine/steps/circle_step.hpp"
 #include "tests/config/config_test_support.hpp"
 
 namespace facet::config::test {
@@ -28,7 +32,7 @@ class RecipeValidation : public testing::Test {
   RecipeLoadResult load(const std::string& text, RecipeLoadOptions options = {}) {
     const auto file = scratch.write("test.recipe.yaml", text);
     if (!options.root) options.root = scratch.path();
-    return loadRecipe(file, options);
+    return loadRecipe(file, facetSteps(), options);
   }
 
   ScratchFolder scratch;
@@ -51,12 +55,12 @@ TEST_F(RecipeValidation, AValidRecipeLoadsWithItsStepsAndChecks) {
   const Recipe& recipe = *r.recipe;
   EXPECT_EQ(recipe.id, 7);
   ASSERT_EQ(recipe.steps.size(), 2u);
-  EXPECT_EQ(recipe.steps[0].kind, StepKind::Align);
+  EXPECT_EQ(recipe.steps[0].kindName(), "align");
   const Step& hole = recipe.steps[1];
-  const auto& circle = hole.as<CircleStep>();
+  const auto& circle = hole.as<service::CircleParams>();
   EXPECT_EQ(circle.relativeTo, "part");
   EXPECT_EQ(circle.centre, cv::Point2d(30, 20));
-  EXPECT_EQ(circle.polarity, CirclePolarity::DarkInside);
+  EXPECT_EQ(circle.polarity, facet::CirclePolarity::DarkToLight);
   const Check* diameter = hole.check("diameter");
   ASSERT_NE(diameter, nullptr);
   EXPECT_DOUBLE_EQ(diameter->lower(), 0.97);
@@ -254,7 +258,7 @@ TEST_F(RecipeValidation, ReferenceToAStepOfTheWrongKindIsRefused) {
   EXPECT_TRUE(hasDiagnostic(r.diagnostics, 16, 18,
                             "'relative_to' needs a step that gives a pose (align, fiducials or "
                             "shape), but 'hole' is a circle step"));
-  EXPECT_TRUE(hasDiagnostic(r.diagnostics, 24, 9, "'to' needs a step that gives a pose"));
+  EXPECT_TRUE(hasDiagnostic(r.diagnostics, 24, 9, "'to' needs a step that gives a line"));
 }
 
 TEST_F(RecipeValidation, TolMinusLargerThanANonNegativeNominalIsRefused) {
@@ -408,8 +412,10 @@ TEST_F(RecipeValidation, ShapeModelsMustBeTrainedAndFresh) {
   EXPECT_GT(trained[0].points, 8u);
   r = load(text);
   ASSERT_TRUE(r.recipe.has_value()) << r.diagnostics.text();
-  const std::string params = trainingParameters(r.recipe->steps[1]);
-  EXPECT_EQ(params, "shape;region=all;angle=-30,30");
+  // The training record holds the parameters as canonical text.
+  const std::string params = "shape;region=all;angle=-30,30";
+  std::ifstream record(scratch.path() / "models/label.shape.train.json");
+  EXPECT_EQ(nlohmann::json::parse(record).value("parameters", ""), params);
 
   // Other training parameters in the recipe: stale.
   std::string changed = text;

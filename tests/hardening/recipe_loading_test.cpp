@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "config/recipe_loader.hpp"
+#include "service/engine/builtin_steps.hpp"
 
 namespace facet::config {
 namespace {
@@ -32,10 +33,11 @@ class RecipeLoading : public ::testing::Test {
   RecipeLoadResult load(const std::string& text) const {
     const fs::path file = folder_ / "part.recipe.yaml";
     std::ofstream(file) << text;
-    return loadRecipe(file);
+    return loadRecipe(file, kinds_);
   }
 
   fs::path folder_;
+  const StepKindRegistry kinds_ = service::builtinSteps();
 };
 
 constexpr const char* kHead = R"(schema_version: 1

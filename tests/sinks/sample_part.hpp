@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "service/daemon/part_result.hpp"
+#include "service/engine/part_result.hpp"
 
 namespace facet::sinks_test {
 

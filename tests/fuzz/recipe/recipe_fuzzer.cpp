@@ -14,6 +14,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "config/recipe_loader.hpp"
+#include "service/engine/builtin_steps.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
 namespace {
@@ -43,7 +44,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   facet::config::RecipeLoadOptions options;
   options.root = folder.path();
   options.requireTrainedModels = (size % 2) == 0;  // both ways the daemon and `train` read
-  const auto result = facet::config::loadRecipe(file, options);
+  static const auto kinds = facet::service::builtinSteps();
+  const auto result = facet::config::loadRecipe(file, kinds, options);
   if (result.recipe.has_value() == result.diagnostics.hasErrors()) std::abort();
   return 0;
 }

@@ -1,4 +1,4 @@
-#include "service/daemon/overlay.hpp"
+#include "service/engine/overlay.hpp"
 
 #include <opencv2/imgproc.hpp>
 

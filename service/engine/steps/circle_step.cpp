@@ -1,0 +1,77 @@
+#include "service/engine/steps/circle_step.hpp"
+
+#include "algorithms/registration/register_images.hpp"
+#include "config/recipe_format.hpp"
+#include "config/yaml_validation.hpp"
+#include "service/engine/steps/polarity_names.hpp"
+#include "service/engine/steps/pose_fields.hpp"
+
+namespace facet::service {
+
+using config::Quantity;
+
+CircleStep::CircleStep() {
+  addRelativeTo(fields_);
+  fields_.point("centre", &CircleParams::centre,
+                "Nominal centre [x, y], pixels of the relative_to step's reference image.", true);
+  fields_.number("nominal_diameter", &CircleParams::nominalDiameter, "Nominal diameter, mm.",
+                 {.minimum = 0.0, .exclusiveMinimum = true, .required = true});
+  fields_.number("search_width", &CircleParams::searchWidth,
+                 "Width of the annulus searched around the nominal circle, mm; less than the "
+                 "diameter.",
+                 {.minimum = 0.0, .exclusiveMinimum = true, .required = true});
+  fields_.choice("polarity", &CircleParams::polarity, circlePolarityNames(),
+                 "Circle darker (a hole) or lighter than its surroundings.");
+  checks_ = {"circle checks",
+             "",
+             {config::checkField("diameter", Quantity::Length, "Fitted diameter.", 0.0),
+              config::checkField("x", Quantity::Length, "Centre offset from nominal along x."),
+              config::checkField("y", Quantity::Length, "Centre offset from nominal along y."),
+              config::checkField("position", Quantity::Length,
+                                 "Distance of the centre from its nominal position (true "
+                                 "position).",
+                                 0.0),
+              config::checkField("roundness", Quantity::Length,
+                                 "Largest minus smallest radius of the edge points.", 0.0)}};
+  format_ =
+      config::stepFormat("circle", "Measures a circle in an annulus around its nominal position.",
+                         fields_.specs(), checks_);
+}
+
+std::shared_ptr<const config::StepParams> CircleStep::read(config::StepReading& in) const {
+  auto c = std::make_shared<CircleParams>();
+  fields_.read(*c, in);
+  using config::formatNumber;
+  if (c->nominalDiameter > 0 && c->searchWidth >= c->nominalDiameter)
+    in.error(in["search_width"], "'search_width' " + formatNumber(c->searchWidth) +
+                                     " mm must be smaller than 'nominal_diameter' " +
+                                     formatNumber(c->nominalDiameter) +
+                                     " mm: the search annulus would cover the centre");
+  return c;
+}
+
+StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
+  const auto& c = step.as<CircleParams>();
+  const cv::Point2d expected = mapPoint(part.frameOf(c.relativeTo), c.centre);
+  CircleMeasureParams p;
+  p.centre = expected;
+  p.radius = c.nominalDiameter / 2.0 / part.mmPerPixel();
+  p.width = c.searchWidth / part.mmPerPixel();
+  p.polarity = c.polarity;
+  const CircleMeasurement m = measureCircle(part.grey, p);
+  part.overlay.circle(expected, std::max(1.0, p.radius - p.width), true, true);
+  part.overlay.circle(expected, p.radius + p.width, true, true);
+  if (!m.ok()) return StepResult::failed("circle not measured: " + circleFailureCause(m.failures));
+  StepResult r;
+  r.values["diameter"] = m.diameter;
+  r.values["x"] = m.centre.x - expected.x;
+  r.values["y"] = m.centre.y - expected.y;
+  r.values["position"] = cv::norm(m.centre - expected);
+  r.values["roundness"] = m.roundness;
+  r.point = m.centre;
+  part.overlay.circle(m.centre, m.radius, true);
+  part.overlay.cross(m.centre, 4, true);
+  return r;
+}
+
+}  // namespace facet::service

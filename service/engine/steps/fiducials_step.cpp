@@ -1,0 +1,118 @@
+#include "service/engine/steps/fiducials_step.hpp"
+
+#include <cmath>
+
+#include "algorithms/circle/disc_locator.hpp"
+#include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/registration/register_images.hpp"
+#include "config/recipe_format.hpp"
+#include "service/engine/steps/polarity_names.hpp"
+#include "service/engine/steps/pose_fields.hpp"
+
+namespace facet::service {
+namespace {
+
+using config::Quantity;
+
+// Least-squares similarity (Umeyama in 2D) taking `from` onto `to`.
+cv::Matx33d fitSimilarity(const std::vector<cv::Point2d>& from,
+                          const std::vector<cv::Point2d>& to) {
+  cv::Point2d mf, mt;
+  for (std::size_t i = 0; i < from.size(); ++i) mf += from[i], mt += to[i];
+  mf *= 1.0 / from.size();
+  mt *= 1.0 / to.size();
+  double sxx = 0, sxy = 0, var = 0;
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    const cv::Point2d a = from[i] - mf, b = to[i] - mt;
+    sxx += a.x * b.x + a.y * b.y;
+    sxy += a.x * b.y - a.y * b.x;
+    var += a.dot(a);
+  }
+  const double c = sxx / var, s = sxy / var;  // scale * cos, scale * sin (maths orientation)
+  const cv::Matx22d M{c, -s, s, c};
+  const cv::Point2d t =
+      mt - cv::Point2d(M(0, 0) * mf.x + M(0, 1) * mf.y, M(1, 0) * mf.x + M(1, 1) * mf.y);
+  return {M(0, 0), M(0, 1), t.x, M(1, 0), M(1, 1), t.y, 0, 0, 1};
+}
+
+}  // namespace
+
+FiducialsStep::FiducialsStep() {
+  addRelativeTo(fields_);
+  fields_.points("marks", &FiducialsParams::marks,
+                 "Nominal mark centres [x, y], pixels; at least two.", 2);
+  fields_.number("mark_diameter", &FiducialsParams::markDiameter, "Diameter of a mark, mm.",
+                 {.minimum = 0.0, .exclusiveMinimum = true, .required = true});
+  fields_.number("search_radius", &FiducialsParams::searchRadius,
+                 "How far from its nominal centre a mark is searched, mm.",
+                 {.minimum = 0.0, .exclusiveMinimum = true});
+  fields_.choice("polarity", &FiducialsParams::polarity, circlePolarityNames(),
+                 "Marks darker or lighter than their surroundings.");
+  checks_ = {"fiducials checks",
+             "",
+             {config::checkField("x", Quantity::Length, "Shift of the marks' centroid along x."),
+              config::checkField("y", Quantity::Length, "Shift of the marks' centroid along y."),
+              config::checkField("angle", Quantity::Angle, "Rotation of the marks, degrees."),
+              config::checkField("spacing", Quantity::Length,
+                                 "Distance between the first two marks.", 0.0)}};
+  format_ = config::stepFormat("fiducials", "Finds round marks near their nominal positions.",
+                               fields_.specs(), checks_);
+}
+
+std::shared_ptr<const config::StepParams> FiducialsStep::read(config::StepReading& in) const {
+  auto f = std::make_shared<FiducialsParams>();
+  fields_.read(*f, in);
+  for (std::size_t i = 0; i < f->marks.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j)
+      if (cv::norm(f->marks[i] - f->marks[j]) < 1e-9)
+        in.error(in["marks"][i],
+                 "mark " + std::to_string(i + 1) + " lies on mark " + std::to_string(j + 1));
+  return f;
+}
+
+StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const {
+  const auto& f = step.as<FiducialsParams>();
+  const cv::Matx33d H = part.frameOf(f.relativeTo);
+  const double radius = f.markDiameter / 2.0 / part.mmPerPixel();
+  const double searchRadius = f.searchRadius / part.mmPerPixel();
+  std::vector<cv::Point2d> nominal, found;
+  for (const auto& mark : f.marks) {
+    const cv::Point2d expected = mapPoint(H, mark);
+    part.overlay.circle(expected, searchRadius + radius, true, true);
+    const std::string where =
+        "mark at (" + std::to_string(mark.x) + ", " + std::to_string(mark.y) + ")";
+    // Coarse location first: the search radius is usually larger than the mark.
+    const auto coarse = locateDisc(part.grey, {.expected = expected,
+                                               .radius = radius,
+                                               .searchRadius = searchRadius,
+                                               .polarity = f.polarity});
+    if (!coarse) return StepResult::failed(where + " not found within the search radius");
+    CircleMeasureParams p;
+    p.centre = coarse->centre;
+    p.radius = radius;
+    p.width = std::max(2.0, 0.35 * radius);
+    p.polarity = f.polarity;
+    const CircleMeasurement m = measureCircle(part.grey, p);
+    if (!m.ok())
+      return StepResult::failed(where + " not measured: " + circleFailureCause(m.failures));
+    part.overlay.circle(m.centre, m.radius, true);
+    nominal.push_back(expected);
+    found.push_back(m.centre);
+  }
+  const cv::Matx33d S = fitSimilarity(nominal, found);
+  StepResult r;
+  r.refToImage = S * H;
+  cv::Point2d cn, cf;
+  for (std::size_t i = 0; i < found.size(); ++i) cn += nominal[i], cf += found[i];
+  cn *= 1.0 / nominal.size();
+  cf *= 1.0 / found.size();
+  r.values["x"] = cf.x - cn.x;
+  r.values["y"] = cf.y - cn.y;
+  r.angleDeg = degrees(std::atan2(-S(1, 0), S(0, 0)));
+  r.values["angle"] = *r.angleDeg;
+  r.values["spacing"] = cv::norm(found[1] - found[0]);
+  r.point = cf;
+  return r;
+}
+
+}  // namespace facet::service

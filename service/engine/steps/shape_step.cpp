@@ -1,0 +1,113 @@
+#include "service/engine/steps/shape_step.hpp"
+
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/registration/register_images.hpp"
+#include "algorithms/shape/find_shape_model.hpp"
+#include "config/recipe_format.hpp"
+#include "service/engine/frame_maps.hpp"
+#include "service/engine/steps/pose_fields.hpp"
+#include "service/engine/steps/shape_model_resource.hpp"
+
+namespace facet::service {
+namespace {
+
+using config::Quantity;
+
+ShapeTraining trainingOf(const ShapeParams& s) {
+  return {s.templateImage, s.region, s.angleRange, s.model};
+}
+
+}  // namespace
+
+ShapeStep::ShapeStep() {
+  addRelativeTo(fields_);
+  fields_.path("template", &ShapeParams::templateImage,
+               "Image the model is trained from, relative to the recipe.", true);
+  fields_.rect("region", &ShapeParams::region,
+               "[x, y, width, height] of the template that holds the part, pixels.");
+  fields_.path("model", &ShapeParams::model, "Trained model file, written by `facet recipe train`.",
+               true, true);
+  addSearch(fields_);
+  fields_.integer("num_matches", &ShapeParams::numMatches, "Most matches searched.",
+                  {.minimum = 1.0, .maximum = 100.0});
+  fields_.number("max_overlap", &ShapeParams::maxOverlap, "Largest overlap of two matches, 0..1.",
+                 {.minimum = 0.0, .maximum = 1.0});
+  const std::string xDoc = "Offset of the found position from nominal along x (mm by default).";
+  const std::string yDoc = "Offset of the found position from nominal along y (mm by default).";
+  checks_ = {"shape checks",
+             "",
+             {config::checkField("count", Quantity::Count, "Number of matches found.", 0.0),
+              config::checkField("x", Quantity::Length, xDoc),
+              config::checkField("y", Quantity::Length, yDoc),
+              config::checkField("angle", Quantity::Angle, "Rotation of the best match, degrees."),
+              config::checkField("score", Quantity::Score, "Score of the best match, 0..1.", 0.0)}};
+  format_ = config::stepFormat("shape", "Finds a trained shape model and checks count and pose.",
+                               fields_.specs(), checks_);
+}
+
+std::shared_ptr<const config::StepParams> ShapeStep::read(config::StepReading& in) const {
+  auto s = std::make_shared<ShapeParams>();
+  fields_.read(*s, in);
+  return s;
+}
+
+std::shared_ptr<const config::StepResources> ShapeStep::prepare(const config::Step& step,
+                                                                config::StepReading& in) const {
+  return prepareShapeModel(trainingOf(step.as<ShapeParams>()), in, "template");
+}
+
+std::vector<config::TrainedModel> ShapeStep::train(const config::Step& step) const {
+  return {trainShapeModel(step, trainingOf(step.as<ShapeParams>()))};
+}
+
+StepResult ShapeStep::run(const config::Step& step, StepContext& part) const {
+  const auto& s = step.as<ShapeParams>();
+  cv::Rect search = clampRect(s.searchRegion, part.grey.size());
+  config::AngleRange angles = s.angleRange;
+  if (s.relativeTo) {
+    // Relative to an earlier pose: search only where that step's reference view lies in the
+    // live image, with the angle range turned by that step's rotation.
+    const StepResult& base = part.done.at(*s.relativeTo);
+    if (base.referenceView) {
+      std::vector<cv::Point2f> mapped;
+      for (const auto& c : outerCorners(cv::Rect(*base.referenceView)))
+        mapped.emplace_back(mapPoint(*base.refToImage, c));
+      const int margin = 8;
+      search &=
+          cv::boundingRect(mapped) + cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin);
+    }
+    if (base.angleDeg) angles = {angles.low + *base.angleDeg, angles.high + *base.angleDeg};
+  }
+  if (search.empty()) return StepResult::failed("search region outside the image");
+  part.overlay.polygon(outerCorners(search), true, true);
+  const auto& shape = step.resourcesAs<ShapeModelResource>();
+  const auto matches =
+      findShapeModel(part.grey(search), shape.model,
+                     findParamsFor(s.minScore, s.numMatches, s.maxOverlap, angles));
+  StepResult r;
+  r.values["count"] = static_cast<double>(matches.size());
+  for (const auto& m : matches) drawContour(part.overlay, m.contour, search.tl(), true);
+  if (matches.empty()) {
+    // Nothing found: the count is still a valid measurement (it may be checked against 0).
+    if (step.check("count") != nullptr && step.checks.size() == 1) return r;
+    return StepResult::failed("no match above min score " + std::to_string(s.minScore));
+  }
+  // Relative to an earlier pose, the nominal position moves with the part.
+  const cv::Point2d nominal = mapPoint(part.frameOf(s.relativeTo), shape.home);
+  const ShapeMatch& best = matches[0];
+  const cv::Point2d at(best.x + search.x, best.y + search.y);
+  r.values["x"] = at.x - nominal.x;
+  r.values["y"] = at.y - nominal.y;
+  r.angleDeg = degrees(best.angle);
+  r.values["angle"] = *r.angleDeg;
+  r.values["score"] = best.score;
+  r.refToImage = translation(cv::Point2d(search.tl())) * poseMap(best.pose(), shape.home);
+  r.referenceView =
+      cv::Rect2d(shape.home - shape.model.referencePoint, cv::Size2d(shape.model.templateSize));
+  r.point = at;
+  part.overlay.cross(at, 8, true);
+  return r;
+}
+
+}  // namespace facet::service
