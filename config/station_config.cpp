@@ -85,6 +85,12 @@ class StationReader {
       station_.http.token = text(h["token"]);
     }
     if (map(root["calibration"])) readCalibration(root["calibration"]);
+    // The station's name names its MQTT topics and its rows in a central database.
+    const std::string fleetName = station_.name.empty() ? file_.stem().string() : station_.name;
+    if (map(root["mqtt"]))
+      station_.mqtt = readMqttSettings(root["mqtt"], file_, base_, fleetName, out_);
+    if (map(root["postgres"]))
+      station_.postgres = readPostgresSettings(root["postgres"], file_, base_, out_);
     if (out_.hasErrors()) return std::nullopt;
     return std::move(station_);
   }

@@ -16,6 +16,7 @@
 
 #include "camera/camera_settings.hpp"
 #include "config/diagnostic.hpp"
+#include "config/fleet_settings.hpp"
 #include "config/recipe_loader.hpp"
 #include "plc/plc_settings.hpp"
 #include "plc/register_map.hpp"
@@ -69,6 +70,8 @@ struct StationConfig {
   ArchiveSettings archive;
   HttpSettings http;
   Calibration calibration;
+  MqttSettings mqtt;          // enabled when the file has an mqtt section
+  PostgresSettings postgres;  // enabled when the file has a postgres section
 
   // Holding registers of the register map, which recipe outputs must not overlap.
   [[nodiscard]] std::vector<RegisterUse> reservedRegisters() const;

@@ -231,6 +231,46 @@ StationFormat::StationFormat() {
                        "OpenCV FileStorage file (YAML/XML) from checkerboard calibration, "
                        "relative to the station file.")}};
 
+  mqttTls = {
+      "mqtt tls",
+      "TLS to the broker; on when ca_file is set.",
+      {path("ca_file", "CA certificate(s) the broker's certificate is checked against.", true),
+       path("cert_file", "Client certificate (with key_file)."),
+       path("key_file", "Client private key (with cert_file)."),
+       flag("insecure", "Do not check the broker's host name (test brokers only).", false)}};
+  mqtt = {
+      "mqtt",
+      "Each part's result as JSON on <topic_prefix>/<station>/result (QoS 1); the station's "
+      "status retained on <topic_prefix>/<station>/status, last will \"offline\".",
+      {text("host", "Broker address.", "127.0.0.1"),
+       integer("port", "Broker port; default 1883, 8883 with tls.", 1, 65535),
+       text("client_id", "MQTT client id; default facet-<station name>."),
+       text("topic_prefix", "First topic levels.", "facet"),
+       text("username", "User name at the broker."),
+       text("password", "Password at the broker (needs username)."),
+       integer("keepalive_s", "MQTT keep-alive, seconds.", 5, 65535, 30),
+       integer("reconnect_max_ms", "Longest wait between reconnections, ms.", 100, 600000, 5000),
+       section("tls", "TLS settings.", &mqttTls),
+       path("outbox", "Folder of results waiting for the broker; default mqtt-outbox."),
+       positive("outbox_quota_mb", "Largest size of the outbox, MB; the oldest go first.", 64)}};
+  postgres = {
+      "postgres",
+      "A central PostgreSQL database with the tables of the results store (one station "
+      "column more), written off the inspection path.",
+      {{.name = "connection",
+        .type = F::String,
+        .description = "libpq connection string, e.g. \"host=db port=5432 dbname=facet "
+                       "user=station1\".",
+        .required = true},
+       text("password", "Password, kept apart from the connection string."),
+       integer("connect_timeout_s", "Wait for a connection, seconds.", 1, 600, 5),
+       integer("reconnect_max_ms", "Longest wait between reconnections, ms.", 100, 600000, 5000),
+       integer("batch_parts", "Parts per transaction when catching up.", 1, 10000, 50),
+       path("outbox",
+            "Folder of results waiting for the database; default "
+            "postgres-outbox."),
+       positive("outbox_quota_mb", "Largest size of the outbox, MB; the oldest go first.", 64)}};
+
   station = {
       "station",
       "A facet station: camera, PLC, recipes, stores and calibration.",
@@ -241,7 +281,9 @@ StationFormat::StationFormat() {
        path("recipes", "Recipes folder, relative to the station file.", true),
        section("results", "Results store.", &results, true),
        section("archive", "Image archive.", &archive), section("http", "HTTP server.", &http),
-       section("calibration", "Pixels to millimetres.", &calibration, true)}};
+       section("calibration", "Pixels to millimetres.", &calibration, true),
+       section("mqtt", "Results to an MQTT broker.", &mqtt),
+       section("postgres", "Results to a PostgreSQL database.", &postgres)}};
   station.fields[0].required = true;
 }
 

@@ -11,6 +11,7 @@ struct StationFormat {
   ObjectSpec camera, replay, aravis, v4l2, scans;
   ObjectSpec plc, registerMap, control, status, location, result;
   ObjectSpec results, archive, http, calibration;
+  ObjectSpec mqtt, mqttTls, postgres;  // results to a fleet (fleet_settings.hpp)
 
   StationFormat();
   StationFormat(const StationFormat&) = delete;  // the tables point into themselves

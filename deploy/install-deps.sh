@@ -16,6 +16,8 @@ packages=(
   # plc, config, service
   libmodbus-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libsqlite3-dev sqlite3
   libcpp-httplib-dev libssl-dev libsystemd-dev nlohmann-json3-dev
+  # results to a fleet: MQTT (libmosquitto) and PostgreSQL (libpq); broker and server for tests
+  libmosquitto-dev mosquitto libpq-dev postgresql
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   python3-pymodbus python3-serial python3-serial-asyncio python3-numpy python3-opencv mbpoll

@@ -54,5 +54,6 @@ void addRecipeCommand(CLI::App& app, const config::StepKindRegistry& kinds);
 int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds);
 void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds);
 void addCalibrateCommand(CLI::App& app);
+void addValidateCommand(CLI::App& app, const config::StepKindRegistry& kinds);
 
 }  // namespace facet::cli

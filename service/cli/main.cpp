@@ -91,6 +91,7 @@ int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds) {
   addRecipeCommand(app, kinds);
   addReplayCommand(app, kinds);
   addCalibrateCommand(app);
+  addValidateCommand(app, kinds);
 
   if (const auto problem = commandProblem(app, argc, argv)) {
     std::cerr << *problem << "\n";

@@ -17,6 +17,7 @@
 #include "config/station_config.hpp"
 #include "service/cli/command_line.hpp"
 #include "service/daemon/part_banner.hpp"
+#include "service/cli/replay_shard.hpp"
 #include "service/daemon/part_origin.hpp"
 #include "service/daemon/process_capability.hpp"
 #include "service/daemon/replay_report.hpp"
@@ -35,6 +36,8 @@ struct ReplayOptions {
   std::string glob;
   int thumbnailWidth = 320;
   bool json = false;
+  std::string shard;        // batch re-inspection: I/N (replay_shard.hpp)
+  std::string resultsFile;  // batch re-inspection: results store to write
 };
 
 std::string utcNow() {
@@ -190,7 +193,13 @@ void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
   cmd->add_option("--recipe", opt->recipeFile, "Recipe file (YAML)")->required();
   cmd->add_option("--images", opt->imagesFolder, "Folder of recorded images (with sidecars)")
       ->required();
-  cmd->add_option("--report", opt->reportFile, "HTML report to write")->required();
+  cmd->add_option("--report", opt->reportFile, "HTML report to write");
+  cmd->add_option("--results", opt->resultsFile,
+                  "Batch re-inspection: write every part to this results store (SQLite) instead "
+                  "of a report");
+  cmd->add_option("--shard", opt->shard,
+                  "Batch re-inspection: take share I of N (0-based, by a hash of the file name; "
+                  "default: JOB_COMPLETION_INDEX/JOB_COMPLETIONS when set); needs --results");
   cmd->add_option("--station", opt->stationFile,
                   "Station config: calibration, recipe root and registers");
   cmd->add_option("--mm-per-pixel", opt->mmPerPixel,
@@ -199,7 +208,25 @@ void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
   cmd->add_option("--thumbnail-width", opt->thumbnailWidth, "Width of failed-part thumbnails, px")
       ->check(CLI::Range(32, 4096));
   cmd->add_flag("--json", opt->json, "Print a summary as one JSON object");
-  cmd->callback([opt, &kinds] { runReplay(*opt, kinds); });
+  cmd->callback([opt, &kinds] {
+    if (!opt->resultsFile.empty() || !opt->shard.empty()) {
+      if (opt->resultsFile.empty()) throw InputError("replay --shard: give --results FILE.db");
+      if (!opt->reportFile.empty())
+        throw InputError("replay: --report and --results exclude each other");
+      runShardedReplay({.recipeFile = opt->recipeFile,
+                        .imagesFolder = opt->imagesFolder,
+                        .stationFile = opt->stationFile,
+                        .mmPerPixel = opt->mmPerPixel,
+                        .glob = opt->glob,
+                        .shard = opt->shard,
+                        .resultsFile = opt->resultsFile,
+                        .json = opt->json},
+                       kinds);
+      return;
+    }
+    if (opt->reportFile.empty()) throw InputError("replay: give --report FILE.html or --results");
+    runReplay(*opt, kinds);
+  });
 }
 
 }  // namespace facet::cli

@@ -4,6 +4,7 @@
 #include <iostream>
 #include <sstream>
 
+#include "service/batch/results_merge.hpp"
 #include "service/cli/command_line.hpp"
 #include "service/daemon/results_store.hpp"
 
@@ -32,6 +33,42 @@ std::chrono::system_clock::time_point parseSince(const std::string& text) {
     throw InputError("--since: expected YYYY-MM-DD[THH:MM:SS] (UTC) or a duration like 8h, got '" +
                      text + "'");
   return system_clock::from_time_t(timegm(&tm));
+}
+
+// facet results merge A.db B.db ... --out all.db (service/batch/results_merge.hpp).
+void addMergeCommand(CLI::App& results) {
+  struct Options {
+    std::vector<std::string> inputs;
+    std::string out;
+    bool json = false;
+  };
+  auto opt = std::make_shared<Options>();
+  auto* merge = results.add_subcommand(
+      "merge", "Join results stores (e.g. the shards of a batch re-inspection) into a new one");
+  merge->add_option("inputs", opt->inputs, "Results databases (SQLite files)")->required();
+  merge->add_option("--out", opt->out, "The merged database to create")->required();
+  merge->add_flag("--json", opt->json, "Print a summary as one JSON object");
+  merge->callback([opt] {
+    std::vector<std::filesystem::path> inputs(opt->inputs.begin(), opt->inputs.end());
+    std::vector<service::MergedInput> merged;
+    try {
+      merged = service::mergeResults(inputs, opt->out);
+    } catch (const std::runtime_error& e) {
+      throw InputError(e.what());
+    }
+    std::int64_t parts = 0;
+    nlohmann::json list = nlohmann::json::array();
+    for (const auto& m : merged) {
+      parts += m.parts;
+      list.push_back({{"file", m.file.string()}, {"parts", m.parts}});
+    }
+    if (opt->json) {
+      printJson({{"out", opt->out}, {"parts", parts}, {"inputs", list}});
+      return;
+    }
+    for (const auto& m : merged) std::cout << m.file.string() << ": " << m.parts << " parts\n";
+    std::cout << opt->out << ": " << parts << " parts\n";
+  });
 }
 
 }  // namespace
@@ -66,6 +103,7 @@ void addResultsCommand(CLI::App& app) {
     for (const auto& p : parts) list.push_back(service::toJson(p));
     printJson({{"parts", list}, {"count", parts.size()}});
   });
+  addMergeCommand(*results);
 }
 
 }  // namespace facet::cli

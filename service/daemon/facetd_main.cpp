@@ -16,6 +16,8 @@
 #include "service/daemon/part_banner.hpp"
 #include "service/daemon/station.hpp"
 #include "service/daemon/systemd_notifier.hpp"
+#include "service/sinks/fleet_publishers.hpp"
+#include "service/sinks/fleet_station_view.hpp"
 
 namespace {
 
@@ -136,8 +138,19 @@ int facet::service::runFacetd(int argc, char** argv, const config::StepKindRegis
   // A replayed folder can wait for the inspection: nothing is dropped.
   options.overflow = blockWhenBehind || !replayFolder.empty() ? service::OverflowPolicy::Block
                                                               : service::OverflowPolicy::DropOldest;
+  // Results to the fleet (the station file's mqtt / postgres sections): each part is handed over
+  // after the PLC has it, and only appended to the sinks' outboxes here (never waits on a peer).
+  std::unique_ptr<service::FleetPublishers> fleet;
+  try {
+    fleet = std::make_unique<service::FleetPublishers>(stationConfig);
+  } catch (const std::exception& e) {
+    std::cerr << "facetd: " << e.what() << "\n";
+    return 1;
+  }
+  if (fleet->any()) options.onPart = [&](const service::PartResult& p) { fleet->submit(p); };
   if (printParts) {
-    options.onPart = [&](const service::PartResult& p) {
+    options.onPart = [&, toFleet = options.onPart](const service::PartResult& p) {
+      if (toFleet) toFleet(p);
       ++counts[service::verdictName(p.verdict)];
       if (!p.expectedVerdict.empty() && p.expectedVerdict != service::verdictName(p.verdict))
         ++unexpected;
@@ -148,13 +161,15 @@ int facet::service::runFacetd(int argc, char** argv, const config::StepKindRegis
     service::checkCalibrationImageSize(stationConfig);
     service::Station station(stationConfig, kinds, options);
     const auto& httpConfig = station.config().http;
-    service::HttpServer http(station, {.bindAddress = httpConfig.bind,
-                                       .port = httpConfig.port,
-                                       .token = httpConfig.token,
-                                       .dashboardDir = {}});
+    service::FleetStationView view(station, *fleet, station.metrics());
+    service::HttpServer http(view, {.bindAddress = httpConfig.bind,
+                                    .port = httpConfig.port,
+                                    .token = httpConfig.token,
+                                    .dashboardDir = {}});
     http.start();
     spdlog::info("http listening on {}:{}", httpConfig.bind, http.port());
     if (!portFile.empty()) std::ofstream(portFile) << http.port() << "\n";
+    fleet->start();
     station.start();
     // READY once camera and PLC are up; a PLC still unreachable after a few seconds does not
     // hold the service back (parts are queued for it), the status says so.
@@ -203,6 +218,8 @@ int facet::service::runFacetd(int argc, char** argv, const config::StepKindRegis
     }
     station.requestStop();
     station.join();
+    // What is still in the outboxes stays on disk for the next start; a short flush first.
+    fleet->stop(std::chrono::milliseconds(2000));
     http.stop();
     if (printParts) {
       std::cout << "summary:";

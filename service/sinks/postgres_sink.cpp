@@ -1,0 +1,297 @@
+#include "service/sinks/postgres_sink.hpp"
+
+#include <libpq-fe.h>
+
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
+#include "service/daemon/results_store.hpp"
+#include "service/sinks/fleet_message.hpp"
+
+namespace facet::service {
+
+const char* const kPostgresSchema = R"sql(
+CREATE TABLE IF NOT EXISTS parts (
+  station        TEXT NOT NULL,
+  part_id        BIGINT NOT NULL,
+  time_us        BIGINT NOT NULL,
+  time_utc       TIMESTAMPTZ NOT NULL,
+  recipe_id      INTEGER NOT NULL,
+  recipe_name    TEXT NOT NULL,
+  recipe_version TEXT NOT NULL,
+  frame_id       BIGINT NOT NULL,
+  source         TEXT NOT NULL,
+  serial         TEXT NOT NULL,
+  expected       TEXT NOT NULL,
+  verdict        TEXT NOT NULL CHECK (verdict IN ('pass', 'fail', 'error')),
+  failed_checks  TEXT NOT NULL,
+  error          TEXT NOT NULL,
+  inspection_ms  DOUBLE PRECISION NOT NULL,
+  timings_json   TEXT NOT NULL,
+  PRIMARY KEY (station, part_id, time_us)
+);
+CREATE INDEX IF NOT EXISTS parts_time ON parts(time_utc);
+CREATE TABLE IF NOT EXISTS measurements (
+  station   TEXT NOT NULL,
+  part_id   BIGINT NOT NULL,
+  time_us   BIGINT NOT NULL,
+  name      TEXT NOT NULL,
+  value     DOUBLE PRECISION,
+  unit      TEXT NOT NULL,
+  nominal   DOUBLE PRECISION,
+  tol_minus DOUBLE PRECISION,
+  tol_plus  DOUBLE PRECISION,
+  checked   BOOLEAN NOT NULL,
+  pass      BOOLEAN NOT NULL,
+  PRIMARY KEY (station, part_id, time_us, name),
+  FOREIGN KEY (station, part_id, time_us) REFERENCES parts ON DELETE CASCADE
+);
+)sql";
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+
+struct ResultDeleter {
+  void operator()(PGresult* r) const { PQclear(r); }
+};
+using Result = std::unique_ptr<PGresult, ResultDeleter>;
+
+std::string trimmed(std::string s) {
+  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
+  return s;
+}
+
+// host:port/dbname from the connection string, for messages (never the password).
+std::string peerOf(const std::string& connection) {
+  char* error = nullptr;
+  std::unique_ptr<PQconninfoOption, decltype(&PQconninfoFree)> options(
+      PQconninfoParse(connection.c_str(), &error), &PQconninfoFree);
+  PQfreemem(error);
+  std::string host = "localhost", port = "5432", db;
+  for (auto* o = options.get(); o && o->keyword; ++o) {
+    if (!o->val) continue;
+    const std::string k = o->keyword;
+    if (k == "host" || k == "hostaddr") host = o->val;
+    if (k == "port") port = o->val;
+    if (k == "dbname") db = o->val;
+  }
+  return host + ":" + port + "/" + db;
+}
+
+std::optional<std::string> number(const std::optional<double>& v) {
+  if (!v || !std::isfinite(*v)) return std::nullopt;
+  return fmt::format("{}", *v);
+}
+
+// PQexecParams with every parameter as text; nullopt is SQL NULL.
+Result execute(pg_conn* conn, const char* sql,
+               const std::vector<std::optional<std::string>>& params) {
+  std::vector<const char*> values;
+  for (const auto& p : params) values.push_back(p ? p->c_str() : nullptr);
+  return Result(PQexecParams(conn, sql, static_cast<int>(values.size()), nullptr, values.data(),
+                             nullptr, nullptr, 0));
+}
+
+bool ok(const Result& r) {
+  const auto s = PQresultStatus(r.get());
+  return s == PGRES_COMMAND_OK || s == PGRES_TUPLES_OK;
+}
+
+constexpr const char* kInsertPart =
+    "INSERT INTO parts VALUES ($1, $2, $3, to_timestamp($3::bigint / 1000000.0::float8), $4, $5, "
+    "$6, $7, $8, $9, $10, $11, $12, $13, $14, $15) ON CONFLICT DO NOTHING";
+constexpr const char* kInsertValue =
+    "INSERT INTO measurements VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)";
+
+}  // namespace
+
+PostgresSink::PostgresSink(config::PostgresSettings settings, std::string station)
+    : settings_(std::move(settings)),
+      station_(std::move(station)),
+      outbox_(settings_.outbox.folder,
+              static_cast<std::uint64_t>(settings_.outbox.quotaMb * 1024 * 1024),
+              "postgres outbox") {
+  status_.name = "postgres";
+  status_.peer = peerOf(settings_.connection);
+  status_.lastError = "not connected yet";
+}
+
+PostgresSink::~PostgresSink() {
+  stop(0ms);
+  if (conn_) PQfinish(conn_);
+}
+
+void PostgresSink::start() {
+  if (thread_.joinable()) return;
+  thread_ = std::thread([this] { run(); });
+}
+
+void PostgresSink::submit(const PartResult& part) {
+  outbox_.append(fleetMessage(station_, part).dump());
+}
+
+void PostgresSink::stop(std::chrono::milliseconds flush) {
+  if (!thread_.joinable()) return;
+  flushDeadline_ = Clock::now() + flush;
+  stopping_ = true;
+  outbox_.wake();
+  thread_.join();
+}
+
+SinkStatus PostgresSink::status() const {
+  std::lock_guard lock(statusMutex_);
+  SinkStatus s = status_;
+  s.outbox = outbox_.stats();
+  return s;
+}
+
+void PostgresSink::setError(std::string error) {
+  std::lock_guard lock(statusMutex_);
+  if (error != status_.lastError)
+    spdlog::warn("postgres {}: {} (results wait in {})", status_.peer, error,
+                 outbox_.folder().string());
+  status_.lastError = std::move(error);
+  status_.connected = false;
+}
+
+void PostgresSink::sleepFor(std::chrono::milliseconds wait) {
+  const auto until = Clock::now() + wait;
+  while (!stopping_ && Clock::now() < until) std::this_thread::sleep_for(20ms);
+}
+
+bool PostgresSink::connect() {
+  const std::string timeout = std::to_string(settings_.connectTimeoutS);
+  const std::string application = "facet-" + station_;
+  std::vector<const char*> keys{"dbname", "connect_timeout", "application_name"};
+  std::vector<const char*> values{settings_.connection.c_str(), timeout.c_str(),
+                                  application.c_str()};
+  if (!settings_.password.empty()) {
+    keys.push_back("password");
+    values.push_back(settings_.password.c_str());
+  }
+  keys.push_back(nullptr);
+  values.push_back(nullptr);
+  // expand_dbname = 1: the first value is the whole connection string.
+  conn_ = PQconnectdbParams(keys.data(), values.data(), 1);
+  if (PQstatus(conn_) != CONNECTION_OK) {
+    std::string why = trimmed(PQerrorMessage(conn_));
+    if (why.find("password authentication failed") != std::string::npos ||
+        why.find("no password supplied") != std::string::npos)
+      why += " (check postgres.connection's user and postgres.password)";
+    setError("cannot connect: " + why);
+    PQfinish(conn_);
+    conn_ = nullptr;
+    return false;
+  }
+  const Result schema(PQexec(conn_, kPostgresSchema));
+  if (!ok(schema)) {
+    setError("cannot create the tables: " + trimmed(PQerrorMessage(conn_)));
+    PQfinish(conn_);
+    conn_ = nullptr;
+    return false;
+  }
+  std::lock_guard lock(statusMutex_);
+  status_.connected = true;
+  status_.lastError.clear();
+  ++status_.connects;
+  spdlog::info("postgres {}: connected; {} results waiting", status_.peer, outbox_.stats().pending);
+  return true;
+}
+
+bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
+  auto rollback = [this] { PQclear(PQexec(conn_, "ROLLBACK")); };
+  if (!ok(Result(PQexec(conn_, "BEGIN")))) return false;
+  std::vector<std::uint64_t> done;
+  for (const auto& record : records) {
+    std::string station;
+    PartResult p;
+    try {
+      p = partFromFleetMessage(nlohmann::json::parse(record.payload), &station);
+    } catch (const std::exception& e) {
+      // Not a message of ours (a damaged file): it would block the outbox forever.
+      spdlog::error("postgres outbox: record {} dropped: {}", record.seq, e.what());
+      done.push_back(record.seq);
+      continue;
+    }
+    nlohmann::json timings = nlohmann::json::array();
+    for (const auto& t : p.timings) timings.push_back({{"step", t.step}, {"ms", t.ms}});
+    std::string failed;
+    for (const auto& c : p.failedChecks) failed += (failed.empty() ? "" : ",") + c;
+    const std::string partId = std::to_string(p.partId);
+    const std::string timeUs = std::to_string(
+        std::chrono::duration_cast<std::chrono::microseconds>(p.time.time_since_epoch()).count());
+    const Result part = execute(conn_, kInsertPart,
+                                {station, partId, timeUs, std::to_string(p.recipeId), p.recipeName,
+                                 p.recipeVersion, std::to_string(p.frameId), p.source, p.serial,
+                                 p.expectedVerdict, std::string(verdictName(p.verdict)), failed,
+                                 p.error, fmt::format("{}", p.inspectionMs), timings.dump()});
+    if (!ok(part)) {
+      spdlog::error("postgres: part {}: {}", p.partId, trimmed(PQerrorMessage(conn_)));
+      rollback();
+      return false;
+    }
+    // 0 rows: the part is there already (sent again after a lost COMMIT answer).
+    if (std::string(PQcmdTuples(part.get())) == "1") {
+      for (const auto& m : p.measurements) {
+        const Result value = execute(
+            conn_, kInsertValue,
+            {station, partId, timeUs, m.name, number(m.value), m.unit, number(m.nominal),
+             number(m.tolMinus), number(m.tolPlus), std::string(m.checked ? "true" : "false"),
+             std::string(m.pass ? "true" : "false")});
+        if (!ok(value)) {
+          spdlog::error("postgres: part {} value {}: {}", p.partId, m.name,
+                        trimmed(PQerrorMessage(conn_)));
+          rollback();
+          return false;
+        }
+      }
+    }
+    done.push_back(record.seq);
+  }
+  if (!ok(Result(PQexec(conn_, "COMMIT")))) return false;
+  outbox_.remove(done);
+  std::lock_guard lock(statusMutex_);
+  status_.delivered += done.size();
+  return true;
+}
+
+void PostgresSink::run() {
+  auto backoff = 100ms;
+  while (true) {
+    if (stopping_ && (outbox_.stats().pending == 0 || Clock::now() >= flushDeadline_ || !conn_))
+      break;
+    if (!conn_) {
+      if (connect()) {
+        backoff = 100ms;
+      } else {
+        sleepFor(backoff);
+        backoff = std::min<std::chrono::milliseconds>(
+            backoff * 2, std::chrono::milliseconds(settings_.reconnectMaxMs));
+        continue;
+      }
+    }
+    if (!outbox_.waitForRecords(200ms)) continue;
+    const auto records = outbox_.peek(static_cast<std::size_t>(settings_.batchParts));
+    if (records.empty() || write(records)) continue;
+    // Failed: a lost connection is reconnected; a statement the server refused (a bug, a
+    // changed table) is logged and retried after the back-off, never silently skipped.
+    const bool lost = PQstatus(conn_) != CONNECTION_OK;
+    setError((lost ? "connection lost: " : "write failed: ") + trimmed(PQerrorMessage(conn_)));
+    PQfinish(conn_);
+    conn_ = nullptr;
+    sleepFor(backoff);
+    backoff = std::min<std::chrono::milliseconds>(
+        backoff * 2, std::chrono::milliseconds(settings_.reconnectMaxMs));
+  }
+  std::lock_guard lock(statusMutex_);
+  status_.connected = false;
+  status_.lastError = "stopped";
+}
+
+}  // namespace facet::service
