@@ -11,9 +11,12 @@
 #include "config/json_schema.hpp"
 #include "config/recipe_library.hpp"
 #include "config/station_config.hpp"
+#include "tests/config/config_test_support.hpp"
 
 namespace facet::config {
 namespace {
+
+using test::facetSteps;
 
 const std::filesystem::path kRecipes = std::filesystem::path(FACET_SOURCE_DIR) / "recipes";
 
