@@ -32,9 +32,16 @@ std::uint64_t stableNameHash(const std::string& text) {
 }
 
 bool Shard::takes(const std::filesystem::path& file) const {
-  return count <= 1 ||
-         stableNameHash(file.filename().string()) % static_cast<std::uint64_t>(count) ==
-             static_cast<std::uint64_t>(index);
+  if (count <= 1) return true;
+  // FNV-1a's low bits follow the last characters of similar names (part_1, part_2, ...): mixed
+  // (MurmurHash3's finaliser) before the modulo so that every shard gets its share.
+  std::uint64_t h = stableNameHash(file.filename().string());
+  h ^= h >> 33;
+  h *= 0xff51afd7ed558ccdULL;
+  h ^= h >> 33;
+  h *= 0xc4ceb9fe1a85ec53ULL;
+  h ^= h >> 33;
+  return h % static_cast<std::uint64_t>(count) == static_cast<std::uint64_t>(index);
 }
 
 Shard parseShard(const std::string& text) {

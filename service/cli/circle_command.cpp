@@ -48,6 +48,7 @@ void run(const CircleOptions& o) {
   p.polarity = parsePolarity(o.polarity);
   p.minCoverageDeg = o.minCoverage;
   const cv::Mat image = readGreyImage(o.image);
+  if (!o.calibration.empty()) checkCalibrationFor(o.calibration, image.size());
 
   const auto t0 = std::chrono::steady_clock::now();
   const CircleMeasurement m = measureCircle(image, p);

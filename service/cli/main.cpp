@@ -101,6 +101,8 @@ int runFacet(int argc, char** argv, const config::StepKindRegistry& kinds) {
   for (int i = 1; i < argc; ++i) jsonWanted = jsonWanted || std::string(argv[i]) == "--json";
   try {
     app.parse(argc, argv);
+  } catch (const CLI::RuntimeError& e) {
+    return e.get_exit_code();  // a command's own exit code (validate: 3 on a mismatch)
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help
     // A wrong argument is bad input (exit 1), as the README promises; CLI11's own codes

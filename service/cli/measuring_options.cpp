@@ -72,14 +72,4 @@ EdgeSelect parseEdgeSelect(const std::string& text) {
   throw InputError("--select must be all, first, last or strongest (got \"" + text + "\")");
 }
 
-cv::Mat readGreyImage(const std::string& path) {
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) throw InputError(path + ": no such image file");
-  const cv::Mat image = cv::imread(path, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (image.empty()) throw InputError(path + ": cannot read the image (unknown format or corrupt)");
-  if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
-    throw InputError(path + ": only 8-bit and 16-bit grey images can be measured");
-  return image;
-}
-
 }  // namespace facet::cli

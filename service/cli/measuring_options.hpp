@@ -19,7 +19,5 @@ MeasuringArc parseMeasuringArc(const std::string& text, const std::string& optio
 cv::Rect parseRegion(const std::string& text, const std::string& option);
 EdgePolarity parseEdgePolarity(const std::string& text);
 EdgeSelect parseEdgeSelect(const std::string& text);
-// An 8/16-bit grey image (colour is converted to grey); InputError naming the file otherwise.
-cv::Mat readGreyImage(const std::string& path);
 
 }  // namespace facet::cli

@@ -5,11 +5,11 @@
 #include "service/cli/command_line.hpp"
 
 namespace facet::cli {
+namespace {
 
-nlohmann::json worldCircle(const std::string& file, cv::Size imageSize,
-                           const CircleMeasurement& m) {
+config::CalibrationData usableCalibration(const std::string& file, cv::Size imageSize) {
   config::Diagnostics problems;
-  const auto data = config::readCalibrationFile(file, problems);
+  auto data = config::readCalibrationFile(file, problems);
   if (!data) throw InputError("calibration file not usable:\n" + problems.text());
   const auto sizeText = [](cv::Size s) {
     return std::to_string(s.width) + "x" + std::to_string(s.height);
@@ -17,8 +17,20 @@ nlohmann::json worldCircle(const std::string& file, cv::Size imageSize,
   if (data->camera && !data->camera->imageSize.empty() && data->camera->imageSize != imageSize)
     throw InputError(file + ": the calibration was made for " + sizeText(data->camera->imageSize) +
                      " images, this image is " + sizeText(imageSize));
-  if (data->camera && data->plane) {
-    const WorldMapping mapping(*data->camera, *data->plane);
+  return std::move(*data);
+}
+
+}  // namespace
+
+void checkCalibrationFor(const std::string& file, cv::Size imageSize) {
+  (void)usableCalibration(file, imageSize);
+}
+
+nlohmann::json worldCircle(const std::string& file, cv::Size imageSize,
+                           const CircleMeasurement& m) {
+  const config::CalibrationData data = usableCalibration(file, imageSize);
+  if (data.camera && data.plane) {
+    const WorldMapping mapping(*data.camera, *data.plane);
     const auto c = circleInPlane(m, mapping);
     if (!c)
       throw MeasurementFailure("off_plane",
@@ -27,12 +39,12 @@ nlohmann::json worldCircle(const std::string& file, cv::Size imageSize,
             {"y_mm", c->centreMm.y},
             {"diameter_mm", c->diameterMm},
             {"rms_mm", c->rmsMm},
-            {"calibration", data->kind()}};
+            {"calibration", data.kind()}};
   }
-  if (data->mmPerPixel <= 0)
+  if (data.mmPerPixel <= 0)
     throw InputError(file +
                      ": the calibration has a lens model but neither a plane nor mm_per_pixel");
-  const double s = data->mmPerPixel;
+  const double s = data.mmPerPixel;
   return {{"x_mm", m.centre.x * s},
           {"y_mm", m.centre.y * s},
           {"diameter_mm", m.diameter * s},

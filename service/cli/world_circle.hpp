@@ -14,6 +14,10 @@ namespace facet::cli {
 // mapped into the plane and the circle fitted there; with mm_per_pixel alone the pixel values
 // are scaled ("calibration": "scale only, no lens model"). Throws InputError for an unusable
 // calibration file (file:line:column) or one made for another image size.
+// The same checks alone, before measuring: a broken calibration is bad input (exit 1) even when
+// the circle would not be found.
+void checkCalibrationFor(const std::string& calibrationFile, cv::Size imageSize);
+
 nlohmann::json worldCircle(const std::string& calibrationFile, cv::Size imageSize,
                            const CircleMeasurement& measurement);
 

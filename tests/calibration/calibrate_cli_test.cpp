@@ -114,7 +114,11 @@ TEST_F(CalibrateCli, WrongBoardSpecIsRefusedWithReasons) {
       test::runFacet("calibrate --images " + (dir / "views").string() +
                      " --board chessboard:8x5:10 --out " + (dir / "wrong.yaml").string());
   EXPECT_NE(run.exitCode, 0) << run.out;
-  EXPECT_NE(run.err.find("view0.png"), std::string::npos) << run.err;
+  // Views are named with their reason; not every view of a too-small spec is recognised as a
+  // larger plate (some read as "no chessboard found"), so the test asks for the reason, not for
+  // a particular view.
+  EXPECT_NE(run.err.find("view"), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find("is the board spec right?"), std::string::npos) << run.err;
   const auto bad =
       test::runFacet("calibrate --images " + (dir / "views").string() +
                      " --board chessboard:10x8:10 --out " + (dir / "wrong.yaml").string());

@@ -77,6 +77,7 @@ std::shared_ptr<const config::StepParams> AlignStep::read(config::StepReading& i
 std::shared_ptr<const config::StepResources> AlignStep::prepare(const config::Step& step,
                                                                 config::StepReading& in) const {
   const auto& a = step.as<AlignParams>();
+  if (!in["reference"]) return nullptr;  // reported by the validator
   if (a.method == AlignParams::Method::Shape)
     return prepareShapeModel(trainingOf(a), in, "reference");
   auto reference = std::make_shared<ReferenceImage>();

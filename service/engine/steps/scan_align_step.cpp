@@ -46,6 +46,7 @@ std::shared_ptr<const config::StepParams> ScanAlignStep::read(config::StepReadin
 
 std::shared_ptr<const config::StepResources> ScanAlignStep::prepare(const config::Step& step,
                                                                     config::StepReading& in) const {
+  if (!in["reference"]) return nullptr;  // reported by the validator
   auto reference = std::make_shared<ReferenceScan>();
   try {
     reference->scan = scan::readScanCsvFile(step.as<ScanAlignParams>().reference.string());

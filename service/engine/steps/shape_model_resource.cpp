@@ -31,6 +31,8 @@ std::string parametersText(const ShapeTraining& t) {
 std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining& training,
                                                             config::StepReading& in,
                                                             const std::string& templateKey) {
+  // A missing key was reported by the validator: nothing to load.
+  if (!in[templateKey] || !in["model"]) return nullptr;
   const cv::Mat image = cv::imread(training.templateImage.string(), cv::IMREAD_UNCHANGED);
   if (image.empty()) {
     in.error(in[templateKey], "'" + templateKey + "' file '" + in[templateKey].Scalar() +
