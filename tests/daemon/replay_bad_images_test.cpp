@@ -170,7 +170,10 @@ TEST(ReplayBadImages, EachBadFileIsAnErrorPartNamedByItsFileAndGoodOnesAreInspec
   // Memory: 30000 x 30000 would be 900 MB, 16000 x 16000 x RGB16 1.5 GB, if ever allocated and
   // touched. The peak must stay under 1 GiB and near that of the good files alone.
   EXPECT_GT(run.sampledPeak, 0u);
-  EXPECT_LE(run.sampledPeak, peakBoth) << "VmHWM read while running exceeds the final peak";
+  // The kernel hands the parent the child's high-water mark as accounted at exit, which can lag
+  // /proc's VmHWM by a few hundred kB (seen: 232 kB of 158 MiB): a margin of 1 MiB.
+  EXPECT_LE(run.sampledPeak, peakBoth + (std::uint64_t{1} << 20))
+      << "VmHWM read while running exceeds the final peak";
   EXPECT_LT(peakBoth, std::uint64_t{1} << 30) << "peak RSS " << (peakBoth >> 20) << " MiB";
   EXPECT_LT(peakBoth - peakGood, kAllowedGrowth)
       << "the bad files raised facetd's peak RSS from " << (peakGood >> 20) << " to "

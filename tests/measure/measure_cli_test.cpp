@@ -121,7 +121,7 @@ TEST_F(MeasureCli, MeasurementFailuresAreJsonErrorsWithTheirCause) {
   EXPECT_EQ(cause("blob --image " + image_ + " --roi 0,0,200,70 --min-area 5000"), "no_blob");
   EXPECT_EQ(cause("blob --image " + image_ + " --roi 500,500,10,10"), "outside_image");
   // Partly outside: measured inside and flagged.
-  const CliRun part = facet("caliper --image " + image_ + " --rect 20,110,20,6,90 --json");
+  const CliRun part = facet("caliper --image " + image_ + " --rect 20,105,60,6,90 --json");
   ASSERT_EQ(part.exitCode, 0) << part.err;
   EXPECT_TRUE(nlohmann::json::parse(part.out).at("partial").get<bool>());
 }
