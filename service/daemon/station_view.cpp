@@ -1,5 +1,5 @@
-#include <opencv2/imgcodecs.hpp>
 #include <spdlog/spdlog.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include "service/daemon/part_banner.hpp"
 #include "service/daemon/station.hpp"

@@ -4,9 +4,9 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "service/daemon/part_banner.hpp"
 #include "service/engine/label_placement.hpp"
 #include "service/engine/overlay.hpp"
-#include "service/daemon/part_banner.hpp"
 
 namespace facet::service {
 namespace {

@@ -35,7 +35,7 @@ struct SceneSpec {
   double blurSigma = 0.0;                      // Gaussian PSF sigma, pixels (0 = none)
   BlurModel blurModel = BlurModel::PixelGrid;  // where the blur acts (see above)
   int lensSupersampling = 8;  // Lens: fine cells per pixel and axis for the scene's coverage
-  double noiseSigma = 0.0;     // additive Gaussian noise, grey levels on the 8-bit scale
+  double noiseSigma = 0.0;    // additive Gaussian noise, grey levels on the 8-bit scale
   cv::Point2d illuminationGradient{0.0, 0.0};  // grey levels added per pixel in x and y,
                                                // zero at the image centre
   int depth = CV_8U;                           // CV_8U or CV_16U (16-bit grey = 8-bit grey * 256)
