@@ -1,8 +1,5 @@
 #include "camera/aravis_camera.hpp"
 
-#include <netinet/in.h>
-#include <sys/socket.h>
-
 #include <algorithm>
 #include <filesystem>
 #include <optional>
@@ -12,74 +9,15 @@
 #include <spdlog/spdlog.h>
 #include <opencv2/core.hpp>
 
+#include "camera/aravis_pixel_format.hpp"
+#include "camera/glib_error.hpp"
+#include "camera/gvsp_socket_buffer.hpp"
 #include "camera/sensor_image.hpp"
 
 namespace facet {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-// How long a stream may stay silent before we ask the control channel whether the camera is
-// still there, and how often the watch thread looks.
-constexpr auto kSilenceBeforeProbe = std::chrono::milliseconds(1000);
-constexpr auto kWatchPeriod = std::chrono::milliseconds(250);
-
-// GigE Vision bootstrap register: control channel privilege (CCP), and its bits that say an
-// application holds control (exclusive or shared). A camera that restarted reads 0 here.
-constexpr guint32 kControlChannelPrivilege = 0x0A00;
-constexpr guint32 kControlBits = 0x3;
-
-// Owns a GError and turns it into a message.
-struct ErrorSlot {
-  GError* error = nullptr;
-  ~ErrorSlot() { g_clear_error(&error); }
-  GError** operator&() { return &error; }
-  explicit operator bool() const { return error != nullptr; }
-  std::string message() const { return error ? error->message : std::string(); }
-};
-
-std::optional<SensorLayout> layoutOf(ArvPixelFormat format) {
-  switch (format) {
-    case ARV_PIXEL_FORMAT_MONO_8:
-      return SensorLayout::Mono8;
-    case ARV_PIXEL_FORMAT_MONO_16:
-      return SensorLayout::Mono16;
-    case ARV_PIXEL_FORMAT_RGB_8_PACKED:
-      return SensorLayout::Rgb8;
-    case ARV_PIXEL_FORMAT_BGR_8_PACKED:
-      return SensorLayout::Bgr8;
-    case ARV_PIXEL_FORMAT_BAYER_RG_8:
-      return SensorLayout::BayerRG8;
-    case ARV_PIXEL_FORMAT_BAYER_GR_8:
-      return SensorLayout::BayerGR8;
-    case ARV_PIXEL_FORMAT_BAYER_GB_8:
-      return SensorLayout::BayerGB8;
-    case ARV_PIXEL_FORMAT_BAYER_BG_8:
-      return SensorLayout::BayerBG8;
-    default:
-      return std::nullopt;
-  }
-}
-
-int cvTypeOf(SensorLayout layout) {
-  switch (layout) {
-    case SensorLayout::Mono16:
-      return CV_16UC1;
-    case SensorLayout::Rgb8:
-    case SensorLayout::Bgr8:
-      return CV_8UC3;
-    case SensorLayout::Yuyv:
-      return CV_8UC2;
-    default:
-      return CV_8UC1;
-  }
-}
-
-bool supportedPixelFormatName(const std::string& name) {
-  static const char* names[] = {"Mono8",    "Mono16",   "RGB8",     "BGR8",
-                                "BayerRG8", "BayerGR8", "BayerGB8", "BayerBG8"};
-  return std::find(std::begin(names), std::end(names), name) != std::end(names);
-}
 
 // Finds the Aravis device id of the camera with this serial number (needs discovery).
 std::string deviceIdForSerial(const std::string& serial) {
@@ -89,36 +27,6 @@ std::string deviceIdForSerial(const std::string& serial) {
     if (s && serial == s) return arv_get_device_id(i);
   }
   return {};
-}
-
-// Aravis sizes its GVSP socket's receive buffer (socket-buffer auto) only when the first
-// packet of the first frame arrives, so that frame's burst meets the system default buffer and,
-// from a fast sender (a camera on loopback, 10 GigE), loses packets: the first part after every
-// (re)connection would be an incomplete frame. Aravis 0.8 does not expose the socket, so it is
-// found among our descriptors by the stream's local UDP port and given the frame size now.
-void presizeStreamSocket(ArvStream* stream, guint payload) {
-  if (!ARV_IS_GV_STREAM(stream)) return;
-  const guint16 port = arv_gv_stream_get_port(ARV_GV_STREAM(stream));
-  const int size = static_cast<int>(std::min<guint>(payload, 1u << 30));
-  std::error_code error;
-  for (const auto& entry : std::filesystem::directory_iterator("/proc/self/fd", error)) {
-    int fd = -1;
-    try {
-      fd = std::stoi(entry.path().filename().string());
-    } catch (const std::exception&) {
-      continue;
-    }
-    sockaddr_in address{};
-    socklen_t length = sizeof address;
-    int type = 0;
-    socklen_t type_length = sizeof type;
-    if (getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length) != 0 ||
-        address.sin_family != AF_INET || ntohs(address.sin_port) != port ||
-        getsockopt(fd, SOL_SOCKET, SO_TYPE, &type, &type_length) != 0 || type != SOCK_DGRAM)
-      continue;
-    if (setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &size, sizeof size) != 0)
-      spdlog::debug("GVSP socket: cannot set a {} byte receive buffer", size);
-  }
 }
 
 bool isLoopbackCamera(ArvCamera* camera) {
@@ -375,156 +283,6 @@ void AravisCamera::softwareTrigger() {
   }
   std::lock_guard health_lock(health_mutex_);
   health_.last_error = "software trigger failed: " + error.message();
-}
-
-std::string AravisCamera::controlChannelProblem() {
-  // A register read through GVCP; Aravis retries internally, so a failure means the camera does
-  // not answer at all. A camera that answers but no longer counts us as its controller was
-  // restarted (or taken over): our stream settings are gone with it.
-  std::lock_guard lock(device_mutex_);
-  if (!camera_) return "no device";
-  if (control_lost_) return {};  // found out (e.g. by a trigger) while we waited for the lock
-  ErrorSlot error;
-  guint32 value = 0;
-  arv_device_read_register(arv_camera_get_device(camera_), kControlChannelPrivilege, &value,
-                           &error);
-  if (error) return "no answer on control channel";
-  if ((value & kControlBits) == 0) return "control channel privilege lost (camera restarted?)";
-  return {};
-}
-
-void AravisCamera::markLost() {
-  std::string why;
-  {
-    std::lock_guard lock(health_mutex_);
-    why = loss_reason_;
-    health_.connected = false;
-    health_.last_error = "camera lost: " + why;
-  }
-  spdlog::error("aravis camera {} lost: {}; reconnecting with backoff", label_, why);
-  lost_ = true;
-  ArvCamera* dead_camera = nullptr;
-  ArvStream* dead_stream = nullptr;
-  {
-    std::lock_guard lock(device_mutex_);
-    if (camera_) g_signal_handlers_disconnect_by_data(arv_camera_get_device(camera_), this);
-    std::swap(dead_camera, camera_);
-    std::swap(dead_stream, stream_);
-    reconnected_ = false;
-    stop_reconnecting_ = false;
-  }
-  if (reconnect_thread_.joinable()) reconnect_thread_.join();
-  reconnect_thread_ = std::thread(&AravisCamera::reconnectLoop, this, dead_camera, dead_stream);
-}
-
-void AravisCamera::startWatching() {
-  {
-    std::lock_guard lock(watch_mutex_);
-    stop_watching_ = false;
-  }
-  watch_thread_ = std::thread([this] {
-    std::unique_lock lock(watch_mutex_);
-    while (!watch_cv_.wait_for(lock, kWatchPeriod, [&] { return stop_watching_; })) {
-      lock.unlock();
-      watch();
-      lock.lock();
-    }
-  });
-}
-
-void AravisCamera::stopWatching() {
-  {
-    std::lock_guard lock(watch_mutex_);
-    stop_watching_ = true;
-  }
-  watch_cv_.notify_all();
-  if (watch_thread_.joinable()) watch_thread_.join();
-}
-
-void AravisCamera::watch() {
-  if (lost_) {
-    // Reconnected while no grab() waited for it: finish here, so health() tells the truth.
-    bool reconnected = false;
-    {
-      std::lock_guard lock(device_mutex_);
-      reconnected = reconnected_;
-    }
-    std::unique_lock grabbing(grab_mutex_, std::try_to_lock);
-    if (reconnected && grabbing && lost_) finishReconnect();
-    return;
-  }
-  const auto silence = Clock::now().time_since_epoch() - Clock::duration(last_sign_of_life_);
-  if (!control_lost_ && silence > kSilenceBeforeProbe) {
-    const std::string problem = controlChannelProblem();
-    if (problem.empty())
-      noteSignOfLife();
-    else
-      flagLost(problem);
-  }
-  if (control_lost_) {
-    // A grab() in progress handles it when it returns; otherwise release and reconnect now.
-    std::unique_lock grabbing(grab_mutex_, std::try_to_lock);
-    if (grabbing && !lost_ && control_lost_) markLost();
-  }
-}
-
-void AravisCamera::reconnectLoop(ArvCamera* dead_camera, ArvStream* dead_stream) {
-  // Releasing a device that does not answer blocks in Aravis (it says goodbye with retries).
-  if (dead_stream) g_object_unref(dead_stream);
-  if (dead_camera) g_object_unref(dead_camera);
-  auto backoff = std::chrono::milliseconds(settings_.reconnect_initial_ms);
-  std::unique_lock lock(device_mutex_);
-  while (!stop_reconnecting_) {
-    if (reconnect_cv_.wait_for(lock, backoff, [&] { return stop_reconnecting_; })) break;
-    lock.unlock();
-    std::string error;
-    try {
-      connect();
-      startStream();
-    } catch (const CameraError& e) {
-      error = e.what();
-      releaseDevice(false);
-    }
-    lock.lock();
-    if (error.empty()) {
-      reconnected_ = true;
-      reconnect_cv_.notify_all();
-      return;
-    }
-    std::lock_guard health_lock(health_mutex_);
-    health_.last_error = error;
-    backoff = std::min(backoff * 2, std::chrono::milliseconds(settings_.reconnect_max_ms));
-  }
-}
-
-void AravisCamera::stopReconnecting() {
-  {
-    std::lock_guard lock(device_mutex_);
-    stop_reconnecting_ = true;
-  }
-  reconnect_cv_.notify_all();
-  if (reconnect_thread_.joinable()) reconnect_thread_.join();
-}
-
-GrabResult AravisCamera::waitForReconnect(Clock::time_point deadline) {
-  {
-    std::unique_lock lock(device_mutex_);
-    if (!reconnect_cv_.wait_until(lock, deadline, [&] { return reconnected_; }))
-      return {GrabStatus::Disconnected, {}, "aravis camera " + label_ + " is disconnected"};
-  }
-  finishReconnect();
-  return {GrabStatus::Ok, {}, {}};
-}
-
-void AravisCamera::finishReconnect() {
-  if (reconnect_thread_.joinable()) reconnect_thread_.join();
-  lost_ = false;
-  reconnected_ = false;
-  ids_.restart();
-  spdlog::info("aravis camera {} reconnected", label_);
-  std::lock_guard lock(health_mutex_);
-  health_.connected = true;
-  ++health_.reconnects;
 }
 
 GrabResult AravisCamera::grab(std::chrono::milliseconds timeout) {

@@ -13,23 +13,13 @@
 #include <spdlog/spdlog.h>
 #include <opencv2/imgcodecs.hpp>
 
+#include "camera/fourcc.hpp"
 #include "camera/sensor_image.hpp"
 
 namespace facet {
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-std::string fourccText(std::uint32_t f) {
-  std::string s(4, ' ');
-  for (int i = 0; i < 4; ++i) s[i] = static_cast<char>((f >> (8 * i)) & 0xFF);
-  return s;
-}
-
-std::uint32_t fourccOf(const std::string& s) {
-  if (s.size() != 4) return 0;
-  return v4l2_fourcc(s[0], s[1], s[2], s[3]);
-}
 
 bool deviceGone(int error) {
   return error == ENODEV || error == EIO || error == ENXIO;

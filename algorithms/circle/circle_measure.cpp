@@ -9,8 +9,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/circle/annulus_edges.hpp"
+#include "algorithms/circle/circle_fit.hpp"
 #include "algorithms/circle/circle_profile_fit.hpp"
-#include "algorithms/geometry/levenberg_marquardt.hpp"
 #include "algorithms/geometry/ransac.hpp"
 
 namespace facet {
@@ -23,113 +23,12 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // contrast (noise 2); unlike the test against the coarse centre, this one knows the circle.
 constexpr double kHypothesisToleranceDeg = 12.0;
 
-struct Circle {
-  Eigen::Vector2d centre;
-  double radius = 0.0;
-};
-
-double residual(const Circle& c, const Eigen::Vector2d& p) {
-  return (p - c.centre).norm() - c.radius;
-}
-
-// The circle through three points, or nothing when they are (nearly) collinear.
-std::optional<Circle> circleThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
-                                    const Eigen::Vector2d& c) {
-  const Eigen::Vector2d ab = b - a, ac = c - a;
-  const double d = 2.0 * (ab.x() * ac.y() - ab.y() * ac.x());
-  if (std::abs(d) < 1e-9 * ab.squaredNorm() * ac.norm() + 1e-12) return std::nullopt;
-  const double ab2 = ab.squaredNorm(), ac2 = ac.squaredNorm();
-  const Eigen::Vector2d o{(ac.y() * ab2 - ab.y() * ac2) / d, (ab.x() * ac2 - ac.x() * ab2) / d};
-  return Circle{a + o, o.norm()};
-}
-
-// Robust weight of a residual given the scale sigma (IRLS).
-double robustWeight(CircleRobustWeight kind, double r, double sigma) {
-  const double a = std::abs(r);
-  switch (kind) {
-    case CircleRobustWeight::Huber: {
-      const double k = 1.345 * sigma;
-      return a <= k ? 1.0 : k / a;
-    }
-    case CircleRobustWeight::Tukey: {
-      const double k = 4.685 * sigma;
-      if (a >= k) return 0.0;
-      const double u = 1.0 - (a / k) * (a / k);
-      return u * u;
-    }
-    case CircleRobustWeight::None:
-      break;
-  }
-  return 1.0;
-}
-
-// Weighted geometric (orthogonal distance) fit by Levenberg-Marquardt: minimises
-// sum w_i (|p_i - c| - R)^2 over (cx, cy, R).
-class GeometricCircleFit {
- public:
-  GeometricCircleFit(const std::vector<Eigen::Vector2d>& pts, const std::vector<double>& w)
-      : pts_(pts), w_(w) {}
-
-  double cost(const Eigen::Vector3d& x) const {
-    double s = 0;
-    for (std::size_t i = 0; i < pts_.size(); ++i) {
-      const double r = (pts_[i] - x.head<2>()).norm() - x.z();
-      s += w_[i] * r * r;
-    }
-    return s;
-  }
-  void normalEquations(int, const Eigen::Vector3d& x, Eigen::Matrix3d& jtj, Eigen::Vector3d& jtr,
-                       double&) const {
-    jtj.setZero();
-    jtr.setZero();
-    for (std::size_t i = 0; i < pts_.size(); ++i) {
-      const Eigen::Vector2d d = pts_[i] - x.head<2>();
-      const double n = d.norm();
-      if (n < 1e-12 || w_[i] == 0.0) continue;
-      const Eigen::Vector3d j{-d.x() / n, -d.y() / n, -1.0};
-      const double r = n - x.z();
-      jtj.noalias() += w_[i] * j * j.transpose();
-      jtr.noalias() += w_[i] * j * r;
-    }
-  }
-  std::optional<double> trialCost(const Eigen::Vector3d& x) const { return cost(x); }
-  void accept() {}
-  bool converged(int, const Eigen::Vector3d& step) const {
-    return step.norm() < 1e-5;  // pixels: far below the accuracy sought
-  }
-
- private:
-  const std::vector<Eigen::Vector2d>& pts_;
-  const std::vector<double>& w_;
-};
-
-// Returns nothing when the fit does not converge to a finite circle.
-std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
-                                   const std::vector<double>& w, Circle c) {
-  GeometricCircleFit problem(pts, w);
-  Eigen::Vector3d x{c.centre.x(), c.centre.y(), c.radius};
-  if (levenbergMarquardt(problem, x) == LevenbergMarquardtStop::NonFiniteStep) return std::nullopt;
-  c = {x.head<2>(), x.z()};
-  if (!c.centre.allFinite() || !std::isfinite(c.radius) || c.radius <= 0.0) return std::nullopt;
-  return c;
-}
-
-// Angular extent covered by points around `centre`, degrees: 360 minus every gap between
-// neighbouring points wider than a few pixels of arc (the natural spacing of edge points).
-double coverageDeg(const std::vector<Eigen::Vector2d>& pts, const Circle& c) {
-  if (pts.size() < 2) return 0.0;
-  std::vector<double> a;
-  a.reserve(pts.size());
-  for (const auto& p : pts) a.push_back(std::atan2(p.y() - c.centre.y(), p.x() - c.centre.x()));
-  std::sort(a.begin(), a.end());
-  const double maxGap = std::max(3.0 / std::max(c.radius, 1e-6), 2.0 * kPi / 180.0);
-  double uncovered = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const double gap = i + 1 < a.size() ? a[i + 1] - a[i] : a.front() + 2.0 * kPi - a.back();
-    if (gap > maxGap) uncovered += gap;
-  }
-  return std::clamp(360.0 - uncovered * 180.0 / kPi, 0.0, 360.0);
-}
+using circle_fit::Circle;
+using circle_fit::circleThrough;
+using circle_fit::coverageDeg;
+using circle_fit::fitGeometric;
+using circle_fit::residual;
+using circle_fit::robustWeight;
 
 CircleMeasurement failed(CircleMeasurement m, CircleFailure f, std::string message) {
   m.failures |= static_cast<std::uint32_t>(f);

@@ -1,5 +1,7 @@
 #include "service/daemon/results_store.hpp"
 
+#include "service/daemon/part_export.hpp"
+
 #include <sqlite3.h>
 
 #include <algorithm>
@@ -25,17 +27,6 @@ std::int64_t toMicros(std::chrono::system_clock::time_point t) {
 
 std::chrono::system_clock::time_point fromMicros(std::int64_t us) {
   return std::chrono::system_clock::time_point(std::chrono::microseconds(us));
-}
-
-std::string isoTime(std::chrono::system_clock::time_point t) {
-  const std::time_t secs = std::chrono::system_clock::to_time_t(t);
-  std::tm tm{};
-  gmtime_r(&secs, &tm);
-  char buf[64];
-  const auto ms = toMicros(t) / 1000 % 1000;
-  std::snprintf(buf, sizeof buf, "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
-                tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(ms));
-  return buf;
 }
 
 // A prepared statement that finalises itself.
@@ -113,15 +104,6 @@ CREATE TABLE IF NOT EXISTS measurements (
 );
 )sql";
 
-std::string join(const std::vector<std::string>& items, char sep) {
-  std::string out;
-  for (const auto& s : items) {
-    if (!out.empty()) out += sep;
-    out += s;
-  }
-  return out;
-}
-
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
   std::stringstream in(s);
@@ -179,7 +161,7 @@ void ResultsStore::store(const PartResult& part) {
     insert.bind(9, part.serial);
     insert.bind(10, part.expectedVerdict);
     insert.bind(11, std::string(verdictName(part.verdict)));
-    insert.bind(12, join(part.failedChecks, ','));
+    insert.bind(12, joinedChecks(part.failedChecks, ','));
     insert.bind(13, part.error);
     insert.bind(14, part.inspectionMs);
     insert.bind(15, timings.dump());
@@ -338,70 +320,6 @@ std::vector<PartResult> ResultsStore::latest(std::size_t count) const {
 std::string ResultsStore::integrityCheck() const {
   Statement q(db_, "PRAGMA integrity_check", file_);
   return q.step() ? q.text(0) : "no answer";
-}
-
-nlohmann::json toJson(const PartResult& p) {
-  nlohmann::json values = nlohmann::json::object();
-  for (const auto& m : p.measurements) {
-    nlohmann::json v{{"value", std::isfinite(m.value) ? nlohmann::json(m.value) : nullptr},
-                     {"unit", m.unit},
-                     {"pass", m.pass}};
-    if (m.checked) {
-      v["nominal"] = m.nominal.value_or(0.0);
-      v["tol_minus"] = m.tolMinus.value_or(0.0);
-      v["tol_plus"] = m.tolPlus.value_or(0.0);
-    }
-    values[m.name] = v;
-  }
-  nlohmann::json timings = nlohmann::json::object();
-  for (const auto& t : p.timings) timings[t.step] = t.ms;
-  return {{"part_id", p.partId},
-          {"time", isoTime(p.time)},
-          {"recipe_id", p.recipeId},
-          {"recipe", p.recipeName},
-          {"recipe_version", p.recipeVersion},
-          {"frame_id", p.frameId},
-          {"source", p.source},
-          {"serial", p.serial},
-          {"expected_verdict", p.expectedVerdict},
-          {"verdict", verdictName(p.verdict)},
-          {"failed_checks", p.failedChecks},
-          {"error", p.error},
-          {"inspection_ms", p.inspectionMs},
-          {"values", values},
-          {"timings_ms", timings}};
-}
-
-std::string toCsv(const std::vector<PartResult>& parts) {
-  std::vector<std::string> names;
-  std::set<std::string> seen;
-  for (const auto& p : parts)
-    for (const auto& m : p.measurements)
-      if (seen.insert(m.name).second) names.push_back(m.name);
-  auto quote = [](const std::string& s) {
-    if (s.find_first_of(",\"\n") == std::string::npos) return s;
-    std::string q = "\"";
-    for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-    return q + "\"";
-  };
-  std::ostringstream out;
-  out << "part_id,time,recipe_id,recipe,frame_id,serial,verdict,failed_checks,error,inspection_ms";
-  for (const auto& n : names) out << ',' << quote(n);
-  out << '\n';
-  for (const auto& p : parts) {
-    out << p.partId << ',' << isoTime(p.time) << ',' << p.recipeId << ',' << quote(p.recipeName)
-        << ',' << p.frameId << ',' << quote(p.serial) << ',' << verdictName(p.verdict) << ','
-        << quote(join(p.failedChecks, ';')) << ',' << quote(p.error) << ',' << p.inspectionMs;
-    std::map<std::string, double> byName;
-    for (const auto& m : p.measurements) byName[m.name] = m.value;
-    for (const auto& n : names) {
-      out << ',';
-      if (auto it = byName.find(n); it != byName.end() && std::isfinite(it->second))
-        out << it->second;
-    }
-    out << '\n';
-  }
-  return out.str();
 }
 
 }  // namespace facet::service

@@ -10,6 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "service/daemon/part_export.hpp"  // toJson and toCsv for the store's users
 #include "service/engine/part_result.hpp"
 
 struct sqlite3;
@@ -64,9 +65,5 @@ class ResultsStore {
   RetentionPolicy retention_;
   sqlite3* db_ = nullptr;
 };
-
-nlohmann::json toJson(const PartResult& part);
-// CSV with a header row; one column per distinct measurement name across `parts`.
-std::string toCsv(const std::vector<PartResult>& parts);
 
 }  // namespace facet::service

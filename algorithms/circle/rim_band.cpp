@@ -1,0 +1,100 @@
+#include "algorithms/circle/rim_band.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+namespace facet::rim_band {
+
+double medianOf(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Robust sigma (1.4826 x median absolute value) of residuals around zero, from an evenly strided
+// subset of at most kScaleSamples: it only scales the Tukey weight and the sector test, where a
+// few percent do not matter, and the median of all of a big rim's residuals cost a tenth of the
+// measurement.
+double robustSigma(const std::vector<double>& residuals) {
+  constexpr std::size_t kScaleSamples = 512;
+  const std::size_t stride = std::max<std::size_t>(1, residuals.size() / kScaleSamples);
+  std::vector<double> a;
+  a.reserve(residuals.size() / stride + 1);
+  for (std::size_t i = 0; i < residuals.size(); i += stride) a.push_back(std::abs(residuals[i]));
+  return 1.4826 * medianOf(std::move(a));
+}
+
+// Angular bins whose grey residuals are too large for the noise. Per bin, the mean of the squared
+// residuals (each capped at 3 sigma, so one stray pixel does not condemn its bin) is compared
+// with the median over all bins, the noise level of a clean rim including the model's own misfit;
+// a bin above it by more than kSectorZ standard errors of a chi-square mean is contaminated.
+std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
+                                           const std::vector<double>& residuals, int bins) {
+  constexpr double kSectorZ = 4.0;
+  std::vector<double> sum(bins, 0.0), count(bins, 0.0);
+  const double cap = 6.0 * robustSigma(residuals);
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const double a = std::min(std::abs(residuals[i]), cap);
+    sum[samples[i].bin] += a * a;
+    count[samples[i].bin] += 1.0;
+  }
+  std::vector<double> means;
+  for (int b = 0; b < bins; ++b)
+    if (count[b] >= 4.0) means.push_back(sum[b] / count[b]);
+  std::vector<std::uint8_t> bad(bins, 0);
+  if (means.size() < 8) return bad;
+  const double reference = medianOf(means);
+  for (int b = 0; b < bins; ++b)
+    if (count[b] > 0.0 &&
+        sum[b] / count[b] > reference * (1.0 + kSectorZ * std::sqrt(2.0 / count[b])))
+      bad[b] = 1;
+  return bad;
+}
+
+// Removes the samples whose pixel, or a neighbour among the samples, has a grey-value gradient
+// the blurred rim cannot explain. The rim's gradient is radial, and more than kFlatZone px from
+// the rim the model is flat but for the illumination ramp (below 1 grey level per pixel); so a
+// tangential gradient anywhere, or any gradient far from the rim, beyond kGradientZ standard
+// deviations of the gradient's noise belongs to something else: a clutter blob or an occluder's
+// border, too faint for the edge points or outside their annulus, or the blurred tail of one.
+// Each such pixel is within the Tukey weight's reach of the model and pulls the rim. Unlike a
+// test on the residuals, this one does not depend on the fit being right (a circle pulled by
+// clutter leaves coherent residuals along its own rim). The neighbours go too: a blurred blob's
+// tail is still a few grey levels high where its gradient has sunk into the noise.
+void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d centre,
+                          double radius, double noiseSigma, cv::Rect box) {
+  constexpr double kGradientZ = 4.0;
+  constexpr double kFlatZone = 3.0;  // pixels from the rim: the blurred edge's slope is < 1% there
+  // The 3x3 Sobel divided by 8 is a unit-gain derivative; its noise is sqrt(12) / 8 of the pixels'.
+  const double limit = kGradientZ * noiseSigma * std::sqrt(12.0) / 8.0;
+  auto at = [&](int x, int y) { return greyAt(image, x, y); };
+  cv::Mat flagged = cv::Mat::zeros(box.height + 2, box.width + 2, CV_8U);  // 1 px margin
+  bool any = false;
+  for (const Sample& e : samples) {
+    const int x = e.column, y = e.row;
+    if (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1) continue;
+    const double gx = (at(x + 1, y - 1) + 2.0 * at(x + 1, y) + at(x + 1, y + 1) - at(x - 1, y - 1) -
+                       2.0 * at(x - 1, y) - at(x - 1, y + 1)) /
+                      8.0;
+    const double gy = (at(x - 1, y + 1) + 2.0 * at(x, y + 1) + at(x + 1, y + 1) - at(x - 1, y - 1) -
+                       2.0 * at(x, y - 1) - at(x + 1, y - 1)) /
+                      8.0;
+    const double dx = x - centre.x, dy = y - centre.y;
+    const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
+    const double tangential = (gy * dx - gx * dy) / rho;
+    const bool foreign = std::abs(rho - radius) > kFlatZone ? gx * gx + gy * gy > limit * limit
+                                                            : std::abs(tangential) > limit;
+    if (!foreign) continue;
+    any = true;
+    for (int v = -1; v <= 1; ++v)
+      for (int u = -1; u <= 1; ++u)
+        flagged.at<std::uint8_t>(y - box.y + 1 + v, x - box.x + 1 + u) = 1;
+  }
+  if (!any) return;
+  std::erase_if(samples, [&](const Sample& e) {
+    return flagged.at<std::uint8_t>(e.row - box.y + 1, e.column - box.x + 1) != 0;
+  });
+}
+
+}  // namespace facet::rim_band

@@ -1,0 +1,23 @@
+#pragma once
+// A part's result as the station exports it: JSON (the dashboard's API, `facet results`), CSV, and
+// the time format both use.
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "service/engine/part_result.hpp"
+
+namespace facet::service {
+
+nlohmann::json toJson(const PartResult& part);
+// CSV with a header row; one column per distinct measurement name across `parts`.
+std::string toCsv(const std::vector<PartResult>& parts);
+// The failed checks as one text field, separated by `sep`.
+std::string joinedChecks(const std::vector<std::string>& checks, char sep);
+// ISO 8601 in UTC with milliseconds, e.g. 2026-11-25T20:15:03.123Z.
+std::string isoTime(std::chrono::system_clock::time_point t);
+
+}  // namespace facet::service
