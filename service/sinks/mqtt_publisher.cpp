@@ -20,6 +20,9 @@ constexpr const char* kOnline = "online";
 constexpr const char* kOffline = "offline";
 // A broker that accepted the TCP connection but has not answered CONNECT within this is dropped.
 constexpr auto kConnackTimeout = 10s;
+// A result unconfirmed this long on a live connection is sent again (at least once): a broker
+// that lost it without closing the connection would otherwise hold the outbox up for good.
+constexpr auto kPubackTimeout = 10s;
 
 std::string errorText(int rc) {
   return rc == MOSQ_ERR_ERRNO ? std::strerror(errno) : mosquitto_strerror(rc);
@@ -116,6 +119,7 @@ void MqttPublisher::connected(int rc) {
   }
   mosquitto_publish(mosq_, nullptr, statusTopic().c_str(), static_cast<int>(std::strlen(kOnline)),
                     kOnline, 1, true);
+  if (inFlight_) inFlight_->since = Clock::now();  // libmosquitto sends it again now
   std::lock_guard lock(statusMutex_);
   status_.connected = true;
   status_.lastError.clear();
@@ -142,8 +146,7 @@ void MqttPublisher::run() {
     return status_.connected;
   };
   auto lose = [&](const std::string& why) {
-    socketOpen = false;
-    inFlight_.reset();  // sent again after reconnecting: at least once
+    socketOpen = false;  // inFlight_ stays: libmosquitto sends it again after reconnecting
     setError(why);
     nextAttempt = Clock::now() + backoff;
     backoff = std::min<std::chrono::milliseconds>(
@@ -173,6 +176,11 @@ void MqttPublisher::run() {
     }
     const bool up = isConnected();
     if (up) backoff = 100ms;
+    if (up && inFlight_ && Clock::now() - inFlight_->since > kPubackTimeout) {
+      spdlog::warn("mqtt {}: result {} not confirmed within {} s; sending it again", settings_.host,
+                   inFlight_->seq, kPubackTimeout.count());
+      inFlight_.reset();
+    }
     if (up && !inFlight_) {
       const auto next = outbox_.peek(1);
       if (!next.empty()) {
@@ -182,7 +190,7 @@ void MqttPublisher::run() {
             mosquitto_publish(mosq_, &mid, resultTopic().c_str(), static_cast<int>(payload.size()),
                               payload.data(), 1, false);
         if (rc == MOSQ_ERR_SUCCESS)
-          inFlight_ = InFlight{mid, next.front().seq};
+          inFlight_ = InFlight{mid, next.front().seq, Clock::now()};
         else if (rc == MOSQ_ERR_PAYLOAD_SIZE) {
           spdlog::error("mqtt: result too large for the broker ({} bytes); dropped",
                         payload.size());

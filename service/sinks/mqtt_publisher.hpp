@@ -60,9 +60,13 @@ class MqttPublisher {
   std::chrono::steady_clock::time_point flushDeadline_;
 
   // Owned by the sending thread (callbacks run on it, inside mosquitto_loop).
+  // The one result sent and not yet confirmed. It survives a lost connection: libmosquitto keeps
+  // it and sends it again (same message id) after reconnecting, so sending it anew as well would
+  // deliver it twice.
   struct InFlight {
     int mid;
     std::uint64_t seq;
+    std::chrono::steady_clock::time_point since;  // sent, or the connection came back
   };
   std::optional<InFlight> inFlight_;
   std::optional<int> offlineMid_;  // the goodbye status message, at stop
