@@ -125,6 +125,7 @@ MqttSubscriber::MqttSubscriber(std::string clientId, int port, std::string topic
     auto* self = static_cast<MqttSubscriber*>(obj);
     std::lock_guard lock(self->mutex_);
     self->subscribed_ = true;
+    ++self->subscriptions_;
   });
   mosquitto_message_callback_set(mosq_, [](mosquitto*, void* obj, const mosquitto_message* m) {
     auto* self = static_cast<MqttSubscriber*>(obj);
@@ -163,6 +164,11 @@ bool MqttSubscriber::waitFor(const std::function<bool(const std::vector<MqttMess
     std::this_thread::sleep_for(20ms);
   }
   return done(messages());
+}
+
+int MqttSubscriber::subscriptions() const {
+  std::lock_guard lock(mutex_);
+  return subscriptions_;
 }
 
 std::vector<MqttMessage> MqttSubscriber::messages() const {

@@ -50,6 +50,8 @@ class MqttSubscriber {
   ~MqttSubscriber();
   // Waits until the subscription is acknowledged.
   bool waitSubscribed(std::chrono::milliseconds timeout);
+  // Subscriptions the broker confirmed so far: one more after each reconnection.
+  int subscriptions() const;
   bool waitFor(const std::function<bool(const std::vector<MqttMessage>&)>& done,
                std::chrono::milliseconds timeout);
   [[nodiscard]] std::vector<MqttMessage> messages() const;
@@ -60,6 +62,7 @@ class MqttSubscriber {
   mutable std::mutex mutex_;
   std::vector<MqttMessage> messages_;
   bool subscribed_ = false;
+  int subscriptions_ = 0;
 };
 
 }  // namespace facet::sinks_test
