@@ -9,6 +9,7 @@
 namespace facet::service {
 namespace {
 
+namespace fs = std::filesystem;
 using plate::value;
 
 // The bore, the plate's top (y = 150), bottom (y = 330) and left (x = 200) edges.

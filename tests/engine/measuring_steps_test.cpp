@@ -3,12 +3,15 @@
 // wrong key) failing with their cause, never with a made-up value.
 #include <cmath>
 
-#include "config/recipe_format.hpp"
+#include "algorithms/geometry/pose2d.hpp"
+#include "service/engine/frame_maps.hpp"
+#include "service/engine/steps/placed_rect.hpp"
 #include "tests/engine/plate_part.hpp"
 
 namespace facet::service {
 namespace {
 
+namespace fs = std::filesystem;
 using plate::value;
 
 class MeasuringSteps : public ::testing::Test {
@@ -81,7 +84,8 @@ TEST_F(MeasuringSteps, CaliperPartlyOutsideMeasuresInsideAndSaysSo) {
 }
 
 TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {
-  const std::string check = "    checks:\n      position: {nominal: 0, tol_minus: 1, tol_plus: 1}\n";
+  const std::string check =
+      "    checks:\n      position: {nominal: 0, tol_minus: 1, tol_plus: 1}\n";
   const auto outside = inspect(
       "  - id: c\n    kind: caliper\n    centre: [-200, -200]\n    length: 40\n    width: 10\n" +
       check);
@@ -105,8 +109,7 @@ TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {
   const auto flat = inspect(
       "  - id: c\n    kind: caliper\n    centre: [400, 200]\n    length: 40\n    width: 10\n" +
       check);
-  EXPECT_NE(plate::failures(flat).find("no contrast"), std::string::npos)
-      << plate::failures(flat);
+  EXPECT_NE(plate::failures(flat).find("no contrast"), std::string::npos) << plate::failures(flat);
 }
 
 TEST_F(MeasuringSteps, LineGivesAngleOffsetAndStraightness) {
@@ -205,6 +208,21 @@ TEST_F(MeasuringSteps, RecipeCheckNamesFileAndLineOfABadField) {
   EXPECT_NE(text.find("length"), std::string::npos) << text;
   EXPECT_NE(text.find("plate.recipe.yaml:11:"), std::string::npos) << text;
   EXPECT_NE(text.find("needs 'measure: pairs'"), std::string::npos) << text;
+}
+
+// A rectangle relative to a pose step follows its pose: centre mapped, axis turned, sizes scaled.
+TEST(PlacedRect, FollowsThePose) {
+  const Pose2D pose{300, 200, radians(30), 2.0};
+  const MeasuringRect r = placeRect(poseMap(pose, {10, 10}), {20, 10}, 40, 10, 15);
+  EXPECT_NEAR(r.cx, 300 + 20 * std::cos(radians(30)), 1e-9);
+  EXPECT_NEAR(r.cy, 200 - 20 * std::sin(radians(30)), 1e-9);
+  EXPECT_NEAR(r.length, 80, 1e-9);
+  EXPECT_NEAR(r.width, 20, 1e-9);
+  EXPECT_NEAR(r.angle, 45, 1e-9);
+  EXPECT_TRUE(
+      insideRect(r, {r.cx + 39 * std::cos(radians(45)), r.cy - 39 * std::sin(radians(45))}));
+  EXPECT_FALSE(
+      insideRect(r, {r.cx + 41 * std::cos(radians(45)), r.cy - 41 * std::sin(radians(45))}));
 }
 
 }  // namespace
