@@ -56,7 +56,8 @@ BlobStep::BlobStep() {
 std::shared_ptr<const config::StepParams> BlobStep::read(config::StepReading& in) const {
   auto b = std::make_shared<BlobStepParams>();
   fields_.read(*b, in);
-  if (b->maxArea < b->minArea) in.error(in["max_area"], "'max_area' is below 'min_area'");
+  if (b->maxArea < b->minArea)
+    in.error(in["max_area"] ? in["max_area"] : in["min_area"], "'max_area' is below 'min_area'");
   return b;
 }
 
