@@ -210,6 +210,56 @@ TEST_F(MeasuringSteps, RecipeCheckNamesFileAndLineOfABadField) {
   EXPECT_NE(text.find("needs 'measure: pairs'"), std::string::npos) << text;
 }
 
+TEST_F(MeasuringSteps, BlobOutsideTheImageFails) {
+  const auto out = inspect(R"(  - id: b
+    kind: blob
+    centre: [-100, 900]
+    length: 30
+    width: 30
+    checks:
+      count: {nominal: 1, tol_minus: 0, tol_plus: 0}
+)");
+  EXPECT_NE(plate::failures(out).find("b: blobs not searched: the blob region lies outside"),
+            std::string::npos)
+      << plate::failures(out);
+}
+
+// With a lens model and a measuring plane, values are measured in the plane, in mm; a check in
+// px gets them back through the scale.
+TEST_F(MeasuringSteps, InACalibratedPlaneValuesAreMillimetresThere) {
+  const auto out = plate::inspect(dir_, R"(  - id: across
+    kind: caliper
+    centre: [320, 240]
+    length: 300
+    width: 10
+    measure: pairs
+    polarity: rising
+    checks:
+      width: {nominal: 12, tol_minus: 0.01, tol_plus: 0.01}
+  - id: across_px
+    kind: caliper
+    centre: [320, 240]
+    length: 300
+    width: 10
+    measure: pairs
+    checks:
+      width: {nominal: 240, tol_minus: 0.2, tol_plus: 0.2, unit: px}
+  - id: top
+    kind: line
+    centre: [320, 152]
+    length: 200
+    width: 16
+    checks:
+      position: {nominal: -0.1, tol_minus: 0.005, tol_plus: 0.005}
+      angle: {nominal: 0, tol_minus: 0.05, tol_plus: 0.05, unit: deg}
+)" + kBoreBlob + R"(    checks:
+      area: {nominal: 0.5027, tol_minus: 0.005, tol_plus: 0.005}
+)",
+                                  plate::render(), plate::straightPlane());
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "across.width").value, 12.0, 0.002);
+}
+
 // A rectangle relative to a pose step follows its pose: centre mapped, axis turned, sizes scaled.
 TEST(PlacedRect, FollowsThePose) {
   const Pose2D pose{300, 200, radians(30), 2.0};

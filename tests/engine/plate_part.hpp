@@ -45,12 +45,28 @@ inline config::RecipeLoadResult load(const fs::path& dir, const std::string& ste
   return config::loadRecipe(dir / "plate.recipe.yaml", kinds());
 }
 
-inline InspectionOutcome inspect(const fs::path& dir, const std::string& steps,
-                                 const cv::Mat& image) {
-  const auto loaded = load(dir, steps);
-  if (!loaded.recipe) throw std::runtime_error(loaded.diagnostics.text());
+// Scale only: 0.05 mm per pixel.
+inline config::Calibration scaleOnly() {
   config::Calibration calibration;
   calibration.mmPerPixel = kMmPerPixel;
+  return calibration;
+}
+
+// A lens model without distortion looking straight at a plane 120 mm away: 0.05 mm per pixel
+// in the plane, so that the plane's millimetres can be checked against the scale's.
+inline config::Calibration straightPlane() {
+  config::Calibration calibration = scaleOnly();
+  calibration.cameraMatrix = (cv::Mat_<double>(3, 3) << 2400, 0, 319.5, 0, 2400, 239.5, 0, 0, 1);
+  calibration.imageSize = {640, 480};
+  calibration.plane = PlanePose{.translationMm = {0, 0, 120}};
+  return calibration;
+}
+
+inline InspectionOutcome inspect(const fs::path& dir, const std::string& steps,
+                                 const cv::Mat& image,
+                                 const config::Calibration& calibration = scaleOnly()) {
+  const auto loaded = load(dir, steps);
+  if (!loaded.recipe) throw std::runtime_error(loaded.diagnostics.text());
   const auto recipe =
       prepareRecipe(std::make_shared<const config::Recipe>(*loaded.recipe), calibration);
   return inspectPart({image, std::nullopt}, *recipe);
