@@ -34,7 +34,9 @@ CaliperStep::CaliperStep() {
                           "the rectangle's centre along its axis."),
        config::checkField("width", Quantity::Length,
                           "measure: pairs: the first selected pair's width.", 0.0),
-       config::checkField("count", Quantity::Count, "Number of selected edges (or pairs).", 0.0),
+       config::checkField(
+           "count", Quantity::Count,
+           "Number of selected edges (or pairs); none fails the step with that cause.", 0.0),
        config::checkField("spacing", Quantity::Length,
                           "Mean distance between neighbouring selected edges (or pair centres); "
                           "needs two.",
