@@ -35,8 +35,9 @@ enum class FieldType {
 };
 
 // What a checked value measures. It decides the allowed units and whether the nominal value is
-// inherently non-negative (a diameter is, a position offset is not).
-enum class Quantity { Length, Angle, Count, Score };
+// inherently non-negative (a diameter is, a position offset is not). An area's units are the
+// squares of a length's (mm and px in the file mean mm^2 and px^2).
+enum class Quantity { Length, Angle, Count, Score, Area };
 
 struct FieldSpec {
   std::string name;

@@ -57,8 +57,8 @@ const ObjectSpec& checkFormat() {
         .minimum = 0.0},
        {.name = "unit",
         .type = F::Enum,
-        .description = "mm or px for lengths (default mm), deg for angles; none for "
-                       "counts and scores.",
+        .description = "mm or px for lengths (default mm; for areas mm^2 or px^2), deg for "
+                       "angles; none for counts and scores.",
         .choices = {"mm", "deg", "px"}},
        {.name = "plc",
         .type = F::Object,

@@ -135,9 +135,12 @@ class RecipeReader {
     const std::string unit = text(node["unit"]);
     switch (c.quantity) {
       case Quantity::Length:
+      case Quantity::Area:
         c.unit = unit == "px" ? Unit::Pixel : Unit::Millimetre;
         if (unit == "deg")
-          error(node["unit"], label + " is a length: its unit is mm or px, not deg");
+          error(node["unit"], label + " is a" +
+                                  (c.quantity == Quantity::Area ? "n area" : " length") +
+                                  ": its unit is mm or px, not deg");
         break;
       case Quantity::Angle:
         c.unit = Unit::Degree;

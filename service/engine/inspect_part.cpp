@@ -13,9 +13,13 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double toCheckUnit(double value, const config::Check& check, bool lengthsInMm, double mmPerPixel) {
-  if (check.quantity != config::Quantity::Length) return value;
-  if (lengthsInMm) return check.unit == config::Unit::Pixel ? value / mmPerPixel : value;
-  return check.unit == config::Unit::Millimetre ? value * mmPerPixel : value;
+  if (check.quantity != config::Quantity::Length && check.quantity != config::Quantity::Area)
+    return value;
+  // An area scales with the square of a length.
+  const double factor =
+      check.quantity == config::Quantity::Area ? mmPerPixel * mmPerPixel : mmPerPixel;
+  if (lengthsInMm) return check.unit == config::Unit::Pixel ? value / factor : value;
+  return check.unit == config::Unit::Millimetre ? value * factor : value;
 }
 
 std::string unitName(const config::Check& check) {
@@ -24,6 +28,8 @@ std::string unitName(const config::Check& check) {
       return "count";
     case config::Quantity::Score:
       return "score";
+    case config::Quantity::Area:
+      return std::string(config::toString(check.unit)) + "2";
     default:
       return std::string(config::toString(check.unit));
   }
@@ -121,7 +127,10 @@ InspectionOutcome inspectPart(const PartInput& part, const PreparedRecipe& prepa
         values.push_back(std::move(m));
       }
       if (result.point)
-        out.overlay.label(*result.point + cv::Point2d(8, -8), labelText(step.id, values), stepPass);
+        out.overlay.label(
+            *result.point + cv::Point2d(8, -8),
+            labelText(step.id, values) + (result.note.empty() ? "" : " (" + result.note + ")"),
+            stepPass);
       out.measurements.insert(out.measurements.end(), values.begin(), values.end());
       done.emplace(step.id, std::move(result));
     }

@@ -11,7 +11,8 @@ namespace facet::service {
 
 struct StepResult {
   bool ok = true;
-  std::string cause;                        // why !ok, for people ("circle not measured: ...")
+  std::string cause;  // why !ok, for people ("circle not measured: ...")
+  std::string note;   // a reservation about a result that stands ("measured inside the image only")
   std::optional<cv::Matx33d> refToImage;    // pose steps: reference pixels -> live pixels
   std::optional<cv::Rect2d> referenceView;  // pose steps: the reference's extent, its pixels
   std::optional<cv::Point2d> point;         // a position in the live image

@@ -53,8 +53,16 @@ TEST(Examples, RecipeOutputsJoinTheStationRegisterMapWithoutCollisions) {
   EXPECT_EQ(spacing->type, plc::ValueType::ScaledInt32);
   EXPECT_DOUBLE_EQ(spacing->factor, 1000.0);
   EXPECT_EQ(spacing->wordOrder, plc::WordOrder::ABCD);
-  EXPECT_NE(spacing->origin.find("bracket_registration.recipe.yaml:51:"), std::string::npos)
+  EXPECT_NE(spacing->origin.find("bracket_registration.recipe.yaml:52:"), std::string::npos)
       << spacing->origin;
+  // The measuring tools' outputs follow the bores'.
+  for (const auto& [name, address] : {std::pair<std::string, int>{"leg_width.width", 106},
+                                      {"top_edge.straightness", 108},
+                                      {"corner_bore.presence", 109}}) {
+    const plc::ResultOutput* out = map.findResult(name);
+    ASSERT_NE(out, nullptr) << name;
+    EXPECT_EQ(out->address, address) << name;
+  }
 }
 
 TEST(Examples, ShippedSchemasEqualTheGeneratedOnes) {

@@ -125,7 +125,8 @@ TEST_F(RecipeValidation, UnknownStepKindSuggestsOne) {
   const auto r = load(kHead + "  - id: hole\n    kind: circel\n");
   EXPECT_TRUE(hasDiagnostic(r.diagnostics, 10, 11,
                             "unknown step kind 'circel' (did you mean 'circle'?); expected one of "
-                            "align, fiducials, shape, circle, distance, scan_align"));
+                            "align, fiducials, shape, circle, caliper, line, blob, distance, "
+                            "scan_align"));
 }
 
 TEST_F(RecipeValidation, UnknownEnumNameSuggestsOne) {

@@ -1,0 +1,42 @@
+#pragma once
+// `caliper`: edges or edge pairs along a rectangle placed on the part (an edge's position, a
+// slot's or a bar's width, the count and pitch of repeated edges such as pins or a comb).
+
+#include <optional>
+#include <string>
+
+#include "algorithms/measure/caliper.hpp"
+#include "config/step_fields.hpp"
+#include "service/engine/step_unit.hpp"
+
+namespace facet::service {
+
+struct CaliperStepParams : config::StepParams {
+  enum class Measure { Edges, Pairs };
+  std::optional<std::string> relativeTo;
+  cv::Point2d centre;  // pixels of the relative_to step's reference image
+  double length = 0;   // pixels, along the measuring axis
+  double width = 0;    // pixels, across it (the profile is averaged over it)
+  double angle = 0;    // degrees, relative to the relative_to step's rotation
+  Measure measure = Measure::Edges;
+  EdgePolarity polarity = EdgePolarity::Any;
+  EdgeSelect select = EdgeSelect::All;
+  double minAmplitude = 20.0;  // grey levels (8-bit scale)
+};
+
+class CaliperStep : public StepUnit {
+ public:
+  CaliperStep();
+  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
+  [[nodiscard]] config::StepOffers offers() const override { return {.point = true}; }
+  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
+      config::StepReading& in) const override;
+  [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
+
+ private:
+  config::StepFields<CaliperStepParams> fields_;
+  config::ObjectSpec checks_;
+  config::StepKindSpec format_;
+};
+
+}  // namespace facet::service

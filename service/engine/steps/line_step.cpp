@@ -1,0 +1,93 @@
+#include "service/engine/steps/line_step.hpp"
+
+#include <cmath>
+
+#include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/measure/line_measure.hpp"
+#include "config/recipe_format.hpp"
+#include "service/engine/steps/edge_polarity_names.hpp"
+#include "service/engine/steps/placed_rect.hpp"
+#include "service/engine/steps/pose_fields.hpp"
+
+namespace facet::service {
+
+using config::Quantity;
+
+LineStep::LineStep() {
+  addRelativeTo(fields_);
+  addMeasuringRect(fields_, "Length of the rectangle along the expected line, pixels.",
+                   "Width across the line, pixels: the edge is searched over it.");
+  fields_.choice("polarity", &LineStepParams::polarity, edgePolarityNames(),
+                 "rising (dark to light across the axis, towards (sin a, cos a): for angle 0 "
+                 "dark above), falling or any.");
+  fields_.number("min_amplitude", &LineStepParams::minAmplitude,
+                 "Smallest grey step of an edge point, grey levels (8-bit scale).",
+                 {.minimum = 0.0, .exclusiveMinimum = true});
+  checks_ = {"line checks",
+             "",
+             {config::checkField("angle", Quantity::Angle,
+                                 "The line's angle in the relative_to step's frame (nominal: the "
+                                 "rectangle's angle)."),
+              config::checkField("position", Quantity::Length,
+                                 "Signed offset of the line from the rectangle's centre, across "
+                                 "the axis."),
+              config::checkField("straightness", Quantity::Length,
+                                 "Largest deviation of an edge point from the fitted line.", 0.0),
+              config::checkField("rms", Quantity::Length,
+                                 "RMS distance of the edge points from the fitted line.", 0.0)}};
+  format_ = config::stepFormat(
+      "line", "A straight edge in a rectangle laid along it: angle, straightness, RMS.",
+      fields_.specs(), checks_);
+}
+
+std::shared_ptr<const config::StepParams> LineStep::read(config::StepReading& in) const {
+  auto l = std::make_shared<LineStepParams>();
+  fields_.read(*l, in);
+  return l;
+}
+
+StepResult LineStep::run(const config::Step& step, StepContext& part) const {
+  const auto& l = step.as<LineStepParams>();
+  const MeasuringRect rect =
+      placeRect(part.frameOf(l.relativeTo), l.centre, l.length, l.width, l.angle);
+  LineMeasureParams p;
+  p.polarity = l.polarity;
+  p.minAmplitude = l.minAmplitude;
+  const LineMeasurement m = measureLine(part.grey, rect, p);
+  part.overlay.polygon(rectCorners(rect), true, true);
+  if (!m.ok()) return StepResult::failed("line not measured: " + m.message);
+
+  // With a lens model and a measuring plane, the angle is taken between the line and the axis as
+  // the plane sees them, and deviations use the plane's scale at the line's middle.
+  const auto plane = part.calibration.worldMapping();
+  const auto where = [&](cv::Point2d q) { return plane ? plane->toPlane(q) : q; };
+  const cv::Point2d centre(rect.cx, rect.cy);
+  const cv::Point2d mid = (m.p1 + m.p2) * 0.5;
+  const MeasuringPath path(rect);
+  const cv::Point2d axis = where(centre + path.axisAt(0)) - where(centre);
+  const cv::Point2d along = where(m.p2) - where(m.p1);
+  const double turn = std::atan2(axis.x * along.y - axis.y * along.x, axis.dot(along));
+  cv::Point2d across = where(centre + path.acrossAt(0)) - where(centre);
+  across /= cv::norm(across);
+  // Offset across the axis of the line's crossing with the rectangle's centre line.
+  const cv::Point2d u = along / cv::norm(along);
+  const cv::Point2d v = where(centre) - where(mid);
+  const double cross = u.x * across.y - u.y * across.x;
+  const double offset = std::abs(cross) > 1e-9 ? (v.x * u.y - v.y * u.x) / cross : 0.0;
+
+  StepResult r;
+  r.lengthsInMm = plane.has_value();
+  const double scale = plane ? plane->mmPerPixelAt(mid) : 1.0;
+  // The plane's y axis points down the image as pixels do: a turn towards it is clockwise.
+  r.values["angle"] = l.angle - degrees(turn);
+  r.values["position"] = offset;
+  r.values["straightness"] = m.straightness * scale;
+  r.values["rms"] = m.rms * scale;
+  r.point = mid;
+  r.angleDeg = m.angle;
+  if (m.partial) r.note = "part of the line rectangle lies outside the image: measured inside only";
+  part.overlay.polyline({m.p1, m.p2}, true);
+  return r;
+}
+
+}  // namespace facet::service

@@ -1,0 +1,279 @@
+// The caliper, line and blob steps on a rendered plate (plate_part.hpp), through recipe files as
+// the line writes them: values in mm, and the bad inputs (outside the image, nothing to find, a
+// wrong key) failing with their cause, never with a made-up value.
+#include <cmath>
+
+#include "algorithms/geometry/pose2d.hpp"
+#include "service/engine/frame_maps.hpp"
+#include "service/engine/steps/placed_rect.hpp"
+#include "tests/engine/plate_part.hpp"
+
+namespace facet::service {
+namespace {
+
+namespace fs = std::filesystem;
+using plate::value;
+
+class MeasuringSteps : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("facet-measuring-" + std::to_string(::getpid()));
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  InspectionOutcome inspect(const std::string& steps, const cv::Mat& image = plate::render()) {
+    return plate::inspect(dir_, steps, image);
+  }
+  static bool labelSays(const InspectionOutcome& out, const std::string& words) {
+    for (const auto& s : out.overlay.shapes)
+      if (s.kind == OverlayShape::Kind::Label && s.text.find(words) != std::string::npos)
+        return true;
+    return false;
+  }
+  fs::path dir_;
+};
+
+TEST_F(MeasuringSteps, CaliperPairGivesThePlatesWidth) {
+  const auto out = inspect(R"(  - id: across
+    kind: caliper
+    centre: [320, 240]
+    length: 300
+    width: 10
+    measure: pairs
+    polarity: rising
+    checks:
+      width: {nominal: 12, tol_minus: 0.01, tol_plus: 0.01}
+      position: {nominal: 0, tol_minus: 0.01, tol_plus: 0.01}
+      count: {nominal: 1, tol_minus: 0, tol_plus: 0}
+)");
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "across.width").value, 12.0, 0.002);
+  EXPECT_EQ(value(out, "across.width").unit, "mm");
+}
+
+TEST_F(MeasuringSteps, CaliperCountsRepeatedEdgesAndTheirSpacing) {
+  const auto out = inspect(R"(  - id: slots
+    kind: caliper
+    centre: [320, 280]
+    length: 60
+    width: 10
+    polarity: falling
+    checks:
+      count: {nominal: 3, tol_minus: 0, tol_plus: 0}
+      spacing: {nominal: 1.0, tol_minus: 0.01, tol_plus: 0.01}
+      position: {nominal: -1.15, tol_minus: 0.01, tol_plus: 0.01}
+)");
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_EQ(value(out, "slots.count").value, 3);
+  EXPECT_NEAR(value(out, "slots.spacing").value, 1.0, 0.002);
+}
+
+TEST_F(MeasuringSteps, CaliperPartlyOutsideMeasuresInsideAndSaysSo) {
+  const auto out = inspect(R"(  - id: edge
+    kind: caliper
+    centre: [100, 240]
+    length: 600
+    width: 10
+    polarity: rising
+    select: first
+    checks:
+      position: {nominal: 5, tol_minus: 0.01, tol_plus: 0.01, unit: mm}
+)");
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "edge.position").value, 5.0, 0.002);
+  EXPECT_TRUE(labelSays(out, "outside the image"));
+}
+
+TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {
+  const std::string check =
+      "    checks:\n      position: {nominal: 0, tol_minus: 1, tol_plus: 1}\n";
+  const auto outside = inspect(
+      "  - id: c\n    kind: caliper\n    centre: [-200, -200]\n    length: 40\n    width: 10\n" +
+      check);
+  EXPECT_EQ(outside.verdict, Verdict::Fail);
+  ASSERT_FALSE(outside.failedChecks.empty());
+  EXPECT_NE(outside.failedChecks[0].find("c: caliper not measured: the caliper lies outside"),
+            std::string::npos)
+      << outside.failedChecks[0];
+  EXPECT_TRUE(std::isnan(value(outside, "c.position").value));
+
+  // Only a rising edge at x = 200 here: a falling one is not made up.
+  const auto wrongPolarity = inspect(
+      "  - id: c\n    kind: caliper\n    centre: [200, 240]\n    length: 40\n    width: 10\n"
+      "    polarity: falling\n" +
+      check);
+  EXPECT_EQ(wrongPolarity.verdict, Verdict::Fail);
+  EXPECT_NE(plate::failures(wrongPolarity).find("no edge"), std::string::npos)
+      << plate::failures(wrongPolarity);
+  EXPECT_TRUE(std::isnan(value(wrongPolarity, "c.position").value));
+
+  const auto flat = inspect(
+      "  - id: c\n    kind: caliper\n    centre: [400, 200]\n    length: 40\n    width: 10\n" +
+      check);
+  EXPECT_NE(plate::failures(flat).find("no contrast"), std::string::npos) << plate::failures(flat);
+}
+
+TEST_F(MeasuringSteps, LineGivesAngleOffsetAndStraightness) {
+  const auto out = inspect(R"(  - id: top
+    kind: line
+    centre: [320, 152]
+    length: 200
+    width: 16
+    polarity: rising
+    checks:
+      angle: {nominal: 0, tol_minus: 0.05, tol_plus: 0.05, unit: deg}
+      position: {nominal: -0.1, tol_minus: 0.005, tol_plus: 0.005}
+      straightness: {nominal: 0, tol_minus: 0, tol_plus: 0.01}
+      rms: {nominal: 0, tol_minus: 0, tol_plus: 0.005}
+  - id: left
+    kind: line
+    centre: [202, 240]
+    length: 150
+    width: 16
+    angle: 90
+    polarity: rising
+    checks:
+      angle: {nominal: 90, tol_minus: 0.05, tol_plus: 0.05, unit: deg}
+      position: {nominal: -2, tol_minus: 0.1, tol_plus: 0.1, unit: px}
+)");
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "top.position").value, -0.1, 0.002);
+  EXPECT_NEAR(value(out, "left.angle").value, 90.0, 0.02);
+}
+
+TEST_F(MeasuringSteps, LineOutsideTheImageFails) {
+  const auto out = inspect(R"(  - id: l
+    kind: line
+    centre: [900, 900]
+    length: 100
+    width: 10
+    checks:
+      straightness: {nominal: 0, tol_minus: 0, tol_plus: 0.01}
+)");
+  EXPECT_EQ(out.verdict, Verdict::Fail);
+  EXPECT_NE(plate::failures(out).find("l: line not measured: the line rectangle lies outside"),
+            std::string::npos)
+      << plate::failures(out);
+}
+
+const std::string kBoreBlob = R"(  - id: bore
+    kind: blob
+    centre: [260, 200]
+    length: 30
+    width: 30
+    polarity: dark
+)";
+
+TEST_F(MeasuringSteps, BlobFindsTheBoreWithItsArea) {
+  const auto out = inspect(kBoreBlob + R"(    checks:
+      presence: {nominal: 1, tol_minus: 0, tol_plus: 0}
+      count: {nominal: 1, tol_minus: 0, tol_plus: 0}
+      area: {nominal: 0.5027, tol_minus: 0.005, tol_plus: 0.005}
+)");
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "bore.area").value, 64 * CV_PI * 0.0025, 0.005);
+  EXPECT_EQ(value(out, "bore.area").unit, "mm2");
+}
+
+TEST_F(MeasuringSteps, MissingBlobFailsWithTheCauseUnlessAbsenceIsChecked) {
+  const auto required = inspect(kBoreBlob + R"(    checks:
+      presence: {nominal: 1, tol_minus: 0, tol_plus: 0}
+)",
+                                plate::render(false));
+  EXPECT_EQ(required.verdict, Verdict::Fail);
+  EXPECT_NE(plate::failures(required).find("bore: no blob found"), std::string::npos)
+      << plate::failures(required);
+  EXPECT_TRUE(std::isnan(value(required, "bore.presence").value));
+
+  const auto absence = inspect(kBoreBlob + R"(    required: false
+    checks:
+      presence: {nominal: 0, tol_minus: 0, tol_plus: 0}
+)",
+                               plate::render(false));
+  EXPECT_EQ(absence.verdict, Verdict::Pass) << plate::failures(absence);
+}
+
+TEST_F(MeasuringSteps, RecipeCheckNamesFileAndLineOfABadField) {
+  const auto loaded = plate::load(dir_, R"(  - id: c
+    kind: caliper
+    centre: [320, 240]
+    length: 0
+    width: 10
+    checks:
+      width: {nominal: 1, tol_minus: 0.1, tol_plus: 0.1}
+)");
+  EXPECT_FALSE(loaded.recipe);
+  const std::string text = loaded.diagnostics.text();
+  // length: 0 is line 8; a width check without pairs is line 11.
+  EXPECT_NE(text.find("plate.recipe.yaml:8:"), std::string::npos) << text;
+  EXPECT_NE(text.find("length"), std::string::npos) << text;
+  EXPECT_NE(text.find("plate.recipe.yaml:11:"), std::string::npos) << text;
+  EXPECT_NE(text.find("needs 'measure: pairs'"), std::string::npos) << text;
+}
+
+TEST_F(MeasuringSteps, BlobOutsideTheImageFails) {
+  const auto out = inspect(R"(  - id: b
+    kind: blob
+    centre: [-100, 900]
+    length: 30
+    width: 30
+    checks:
+      count: {nominal: 1, tol_minus: 0, tol_plus: 0}
+)");
+  EXPECT_NE(plate::failures(out).find("b: blobs not searched: the blob region lies outside"),
+            std::string::npos)
+      << plate::failures(out);
+}
+
+// With a lens model and a measuring plane, values are measured in the plane, in mm; a check in
+// px gets them back through the scale.
+TEST_F(MeasuringSteps, InACalibratedPlaneValuesAreMillimetresThere) {
+  const auto out = plate::inspect(dir_, R"(  - id: across
+    kind: caliper
+    centre: [320, 240]
+    length: 300
+    width: 10
+    measure: pairs
+    polarity: rising
+    checks:
+      width: {nominal: 12, tol_minus: 0.01, tol_plus: 0.01}
+  - id: across_px
+    kind: caliper
+    centre: [320, 240]
+    length: 300
+    width: 10
+    measure: pairs
+    checks:
+      width: {nominal: 240, tol_minus: 0.2, tol_plus: 0.2, unit: px}
+  - id: top
+    kind: line
+    centre: [320, 152]
+    length: 200
+    width: 16
+    checks:
+      position: {nominal: -0.1, tol_minus: 0.005, tol_plus: 0.005}
+      angle: {nominal: 0, tol_minus: 0.05, tol_plus: 0.05, unit: deg}
+)" + kBoreBlob + R"(    checks:
+      area: {nominal: 0.5027, tol_minus: 0.005, tol_plus: 0.005}
+)",
+                                  plate::render(), plate::straightPlane());
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "across.width").value, 12.0, 0.002);
+}
+
+// A rectangle relative to a pose step follows its pose: centre mapped, axis turned, sizes scaled.
+TEST(PlacedRect, FollowsThePose) {
+  const Pose2D pose{300, 200, radians(30), 2.0};
+  const MeasuringRect r = placeRect(poseMap(pose, {10, 10}), {20, 10}, 40, 10, 15);
+  EXPECT_NEAR(r.cx, 300 + 20 * std::cos(radians(30)), 1e-9);
+  EXPECT_NEAR(r.cy, 200 - 20 * std::sin(radians(30)), 1e-9);
+  EXPECT_NEAR(r.length, 80, 1e-9);
+  EXPECT_NEAR(r.width, 20, 1e-9);
+  EXPECT_NEAR(r.angle, 45, 1e-9);
+  EXPECT_TRUE(
+      insideRect(r, {r.cx + 39 * std::cos(radians(45)), r.cy - 39 * std::sin(radians(45))}));
+  EXPECT_FALSE(
+      insideRect(r, {r.cx + 41 * std::cos(radians(45)), r.cy - 41 * std::sin(radians(45))}));
+}
+
+}  // namespace
+}  // namespace facet::service
