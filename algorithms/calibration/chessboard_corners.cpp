@@ -8,16 +8,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/edges/subpixel_edges.hpp"
+#include "algorithms/image/grey8.hpp"
 
 namespace facet {
 namespace {
-
-cv::Mat to8Bit(const cv::Mat& image) {
-  if (image.depth() == CV_8U) return image;
-  cv::Mat out;
-  image.convertTo(out, CV_8U, 1.0 / 256.0);
-  return out;
-}
 
 double meanGrey(const cv::Mat& image8, cv::Point2d centre, double radius) {
   const int r = std::max(1, static_cast<int>(radius));
@@ -197,7 +191,7 @@ bool refineChessboardCorners(const cv::Mat& image, int cols, int rows,
 
 PatternDetection detectChessboard(const cv::Mat& image, const BoardSpec& board) {
   PatternDetection out;
-  const cv::Mat image8 = to8Bit(image);
+  const cv::Mat image8 = toGrey8(image);
   // The grid only needs to be found to within a pixel or two (the refinement does the rest):
   // large images are searched at half size, where OpenCV's detectors run about 4x faster.
   const bool halve = image8.cols > 800;

@@ -8,16 +8,10 @@
 
 #include "algorithms/calibration/conic.hpp"
 #include "algorithms/edges/subpixel_edges.hpp"
+#include "algorithms/image/grey8.hpp"
 
 namespace facet {
 namespace {
-
-cv::Mat to8Bit(const cv::Mat& image) {
-  if (image.depth() == CV_8U) return image;
-  cv::Mat out;
-  image.convertTo(out, CV_8U, 1.0 / 256.0);
-  return out;
-}
 
 // Plate order: right-handed as the camera sees it; of the two 180-degree turns of a symmetric
 // grid the one whose first mark is nearer the image's top-left corner.
@@ -44,7 +38,7 @@ std::optional<cv::Matx33d> robustConic(std::vector<cv::Point2d> pts) {
 
 CircleMarks detectCircleMarks(const cv::Mat& image, const BoardSpec& board) {
   CircleMarks out;
-  const cv::Mat image8 = to8Bit(image);
+  const cv::Mat image8 = toGrey8(image);
   cv::SimpleBlobDetector::Params blobs;
   blobs.minArea = 20;
   blobs.maxArea = static_cast<float>(image.total()) / static_cast<float>(board.pointCount());
