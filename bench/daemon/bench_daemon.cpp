@@ -44,6 +44,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "bench/machine_state.hpp"
 #include "camera/image_file_reader.hpp"
 #include "config/station_config.hpp"
 #include "plc/plc_simulator.hpp"
@@ -204,18 +205,8 @@ double ms(Clock::duration d) {
   return std::chrono::duration<double, std::milli>(d).count();
 }
 
-double cpuSeconds() {
-  timespec t{};
-  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-std::string loadAverage() {
-  std::ifstream f("/proc/loadavg");
-  std::string a, b, c;
-  f >> a >> b >> c;
-  return a + " " + b + " " + c;
-}
+using bench::cpuSeconds;
+using bench::loadAverage;
 
 // Mean per stage (facet_stage_ms) and per recipe step of one station's parts.
 struct StageSplit {

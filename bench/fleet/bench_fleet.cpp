@@ -29,6 +29,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include "bench/machine_state.hpp"
 #include "camera/camera_factory.hpp"
 #include "config/recipe_loader.hpp"
 #include "config/station_config.hpp"
@@ -58,18 +59,8 @@ double percentile(std::vector<double> v, double q) {
   return v[std::min(i, v.size() - 1)];
 }
 
-double cpuSeconds(clockid_t clock) {
-  timespec t{};
-  ::clock_gettime(clock, &t);
-  return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
-}
-
-std::string loadAverage() {
-  std::ifstream f("/proc/loadavg");
-  std::string a, b, c;
-  f >> a >> b >> c;
-  return a + " " + b + " " + c;
-}
+using bench::cpuSeconds;
+using bench::loadAverage;
 
 // The example station, its camera replaying the recorded bracket parts in a loop, its PLC the
 // simulator on `plcPort`, its stores in `dir`.
