@@ -50,6 +50,10 @@ struct LevenbergMarquardtCallbacks {
   Accept accept;
   Converged converged;
 };
+// Spelled out: clang before 17 does not deduce an aggregate's template arguments (P1816).
+template <class Cost, class Normal, class Trial, class Accept, class Converged>
+LevenbergMarquardtCallbacks(Cost, Normal, Trial, Accept, Converged)
+    -> LevenbergMarquardtCallbacks<Cost, Normal, Trial, Accept, Converged>;
 
 // Minimises the problem's cost starting from x (updated in place to the last accepted point).
 template <int N, class Problem>
