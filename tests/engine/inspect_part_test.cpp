@@ -132,6 +132,25 @@ TEST_F(InspectionTest, OversizedHoleFailsThatCheckOnly) {
   EXPECT_EQ(out.failedChecks, std::vector<std::string>{"big_hole.diameter"});
 }
 
+TEST_F(InspectionTest, HoleOffItsPlaceIsMeasuredWhereItIsAndFailsItsPosition) {
+  scene::SceneSpec spec;
+  spec.size = {640, 480};
+  spec.background = 40;
+  spec.blurSigma = 0.8;
+  spec.noiseSigma = 2;
+  scene::Scene scene(spec);
+  scene::PartDrawing bracket = scene::bracketPart();
+  bracket.primitives[2].centre.x += 8;  // the small hole 8 px = 0.4 mm off, outside its annulus
+  scene::placePart(scene, bracket, {300, 250, 0.0, 1.0}, 200, 40);
+  const auto out = inspect(scene.render());
+  EXPECT_EQ(out.verdict, Verdict::Fail);
+  EXPECT_NEAR(value(out, "small_hole.diameter").value, 0.7, 0.01);
+  EXPECT_TRUE(value(out, "small_hole.diameter").pass);
+  // The pitch grows by the offset: the defect is measured, not just reported as a failed step.
+  EXPECT_NEAR(value(out, "pitch.distance").value, 4.0003 + 0.4, 0.01);
+  EXPECT_EQ(out.failedChecks, std::vector<std::string>{"pitch.distance"});
+}
+
 TEST_F(InspectionTest, MissingHoleFailsItsStepAndTheDistanceThatNeedsIt) {
   const auto out = inspect(part({320, 240, 0.3, 1.0}, 0.0));
   EXPECT_EQ(out.verdict, Verdict::Fail);

@@ -1,6 +1,7 @@
 #include "service/engine/steps/circle_step.hpp"
 
 #include "algorithms/calibration/plane_circle.hpp"
+#include "algorithms/circle/disc_locator.hpp"
 #include "algorithms/registration/register_images.hpp"
 #include "config/recipe_format.hpp"
 #include "config/yaml_validation.hpp"
@@ -63,11 +64,30 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   p.radius = c.nominalDiameter / 2.0 / scale;
   p.width = c.searchWidth / scale;
   p.polarity = c.polarity;
-  const CircleMeasurement m = measureCircle(part.grey, p);
+  CircleMeasurement m = measureCircle(part.grey, p);
   part.overlay.circle(expected, std::max(1.0, p.radius - p.width), true, true);
   part.overlay.circle(expected, p.radius + p.width, true, true);
+  std::string note;
+  if (!m.ok() && !m.has(CircleFailure::BadInput) && !m.has(CircleFailure::AnnulusOutsideImage)) {
+    // Nothing round in the annulus: a hole drilled off its place is still a hole, and the line
+    // must learn how far off it is, not only that the step failed. Look for the disc within one
+    // diameter of its nominal place and measure it there; its position check then judges it.
+    if (const auto found = locateDisc(part.grey, {.expected = expected,
+                                                  .radius = p.radius,
+                                                  .searchRadius = 2.0 * p.radius,
+                                                  .polarity = c.polarity,
+                                                  .minScore = 0.6})) {
+      CircleMeasureParams there = p;
+      there.centre = found->centre;
+      if (const CircleMeasurement moved = measureCircle(part.grey, there); moved.ok()) {
+        m = moved;
+        note = "found off its nominal place";
+      }
+    }
+  }
   if (!m.ok()) return StepResult::failed("circle not measured: " + circleFailureCause(m.failures));
   StepResult r;
+  r.note = note;
   if (plane) {
     const auto w = circleInPlane(m, *plane);
     if (!w) return StepResult::failed("circle not measured: its rim does not map into the plane");
