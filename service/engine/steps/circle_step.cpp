@@ -20,7 +20,9 @@ CircleStep::CircleStep() {
                  {.minimum = 0.0, .exclusiveMinimum = true, .required = true});
   fields_.number("search_width", &CircleParams::searchWidth,
                  "Width of the annulus searched around the nominal circle, mm; less than the "
-                 "diameter.",
+                 "diameter. A circle not found there is looked for within one diameter of its "
+                 "nominal centre and measured where it is (its x, y and position report the "
+                 "offset).",
                  {.minimum = 0.0, .exclusiveMinimum = true, .required = true});
   fields_.choice("polarity", &CircleParams::polarity, circlePolarityNames(),
                  "Circle darker (a hole) or lighter than its surroundings.");
