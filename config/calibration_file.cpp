@@ -214,6 +214,11 @@ std::optional<CalibrationData> readOpenCvFile(const std::filesystem::path& file,
   } catch (const cv::Exception& e) {
     out.error({file}, "not readable: " + e.msg);
     return std::nullopt;
+  } catch (const std::exception& e) {
+    // OpenCV's parser lets some standard exceptions through on malformed files (found by the
+    // calibration fuzzer: a mangled !!opencv-matrix header).
+    out.error({file}, std::string("not readable: ") + e.what());
+    return std::nullopt;
   }
   bool ok = true;
   if (K.rows != 3 || K.cols != 3) {
