@@ -91,7 +91,8 @@ TEST(ReplayShards, ThreeShardsAsProcessesGiveExactlyTheRowsOfOneRun) {
   // Merging a shard twice is refused, naming the repeated part.
   const std::string again = dir / ("shard" + std::to_string(largest) + ".db");
   ASSERT_GT(shareOf[largest], 0);
-  const auto twice = runFacet("results merge " + again + " " + again + " --out " + (dir / "twice.db"));
+  const auto twice =
+      runFacet("results merge " + again + " " + again + " --out " + (dir / "twice.db"));
   EXPECT_EQ(twice.exitCode, 1);
   EXPECT_NE(twice.err.find("is in an earlier input"), std::string::npos) << twice.err;
 }
