@@ -87,8 +87,9 @@ steps:
     return inspectPart({image, std::nullopt}, *recipe_);
   }
 
-  // The bracket at a pose, optionally with its big hole resized or filled.
-  static cv::Mat part(const Pose2D& pose, double bigHoleRadius) {
+  // The bracket at a pose, optionally with its big hole resized or filled, or its small hole
+  // moved along the part's x.
+  static cv::Mat part(const Pose2D& pose, double bigHoleRadius, double smallHoleShift = 0.0) {
     scene::SceneSpec spec;
     spec.size = {640, 480};
     spec.background = 40;
@@ -97,6 +98,7 @@ steps:
     scene::Scene scene(spec);
     scene::PartDrawing bracket = scene::bracketPart();
     bracket.primitives[1].radius = bigHoleRadius;
+    bracket.primitives[2].centre.x += smallHoleShift;
     scene::placePart(scene, bracket, pose, 200, 40);
     return scene.render();
   }
@@ -133,16 +135,8 @@ TEST_F(InspectionTest, OversizedHoleFailsThatCheckOnly) {
 }
 
 TEST_F(InspectionTest, HoleOffItsPlaceIsMeasuredWhereItIsAndFailsItsPosition) {
-  scene::SceneSpec spec;
-  spec.size = {640, 480};
-  spec.background = 40;
-  spec.blurSigma = 0.8;
-  spec.noiseSigma = 2;
-  scene::Scene scene(spec);
-  scene::PartDrawing bracket = scene::bracketPart();
-  bracket.primitives[2].centre.x += 8;  // the small hole 8 px = 0.4 mm off, outside its annulus
-  scene::placePart(scene, bracket, {300, 250, 0.0, 1.0}, 200, 40);
-  const auto out = inspect(scene.render());
+  // The small hole 8 px = 0.4 mm off, outside its annulus.
+  const auto out = inspect(part({300, 250, 0.0, 1.0}, 10.0, 8.0));
   EXPECT_EQ(out.verdict, Verdict::Fail);
   EXPECT_NEAR(value(out, "small_hole.diameter").value, 0.7, 0.01);
   EXPECT_TRUE(value(out, "small_hole.diameter").pass);
