@@ -132,10 +132,22 @@ def main():
         assert BROKEN_RECIPE in problems and 'circel' in problems, problems
 
         # The overlay's labels lie inside the picture, clear of the banner and of each other.
+        # Every demo part is inspected (pass or fail), and an inspected part's picture labels
+        # what it measured. The summary read around the picture names the part it shows.
+        before = wd.http('GET', base + '/api/summary')[1]['recent'][-1]
         status, png = wd.http('GET', base + '/api/last.png')
         assert status == 200, status
+        after = wd.http('GET', base + '/api/summary')[1]['recent'][-1]
         open(os.path.join(args.out, 'last-overlay.png'), 'wb').write(png)
-        boxes = overlay_labels.check_labels_inside(png, '/api/last.png')
+        shown = 'the picture shows part %s%s: %s' % (
+            before['part_id'], '' if before == after else ' or %s' % after['part_id'],
+            [{k: p.get(k) for k in ('part_id', 'verdict', 'failed_checks', 'error')}
+             for p in ([before] if before == after else [before, after])])
+        print(shown)
+        for part in (before, after):
+            assert part['verdict'] in ('pass', 'fail'), 'a demo part was not inspected: %s\n%s' % (
+                shown, open(os.path.join(work, 'facetd.log')).read()[-4000:])
+        boxes = overlay_labels.check_labels_inside(png, '/api/last.png (%s)' % shown)
         print('overlay labels inside the picture and apart: %s' % boxes)
 
         badges = browser.run('return [...document.querySelectorAll("#health .badge")]'

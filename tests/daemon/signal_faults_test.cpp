@@ -91,6 +91,18 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
   plc.start();
   auto facetd = startFacetd(dir, station, "debug", /*withPlc=*/true);
 
+  // How long one part takes here (a fraction of a second, far more under a sanitizer): facetd
+  // is given that long per part it may be finishing, plus 30 s, to exit after SIGTERM.
+  const auto lineOf = [&](const std::string& text) {
+    return facetd->waitForLine(
+        [&](const std::string& l) { return l.find(text) != std::string::npos; }, 300s);
+  };
+  ASSERT_TRUE(lineOf("part=1 inspecting ")) << "no part inspected\n" << facetd->outputTail();
+  const auto firstBegan = Clock::now();
+  ASSERT_TRUE(lineOf("part=1 recipe=2 verdict=")) << "part 1 not finished\n"
+                                                  << facetd->outputTail();
+  const auto perPart = Clock::now() - firstBegan;
+
   // A part after the first has begun its inspection. (When the inspection is slower than the
   // camera, as under a sanitizer, parts in between are dropped as missed: any id >= 2 will do.)
   const auto startedLine = facetd->waitForLine(
@@ -104,8 +116,12 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
   facetd->signal(SIGTERM);
   const auto partId = std::stoll(startedLine->substr(startedLine->find("part=") + 5));
   const std::string part = "part " + std::to_string(partId);
-  const auto code = facetd->wait(30s);
-  ASSERT_TRUE(code.has_value()) << "facetd did not exit within 30 s of SIGTERM";
+  // The part in inspection and, at most, the one the camera handed over just before.
+  const auto allowed = std::chrono::duration_cast<std::chrono::milliseconds>(30s + 2 * perPart);
+  const auto code = facetd->wait(allowed);
+  ASSERT_TRUE(code.has_value())
+      << "facetd did not exit within " << allowed.count() << " ms of SIGTERM (one part took "
+      << std::chrono::duration_cast<std::chrono::milliseconds>(perPart).count() << " ms)";
   EXPECT_EQ(*code, 0);
 
   // SIGTERM arrived while that part was inspected: the log says so before the part's verdict.
