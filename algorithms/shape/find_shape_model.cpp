@@ -156,15 +156,28 @@ struct Finisher {
     // farther.
     const double tolerance = params.refineScaleTolerance;
     const cv::Rect roi = placedBox(box, start).boundingRect() + cv::Size(8, 8) - cv::Point(4, 4);
-    shape_detail::Refined r = shape_detail::refineLeastSquares(
-        image, model, roi, start, params.polarity, scaleRange || tolerance > 0.0);
-    if (!scaleRange && r.ok && std::abs(r.pose.scale / start.scale - 1.0) > tolerance)
+    const bool fitScale = scaleRange || tolerance > 0.0;
+    shape_detail::Refined r =
+        shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, fitScale);
+    const bool scaleMisfit =
+        !scaleRange && r.ok && std::abs(r.pose.scale / start.scale - 1.0) > tolerance;
+    if (scaleMisfit)
       r = shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, false);
     // A refinement that wanders off by more than the search's own uncertainty has locked onto
-    // something else; one that scores lower than its start made the pose worse.
+    // something else.
     if (!r.ok || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0) return interpolated;
     const Finished refined{r.pose, scoreAt(r.pose), r.residual};
-    return refined.score >= interpolated.score ? refined : interpolated;
+    // Where the refinement fitted the part fully (its scale too, within the tolerance), it is
+    // kept unless it lays the model on the image's edges less well than its start: the score
+    // cannot judge it, since a pose tilted towards a displaced hole may score higher than the
+    // one that fits the rest of the part (Refined::support). A part held at a scale it does
+    // not have fits nowhere exactly; there the pose that agrees best overall (the score) wins.
+    if (!fitScale || scaleMisfit)
+      return refined.score >= interpolated.score ? refined : interpolated;
+    // Nor may it turn a part found into one missed.
+    if (refined.score < params.minScore && interpolated.score >= params.minScore)
+      return interpolated;
+    return r.support >= r.startSupport ? refined : interpolated;
   }
 };
 

@@ -12,6 +12,7 @@ namespace facet::shape_detail {
 
 Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Rect roi, Pose2D pose,
                            Polarity polarity, bool withScale) {
+  const Pose2D start = pose;
   Refined result{pose, 0.0, false};
   roi &= cv::Rect(0, 0, image.cols, image.rows);
   if (roi.width < 3 || roi.height < 3) return result;
@@ -40,15 +41,15 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
     double r;
   };
   std::vector<Pair> pairs;
-  std::vector<double> absResiduals;
-  for (int iteration = 0; iteration < 15; ++iteration) {
-    const int radius = iteration < 2 ? 3 - iteration : 1;
-    const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+  // Each model point placed by `at` paired with the nearest direction-agreeing edge point within
+  // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
+  const auto correspond = [&](const Pose2D& at, int radius, bool anySign) {
+    const double c = std::cos(at.angle), s = std::sin(at.angle);
     double polaritySum = 0.0;
     pairs.clear();
     for (const auto& mp : model.finePoints) {
       const double px = mp.position.x, py = mp.position.y;
-      const cv::Point2d q = pose.apply({px, py});
+      const cv::Point2d q = at.apply({px, py});
       const double dx = c * mp.direction.x + s * mp.direction.y;
       const double dy = -s * mp.direction.x + c * mp.direction.y;
       const int cx = cvRound(q.x) - roi.x, cy = cvRound(q.y) - roi.y;
@@ -64,9 +65,7 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
           const double agree = polarity == Polarity::IgnoreLocal    ? std::abs(dot)
                                : polarity == Polarity::IgnoreGlobal ? sign * dot
                                                                     : dot;
-          if (agree < kMinCos &&
-              !(iteration == 0 && polarity == Polarity::IgnoreGlobal && std::abs(dot) >= kMinCos))
-            continue;
+          if (agree < kMinCos && !(anySign && std::abs(dot) >= kMinCos)) continue;
           const double d2 = (e.position.x - q.x) * (e.position.x - q.x) +
                             (e.position.y - q.y) * (e.position.y - q.y);
           if (d2 < bestD2) bestD2 = d2, bestIdx = row[u], bestDot = dot;
@@ -78,13 +77,34 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
       const double r = e.normal.x * (q.x - e.position.x) + e.normal.y * (q.y - e.position.y);
       // q = t + s R(a) p: dq/da = s R'(a) p, dq/ds = R(a) p.
       const double rpx = c * px + s * py, rpy = -s * px + c * py;
-      pairs.push_back({Eigen::Vector4d(e.normal.x, e.normal.y,
-                                       pose.scale * (e.normal.x * rpy - e.normal.y * rpx),
-                                       e.normal.x * rpx + e.normal.y * rpy),
-                       r});
+      pairs.push_back(
+          {Eigen::Vector4d(e.normal.x, e.normal.y, at.scale * (e.normal.x * rpy - e.normal.y * rpx),
+                           e.normal.x * rpx + e.normal.y * rpy),
+           r});
     }
+    return polaritySum;
+  };
+  // How well model points lie on image edges at `at`: each point within a pixel of an edge
+  // (across it) counts by Tukey's biweight of its distance, 1 on the edge, 0 a pixel away. A
+  // correlation score cannot tell a pose that fits the part from one tilted towards a displaced
+  // feature (a hole out of place): both overlap the edges within the score's tolerance of a
+  // pixel or two, and the tilted one may overlap more. A smooth weight, not a count within a
+  // threshold: two poses a few hundredths of a pixel apart must not be ranked by noise.
+  const auto support = [&](const Pose2D& at) {
+    correspond(at, 1, false);
+    double sum = 0.0;
+    for (const auto& pr : pairs)
+      if (std::abs(pr.r) < 1.0) sum += (1.0 - pr.r * pr.r) * (1.0 - pr.r * pr.r);
+    return sum;
+  };
+
+  std::vector<double> absResiduals;
+  for (int iteration = 0; iteration < 15; ++iteration) {
+    const int radius = iteration < 2 ? 3 - iteration : 1;
+    const double polaritySum =
+        correspond(pose, radius, iteration == 0 && polarity == Polarity::IgnoreGlobal);
     if (iteration == 0 && polarity == Polarity::IgnoreGlobal) sign = polaritySum < 0 ? -1.0 : 1.0;
-    if (pairs.size() < 6) return result;
+    if (pairs.size() < 6) break;  // result keeps the last pose that stood on enough pairs
 
     // Robust weights: Huber while the pose is coarse, then Tukey's biweight with a cut-off from
     // the median residual, so that edges of occluders and clutter drop out entirely.
@@ -110,9 +130,9 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
       sumSq += w * pr.r * pr.r;
       weightSum += w;
     }
-    if (weightSum < 6.0) return result;
+    if (weightSum < 6.0) break;
     Eigen::VectorXd delta = H.topLeftCorner(unknowns, unknowns).ldlt().solve(-g.head(unknowns));
-    if (!delta.allFinite()) return result;
+    if (!delta.allFinite()) break;
     pose.x += delta[0];
     pose.y += delta[1];
     pose.angle += delta[2];
@@ -121,6 +141,10 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
     if (iteration >= 3 && std::hypot(delta[0], delta[1]) < 1e-4 && std::abs(delta[2]) < 1e-6) break;
   }
   result.pose.angle = wrapAngle(result.pose.angle);
+  if (result.ok) {
+    result.support = support(result.pose);
+    result.startSupport = support(start);
+  }
   return result;
 }
 

@@ -15,6 +15,11 @@ struct Refined {
   Pose2D pose;
   double residual = 0.0;  // weighted RMS point-to-line distance, pixels
   bool ok = false;        // false: too few correspondences, the pose is the start pose
+  // How well the model's points lie on image edges (each weighted by its distance across the
+  // edge, 1 on it, 0 from a pixel away) at the refined pose and at the start: a refinement
+  // that lowers it has made the pose worse.
+  double support = 0.0;
+  double startSupport = 0.0;
 };
 
 // Refines `pose` using the image's edges inside `roi` (image pixels, clipped to the image).

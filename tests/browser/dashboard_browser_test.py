@@ -59,8 +59,11 @@ def station_config(source, work):
 def start_facetd(facetd, config, work):
     port_file = os.path.join(work, 'http.port')
     log = open(os.path.join(work, 'facetd.log'), 'w')
+    # --block-when-behind: every frame is inspected however slow the build (a sanitizer's is
+    # slower than the 3 frames/s), so the last picture is always of an inspected part.
     process = subprocess.Popen([facetd, '--config', config, '--recipe', '2', '--no-plc',
-                                '--http-port-file', port_file], stdout=log, stderr=subprocess.STDOUT)
+                                '--block-when-behind', '--http-port-file', port_file],
+                               stdout=log, stderr=subprocess.STDOUT)
     deadline = time.time() + 30
     while not (os.path.exists(port_file) and open(port_file).read().strip()):
         if process.poll() is not None or time.time() > deadline:

@@ -53,7 +53,15 @@ TEST(Examples, RecipeOutputsJoinTheStationRegisterMapWithoutCollisions) {
   EXPECT_EQ(spacing->type, plc::ValueType::ScaledInt32);
   EXPECT_DOUBLE_EQ(spacing->factor, 1000.0);
   EXPECT_EQ(spacing->wordOrder, plc::WordOrder::ABCD);
-  EXPECT_NE(spacing->origin.find("bracket_registration.recipe.yaml:52:"), std::string::npos)
+  // The origin names the file and the line of the output's `plc:` entry.
+  std::ifstream file(kRecipes / "bracket_registration.recipe.yaml");
+  int line = 0, plcLine = 0;
+  for (std::string text; std::getline(file, text) && plcLine == 0;)
+    if (++line; text.find("plc: {register: 104") != std::string::npos) plcLine = line;
+  ASSERT_GT(plcLine, 0);
+  EXPECT_NE(
+      spacing->origin.find("bracket_registration.recipe.yaml:" + std::to_string(plcLine) + ":"),
+      std::string::npos)
       << spacing->origin;
   // The measuring tools' outputs follow the bores'.
   for (const auto& [name, address] : {std::pair<std::string, int>{"leg_width.width", 106},

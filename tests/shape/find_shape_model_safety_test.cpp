@@ -1,7 +1,8 @@
 // findShapeModel never makes things worse than it has to: early termination keeps every clear
-// part, the least-squares refinement never lowers the score of the pose it started from and
-// follows a part slightly larger than its template, and the full search returns the best of the
-// near-symmetric poses of a part.
+// part; the least-squares refinement follows a part slightly larger than its template, never
+// lowers the score of its start on a part held at a scale it does not have, and fits the part,
+// not a hole out of place; the full search returns the best of the near-symmetric poses of a
+// part.
 #include <algorithm>
 #include <cmath>
 
@@ -9,6 +10,7 @@
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "tests/shape/bracket_scenes.hpp"
+#include "tests/support/scene/parts.hpp"
 
 namespace facet {
 namespace {
@@ -88,6 +90,34 @@ TEST(FindShapeModelSafety, RefinementNeverLowersTheScore) {
     EXPECT_GE(out[0].score, in[0].score - 1e-9) << scale;
     EXPECT_LE(std::abs(out[0].scale - 1.0), 0.02 + 1e-9) << scale;
   }
+}
+
+// A part whose small hole is 10 px out of place (a drilling fault the inspection is there to
+// find): the pose must come from the rest of the part. A pose tilted towards the displaced hole
+// scores higher than the true one (it half-covers the hole's edges as well), so the refinement
+// is judged by the model points it puts exactly on edges, not by the score.
+TEST(FindShapeModelSafety, RefinementFitsThePartNotAHoleOutOfPlace) {
+  const ShapeModel model = createShapeModel(bracketTemplate());
+  scene::PartDrawing faulty = scene::bracketPart();
+  faulty.primitives[2].centre.x += 10;  // the hole at (38, -27)
+  int tilted = 0;
+  for (const double angleDeg : {-23.0, 4.0, 19.5, 61.0}) {
+    const Pose2D truth{200.4, 150.3, radians(angleDeg), 1.0};
+    scene::Scene s(bracketSpec({400, 300}, 11));
+    scene::placePart(s, faulty, truth, testing::kPartGrey, testing::kBackground);
+    const auto found = findShapeModel(s.render(), model);
+    FindParams interp;
+    interp.subpixel = SubpixelMode::Interpolation;
+    const auto coarse = findShapeModel(s.render(), model, interp);
+    ASSERT_EQ(found.size(), 1u) << angleDeg;
+    ASSERT_EQ(coarse.size(), 1u) << angleDeg;
+    const double angleError = std::abs(found[0].angle - truth.angle) * 180 / CV_PI;
+    EXPECT_LT(angleError, 0.02) << angleDeg << " deg";
+    EXPECT_LT(positionError(found[0], truth), 0.05) << angleDeg << " deg";
+    tilted += std::abs(coarse[0].angle - truth.angle) * 180 / CV_PI > 0.1;
+  }
+  // The case is real: the interpolated search pose is pulled off by the hole.
+  EXPECT_GT(tilted, 0);
 }
 
 // A cross whose four arms differ by a few pixels: each quarter turn is a near match. The full

@@ -44,12 +44,16 @@ std::string numbered(const std::string& stem, int i, const std::string& ext) {
   return name;
 }
 
+// `measured`: the value the recipe must find on a bad part, so that the golden-set gate fails a
+// part that fails for another reason than its defect ({name, value}, held to 0.01 mm).
 void annotate(Scene& scene, const std::string& serial, bool pass, const std::string& defect,
-              const Pose2D& pose) {
+              const Pose2D& pose, const std::pair<std::string, double>& measured = {}) {
   auto& a = scene.annotations();
   a["serial"] = serial;
   a["expected_verdict"] = pass ? "pass" : "fail";
   if (!defect.empty()) a["defect"] = defect;
+  if (!measured.first.empty())
+    a["expected_values"] = {{measured.first, {{"value", measured.second}, {"tolerance", 0.01}}}};
   a["pose"] = {{"x", pose.x}, {"y", pose.y}, {"angle_deg", facet::degrees(pose.angle)}};
 }
 
@@ -73,14 +77,23 @@ void bracketRegistration(const fs::path& root) {
     const Pose2D pose = randomPose(rng, 40.0, 20.0);
     PartDrawing drawn = part;
     std::string defect;
-    if (i % 4 == 3) {
-      if (i == 3) drawn.primitives[1].radius = 12.0, defect = "big hole Ø1.2 mm (nominal 1.0)";
-      if (i == 7) drawn.primitives[2].centre.x += 10.0, defect = "small hole 0.5 mm off";
-      if (i == 11) drawn.primitives[1].radius = 8.5, defect = "big hole Ø0.85 mm (nominal 1.0)";
+    std::pair<std::string, double> measured;
+    if (i == 3) {
+      drawn.primitives[1].radius = 12.0;
+      defect = "big hole Ø1.2 mm (nominal 1.0)";
+      measured = {"big_bore.diameter", 1.2};
+    } else if (i == 7) {
+      drawn.primitives[2].centre.x += 10.0;
+      defect = "small hole 0.5 mm off";
+      measured = {"small_bore.position", 0.5};
+    } else if (i == 11) {
+      drawn.primitives[1].radius = 8.5;
+      defect = "big hole Ø0.85 mm (nominal 1.0)";
+      measured = {"big_bore.diameter", 0.85};
     }
     Scene scene(liveSpec(1000 + i));
     placePart(scene, drawn, pose, kPartGrey, kBackground);
-    annotate(scene, numbered("BR", i, ""), defect.empty(), defect, pose);
+    annotate(scene, numbered("BR", i, ""), defect.empty(), defect, pose, measured);
     scene.write(folder / numbered("part", i, ".png"));
   }
 }
