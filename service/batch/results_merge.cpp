@@ -10,9 +10,6 @@
 namespace facet::service {
 namespace {
 
-constexpr const char* kPartColumns =
-    "part_id, time_us, time_utc, recipe_id, recipe_name, recipe_version, frame_id, source, "
-    "serial, expected, verdict, failed_checks, error, inspection_ms, timings_json";
 constexpr const char* kValueColumns =
     "part_id, name, value, unit, nominal, tol_minus, tol_plus, checked, pass";
 
@@ -89,8 +86,15 @@ std::vector<MergedInput> mergeResults(const std::vector<std::filesystem::path>& 
                                    "file twice?)");
         MergedInput m{in};
         db.exec("BEGIN", out);
-        db.exec(std::string("INSERT INTO main.parts (") + kPartColumns + ") SELECT " +
-                    kPartColumns + " FROM source.parts",
+        // A shard written before parts had `defect` gives '' for it.
+        const bool withDefect =
+            db.number(
+                "SELECT count(*) FROM pragma_table_info('parts', 'source') WHERE name = "
+                "'defect'") > 0;
+        std::string columns = kStoredPartColumns;
+        if (!withDefect) columns.replace(columns.rfind("defect"), 6, "''");
+        db.exec(std::string("INSERT INTO main.parts (") + kStoredPartColumns + ") SELECT " +
+                    columns + " FROM source.parts",
                 in);
         m.parts = db.changes();
         db.exec(std::string("INSERT INTO main.measurements (") + kValueColumns + ") SELECT " +

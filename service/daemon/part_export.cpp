@@ -45,6 +45,7 @@ nlohmann::json toJson(const PartResult& p) {
           {"source", p.source},
           {"serial", p.serial},
           {"expected_verdict", p.expectedVerdict},
+          {"defect", p.recordedDefect},
           {"verdict", verdictName(p.verdict)},
           {"failed_checks", p.failedChecks},
           {"error", p.error},

@@ -71,6 +71,16 @@ void exec(sqlite3* db, const char* sql, const std::filesystem::path& file) {
   }
 }
 
+bool hasColumn(sqlite3* db, const char* table, const char* column,
+               const std::filesystem::path& file) {
+  Statement q(
+      db, std::string("SELECT count(*) FROM pragma_table_info('") + table + "') WHERE name = ?1",
+      file);
+  q.bind(1, std::string(column));
+  q.step();
+  return sqlite3_column_int64(q.get(), 0) > 0;
+}
+
 constexpr const char* kSchema = R"sql(
 CREATE TABLE IF NOT EXISTS parts (
   part_id        INTEGER PRIMARY KEY,
@@ -87,7 +97,8 @@ CREATE TABLE IF NOT EXISTS parts (
   failed_checks  TEXT NOT NULL,
   error          TEXT NOT NULL,
   inspection_ms  REAL NOT NULL,
-  timings_json   TEXT NOT NULL
+  timings_json   TEXT NOT NULL,
+  defect         TEXT NOT NULL DEFAULT ''
 );
 CREATE INDEX IF NOT EXISTS parts_time ON parts(time_us);
 CREATE TABLE IF NOT EXISTS measurements (
@@ -130,6 +141,9 @@ ResultsStore::ResultsStore(const std::filesystem::path& file, RetentionPolicy re
     // consistent file. synchronous=NORMAL is durable across process crashes in WAL mode.
     exec(db_, "PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; PRAGMA foreign_keys=ON;", file_);
     exec(db_, kSchema, file_);
+    // A store written before parts had `defect` (the recorded part's known fault) gains it.
+    if (!hasColumn(db_, "parts", "defect", file_))
+      exec(db_, "ALTER TABLE parts ADD COLUMN defect TEXT NOT NULL DEFAULT ''", file_);
   } catch (...) {
     sqlite3_close(db_);
     db_ = nullptr;
@@ -145,8 +159,9 @@ void ResultsStore::store(const PartResult& part) {
   exec(db_, "BEGIN", file_);
   try {
     Statement insert(db_,
-                     "INSERT INTO parts VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, "
-                     "?13, ?14, ?15)",
+                     "INSERT INTO parts (" + std::string(kStoredPartColumns) +
+                         ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, "
+                         "?15, ?16)",
                      file_);
     nlohmann::json timings = nlohmann::json::array();
     for (const auto& t : part.timings) timings.push_back({{"step", t.step}, {"ms", t.ms}});
@@ -165,6 +180,7 @@ void ResultsStore::store(const PartResult& part) {
     insert.bind(13, part.error);
     insert.bind(14, part.inspectionMs);
     insert.bind(15, timings.dump());
+    insert.bind(16, part.recordedDefect);
     insert.step();
     Statement value(db_, "INSERT INTO measurements VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
                     file_);
@@ -245,7 +261,7 @@ std::vector<PartResult> ResultsStore::select(const std::string& where, const std
                                              std::int64_t bind, std::size_t limit) const {
   std::string sql =
       "SELECT part_id, time_us, recipe_id, recipe_name, recipe_version, frame_id, source, serial, "
-      "expected, verdict, failed_checks, error, inspection_ms, timings_json FROM parts " +
+      "expected, verdict, failed_checks, error, inspection_ms, timings_json, defect FROM parts " +
       where + " ORDER BY part_id " + order;
   if (limit > 0) sql += " LIMIT " + std::to_string(limit);
   Statement q(db_, sql, file_);
@@ -269,6 +285,7 @@ std::vector<PartResult> ResultsStore::select(const std::string& where, const std
     p.inspectionMs = sqlite3_column_double(q.get(), 12);
     for (const auto& t : nlohmann::json::parse(q.text(13), nullptr, false))
       if (t.is_object()) p.timings.push_back({t.value("step", ""), t.value("ms", 0.0)});
+    p.recordedDefect = q.text(14);
     index[static_cast<std::int64_t>(p.partId)] = parts.size();
     parts.push_back(std::move(p));
   }

@@ -18,6 +18,12 @@ struct sqlite3_stmt;
 
 namespace facet::service {
 
+// The columns of the parts table, in the order the store writes them (the merge of shard stores
+// copies them by name).
+inline constexpr const char* kStoredPartColumns =
+    "part_id, time_us, time_utc, recipe_id, recipe_name, recipe_version, frame_id, source, "
+    "serial, expected, verdict, failed_checks, error, inspection_ms, timings_json, defect";
+
 struct RetentionPolicy {
   std::optional<std::chrono::seconds> maxAge;  // parts older than this are deleted (none = keep)
   std::optional<std::int64_t> maxParts;        // keep at most this many newest parts (none = all)

@@ -1,5 +1,6 @@
 // Shards, results merge and the golden-set comparison, without the command line.
 #include <gtest/gtest.h>
+#include <sqlite3.h>
 
 #include <cstdlib>
 #include <set>
@@ -98,6 +99,30 @@ TEST(ResultsMerge, JoinsStoresRowForRowAndRefusesOverlaps) {
   EXPECT_FALSE(std::filesystem::exists(dir / "twice.db"));
   EXPECT_THROW(mergeResults({dir / "a.db"}, dir / "all.db"), std::runtime_error);  // exists
   EXPECT_THROW(mergeResults({dir / "missing.db"}, dir / "x.db"), std::runtime_error);
+}
+
+// Recorded defects travel with the rows; a shard from a store without the column merges with
+// them empty.
+TEST(ResultsMerge, CarriesRecordedDefectsAndTakesAShardWithoutTheColumn) {
+  daemon_test::TempDir dir;
+  {
+    ResultsStore a(dir / "a.db"), b(dir / "b.db");
+    auto bad = sinks_test::samplePart(1);
+    bad.recordedDefect = "big hole";
+    a.store(bad);
+    b.store(sinks_test::samplePart(2));
+  }
+  sqlite3* db = nullptr;
+  ASSERT_EQ(sqlite3_open((dir / "b.db").c_str(), &db), SQLITE_OK);
+  ASSERT_EQ(sqlite3_exec(db, "ALTER TABLE parts DROP COLUMN defect", nullptr, nullptr, nullptr),
+            SQLITE_OK)
+      << sqlite3_errmsg(db);
+  sqlite3_close(db);
+  mergeResults({dir / "a.db", dir / "b.db"}, dir / "all.db");
+  const auto parts = ResultsStore(dir / "all.db").query({});
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].recordedDefect, "big hole");
+  EXPECT_EQ(parts[1].recordedDefect, "");
 }
 
 TEST(GoldenSet, ReportsVerdictAndValueMismatches) {

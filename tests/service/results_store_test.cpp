@@ -49,6 +49,7 @@ PartResult part(std::uint64_t id, Verdict v, double diameter) {
   p.measurements.push_back({"align.score", 0.93, "score", {}, {}, {}, false, true});
   p.timings.push_back({"bore", 0.8});
   if (v == Verdict::Fail) p.failedChecks.push_back("bore.diameter");
+  if (v == Verdict::Fail) p.expectedVerdict = "fail", p.recordedDefect = "bore 10.2 mm";
   return p;
 }
 
@@ -69,6 +70,36 @@ TEST(ResultsStore, StoresAndReadsBackEveryField) {
   EXPECT_FALSE(parts[1].measurements[0].pass);
   EXPECT_FALSE(parts[1].measurements[1].nominal.has_value());
   EXPECT_EQ(parts[0].timings.at(0).step, "bore");
+  EXPECT_EQ(parts[1].expectedVerdict, "fail");
+  EXPECT_EQ(parts[1].recordedDefect, "bore 10.2 mm");
+  EXPECT_EQ(parts[0].recordedDefect, "");
+  EXPECT_EQ(toJson(parts[1]).at("defect"), "bore 10.2 mm");
+  EXPECT_EQ(store.integrityCheck(), "ok");
+}
+
+// A store written before parts had the recorded defect: opened, it gains the column, keeps its
+// parts (defect '') and stores new ones with theirs.
+TEST(ResultsStore, StoreWithoutTheDefectColumnGainsItAndKeepsItsParts) {
+  const fs::path file = freshFile("old.sqlite");
+  {
+    ResultsStore store(file);
+    store.store(part(1, Verdict::Pass, 10.0));
+  }
+  {
+    sqlite3* db = nullptr;
+    ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
+    ASSERT_EQ(sqlite3_exec(db, "ALTER TABLE parts DROP COLUMN defect", nullptr, nullptr, nullptr),
+              SQLITE_OK)
+        << sqlite3_errmsg(db);
+    sqlite3_close(db);
+  }
+  ResultsStore store(file);
+  store.store(part(2, Verdict::Fail, 10.2));
+  const auto parts = store.latest(10);
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].serial, "SN1");
+  EXPECT_EQ(parts[0].recordedDefect, "");
+  EXPECT_EQ(parts[1].recordedDefect, "bore 10.2 mm");
   EXPECT_EQ(store.integrityCheck(), "ok");
 }
 
