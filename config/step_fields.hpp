@@ -55,6 +55,16 @@ class StepFields {
     });
   }
 
+  // A number without a default: the member stays empty when the key is absent (a key that
+  // chooses between variants, such as a caliper's length or radius).
+  StepFields& number(std::string name, std::optional<double> P::*m, std::string doc,
+                     FieldLimits l = {}) {
+    return add(limited(std::move(name), FieldType::Number, std::move(doc), l),
+               [m](P& p, const YAML::Node& n, StepReading&) {
+                 if (const auto v = readNumber(n)) p.*m = *v;
+               });
+  }
+
   StepFields& integer(std::string name, int P::*m, std::string doc, FieldLimits l = {}) {
     FieldSpec spec = limited(std::move(name), FieldType::Integer, std::move(doc), l);
     if (!l.required) spec.defaultValue = defaults().*m;

@@ -112,6 +112,104 @@ TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {
   EXPECT_NE(plate::failures(flat).find("no contrast"), std::string::npos) << plate::failures(flat);
 }
 
+// An arc around the plate's corner (200, 150) crosses its left edge at -90 degrees and its top
+// edge at 0, both radial there: the caliper finds them 90 degrees apart, and positions, pair
+// widths and spacing are lengths along the arc (30 px * pi / 2 = 47.12 px = 2.356 mm).
+TEST_F(MeasuringSteps, CaliperOnAnArcGivesTheRadialEdgesAndLengthsAlongIt) {
+  const double quarter = 30 * CV_PI / 2 * plate::kMmPerPixel;
+  const auto out = inspect(R"(  - id: corner
+    kind: caliper
+    centre: [200, 150]
+    radius: 30
+    start_angle: -135
+    extent: 180
+    width: 8
+    checks:
+      count: {nominal: 2, tol_minus: 0, tol_plus: 0}
+      position: {nominal: -1.178, tol_minus: 0.01, tol_plus: 0.01}
+      spacing: {nominal: 2.356, tol_minus: 0.01, tol_plus: 0.01}
+  - id: corner_pair
+    kind: caliper
+    centre: [200, 150]
+    radius: 30
+    start_angle: -135
+    extent: 180
+    width: 8
+    measure: pairs
+    polarity: rising
+    checks:
+      width: {nominal: 2.356, tol_minus: 0.01, tol_plus: 0.01}
+      position: {nominal: 0, tol_minus: 0.01, tol_plus: 0.01}
+)");
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "corner.position").value, -quarter / 2, 0.005);
+  EXPECT_NEAR(value(out, "corner.spacing").value, quarter, 0.005);
+  EXPECT_NEAR(value(out, "corner_pair.width").value, quarter, 0.005);
+  EXPECT_NEAR(value(out, "corner_pair.position").value, 0.0, 0.005);
+
+  // Clockwise from +45 degrees the part begins at the top edge (rising, dark to light, that
+  // way), a quarter turn before the arc's middle.
+  const auto back = inspect(R"(  - id: corner
+    kind: caliper
+    centre: [200, 150]
+    radius: 30
+    start_angle: 45
+    extent: -180
+    width: 8
+    polarity: rising
+    select: first
+    checks:
+      position: {nominal: -1.178, tol_minus: 0.01, tol_plus: 0.01}
+)");
+  ASSERT_EQ(back.verdict, Verdict::Pass) << plate::failures(back);
+  EXPECT_NEAR(value(back, "corner.position").value, -quarter / 2, 0.005);
+}
+
+// A caliper is a rectangle or an arc: the keys of one with the other, or of neither, are
+// refused where they stand.
+TEST_F(MeasuringSteps, CaliperShapeKeysThatDoNotFitAreRefused) {
+  const auto both = plate::load(dir_, R"(  - id: c
+    kind: caliper
+    centre: [320, 240]
+    length: 40
+    radius: 30
+    extent: 90
+    width: 10
+)");
+  EXPECT_FALSE(both.recipe);
+  EXPECT_NE(both.diagnostics.text().find("plate.recipe.yaml:9:"), std::string::npos)
+      << both.diagnostics.text();
+  EXPECT_NE(both.diagnostics.text().find("exclude each other"), std::string::npos);
+  const auto neither = plate::load(dir_, R"(  - id: c
+    kind: caliper
+    centre: [320, 240]
+    width: 10
+)");
+  EXPECT_FALSE(neither.recipe);
+  EXPECT_NE(neither.diagnostics.text().find("'length' (a rectangle) or 'radius' (an arc)"),
+            std::string::npos)
+      << neither.diagnostics.text();
+  const auto mixed = plate::load(dir_, R"(  - id: c
+    kind: caliper
+    centre: [320, 240]
+    radius: 30
+    angle: 10
+    width: 10
+  - id: d
+    kind: caliper
+    centre: [320, 240]
+    length: 40
+    extent: 90
+    width: 10
+)");
+  EXPECT_FALSE(mixed.recipe);
+  const std::string text = mixed.diagnostics.text();
+  EXPECT_NE(text.find("an arc begins at 'start_angle'"), std::string::npos) << text;
+  EXPECT_NE(text.find("an arc needs 'extent'"), std::string::npos) << text;
+  EXPECT_NE(text.find("plate.recipe.yaml:15:"), std::string::npos) << text;
+  EXPECT_NE(text.find("'extent' needs 'radius'"), std::string::npos) << text;
+}
+
 TEST_F(MeasuringSteps, LineGivesAngleOffsetAndStraightness) {
   const auto out = inspect(R"(  - id: top
     kind: line
@@ -252,12 +350,37 @@ TEST_F(MeasuringSteps, InACalibratedPlaneValuesAreMillimetresThere) {
     checks:
       position: {nominal: -0.1, tol_minus: 0.005, tol_plus: 0.005}
       angle: {nominal: 0, tol_minus: 0.05, tol_plus: 0.05, unit: deg}
+  - id: corner
+    kind: caliper
+    centre: [200, 150]
+    radius: 30
+    start_angle: -135
+    extent: 180
+    width: 8
+    checks:
+      spacing: {nominal: 2.356, tol_minus: 0.01, tol_plus: 0.01}
 )" + kBoreBlob + R"(    checks:
       area: {nominal: 0.5027, tol_minus: 0.005, tol_plus: 0.005}
 )",
                                   plate::render(), plate::straightPlane());
   ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
   EXPECT_NEAR(value(out, "across.width").value, 12.0, 0.002);
+}
+
+// An arc relative to a pose step follows it too: centre mapped, start turned, radius scaled.
+TEST(PlacedArc, FollowsThePose) {
+  const Pose2D pose{300, 200, radians(30), 2.0};
+  const MeasuringArc a = placeArc(poseMap(pose, {10, 10}), {20, 10}, 15, -20, 90, 6);
+  EXPECT_NEAR(a.cx, 300 + 20 * std::cos(radians(30)), 1e-9);
+  EXPECT_NEAR(a.cy, 200 - 20 * std::sin(radians(30)), 1e-9);
+  EXPECT_NEAR(a.radius, 30, 1e-9);
+  EXPECT_NEAR(a.width, 12, 1e-9);
+  EXPECT_NEAR(a.startAngle, 10, 1e-9);
+  EXPECT_NEAR(a.extent, 90, 1e-9);
+  const auto outline = arcOutline(a);
+  ASSERT_GE(outline.size(), 4u);
+  EXPECT_NEAR(cv::norm(outline.front() - cv::Point2d(a.cx, a.cy)), 36, 1e-9);
+  EXPECT_NEAR(cv::norm(outline.back() - cv::Point2d(a.cx, a.cy)), 24, 1e-9);
 }
 
 // A rectangle relative to a pose step follows its pose: centre mapped, axis turned, sizes scaled.

@@ -1,5 +1,8 @@
 #include "service/engine/steps/caliper_step.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "config/recipe_format.hpp"
 #include "service/engine/steps/edge_polarity_names.hpp"
 #include "service/engine/steps/placed_rect.hpp"
@@ -12,8 +15,36 @@ using Measure = CaliperStepParams::Measure;
 
 CaliperStep::CaliperStep() {
   addRelativeTo(fields_);
-  addMeasuringRect(fields_, "Length of the rectangle along the measuring axis, pixels.",
-                   "Width across the axis, pixels: the grey profile is averaged over it.");
+  // A rectangle (length, angle) or an arc (radius, start_angle, extent): read() takes one.
+  fields_.point("centre", &CaliperStepParams::centre,
+                "Centre [x, y] of the rectangle or of the arc's circle, pixels of the relative_to "
+                "step's reference image.",
+                true);
+  fields_.number("length", &CaliperStepParams::length,
+                 "Rectangle: its length along the measuring axis, pixels (or give 'radius' for an "
+                 "arc).",
+                 {.minimum = 0.0, .exclusiveMinimum = true});
+  fields_.number("width", &CaliperStepParams::width,
+                 "Width across the axis (radially on an arc), pixels: the grey profile is "
+                 "averaged over it.",
+                 {.minimum = 0.0, .exclusiveMinimum = true, .required = true});
+  fields_.number("angle", &CaliperStepParams::angle,
+                 "Rectangle: direction of its axis, degrees counter-clockwise on screen (axis "
+                 "(cos a, -sin a)); relative to the relative_to step's rotation.",
+                 {.minimum = -360.0, .maximum = 360.0});
+  fields_.number("radius", &CaliperStepParams::radius,
+                 "Arc: radius of the circle the caliper follows, pixels. Edges it finds are "
+                 "radial lines crossing it (teeth, slots around a hub); positions, widths and "
+                 "spacing are lengths along the arc.",
+                 {.minimum = 0.0, .exclusiveMinimum = true});
+  fields_.number("start_angle", &CaliperStepParams::startAngle,
+                 "Arc: where it begins, degrees counter-clockwise on screen from +x; relative to "
+                 "the relative_to step's rotation.",
+                 {.minimum = -360.0, .maximum = 360.0});
+  fields_.number("extent", &CaliperStepParams::extent,
+                 "Arc: its length in degrees, counter-clockwise (negative: clockwise); the "
+                 "measuring axis runs that way.",
+                 {.minimum = -360.0, .maximum = 360.0});
   fields_.choice("measure", &CaliperStepParams::measure,
                  {{"edges", Measure::Edges}, {"pairs", Measure::Pairs}},
                  "edges (single edges) or pairs (neighbouring edges of opposite polarity: a "
@@ -49,6 +80,20 @@ CaliperStep::CaliperStep() {
 std::shared_ptr<const config::StepParams> CaliperStep::read(config::StepReading& in) const {
   auto c = std::make_shared<CaliperStepParams>();
   fields_.read(*c, in);
+  if (in["radius"] && in["length"])
+    in.error(in["radius"], "'radius' (an arc) and 'length' (a rectangle) exclude each other");
+  else if (!in["radius"] && !in["length"])
+    in.error(in.node(), "caliper needs 'length' (a rectangle) or 'radius' (an arc)");
+  if (in["radius"]) {
+    if (in["angle"])
+      in.error(in["angle"], "'angle' turns a rectangle; an arc begins at 'start_angle'");
+    if (!in["extent"]) in.error(in["radius"], "an arc needs 'extent' (degrees)");
+    if (in["extent"] && c->extent && *c->extent == 0.0)
+      in.error(in["extent"], "'extent' must not be 0");
+  } else {
+    for (const char* key : {"start_angle", "extent"})
+      if (in[key]) in.error(in[key], std::string("'") + key + "' needs 'radius' (an arc)");
+  }
   if (const YAML::Node checks = in["checks"];
       checks && checks.IsMap() && checks["width"] && c->measure != Measure::Pairs)
     in.error(checks["width"], "check 'width' needs 'measure: pairs'");
@@ -57,51 +102,74 @@ std::shared_ptr<const config::StepParams> CaliperStep::read(config::StepReading&
 
 StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
   const auto& c = step.as<CaliperStepParams>();
-  const MeasuringRect rect =
-      placeRect(part.frameOf(c.relativeTo), c.centre, c.length, c.width, c.angle);
-  const MeasuringPath path(rect);
+  const cv::Matx33d frame = part.frameOf(c.relativeTo);
+  std::optional<MeasuringRect> rect;
+  std::optional<MeasuringArc> arc;
+  if (c.radius)
+    arc = placeArc(frame, c.centre, *c.radius, c.startAngle.value_or(0.0), c.extent.value_or(0.0),
+                   c.width);
+  else
+    rect = placeRect(frame, c.centre, c.length.value_or(0.0), c.width, c.angle);
+  const MeasuringPath path = arc ? MeasuringPath(*arc) : MeasuringPath(*rect);
   CaliperParams p;
   p.polarity = c.polarity;
   p.select = c.select;
   p.minAmplitude = c.minAmplitude;
   p.pairs = c.measure == Measure::Pairs;
   const CaliperResult m = measureCaliper(part.grey, path, p);
-  part.overlay.polygon(rectCorners(rect), true, true);
+  part.overlay.polygon(arc ? arcOutline(*arc) : rectCorners(*rect), true, true);
   if (!m.ok()) return StepResult::failed("caliper not measured: " + m.message);
 
-  // Where each selected edge or pair lies on the axis, and the pairs' end points.
+  // Where each selected edge or pair lies on the axis (s), and the pairs' ends.
+  std::vector<double> along;
   std::vector<cv::Point2d> points;
-  std::vector<std::pair<cv::Point2d, cv::Point2d>> ends;
+  std::vector<std::pair<double, double>> ends;
   if (p.pairs) {
     for (const CaliperPair& pr : m.pairs) {
+      along.push_back((pr.first.position + pr.second.position) / 2);
       points.push_back(pr.centre);
-      ends.emplace_back(pr.first.point, pr.second.point);
+      ends.emplace_back(pr.first.position, pr.second.position);
     }
   } else {
-    for (const CaliperEdge& e : m.edges) points.push_back(e.point);
+    for (const CaliperEdge& e : m.edges) {
+      along.push_back(e.position);
+      points.push_back(e.point);
+    }
   }
-  // With a lens model and a measuring plane, positions and widths are measured in the plane, in
-  // mm, along the axis as the plane sees it.
+  // Lengths along the axis, from its middle. With a lens model and a measuring plane they are
+  // measured in the plane, in mm: the axis as the plane sees it (a rectangle), or the arc's
+  // points carried into the plane and their path summed (an arc; its image is not a circle
+  // there under perspective).
   const auto plane = part.calibration.worldMapping();
-  const cv::Point2d centre(rect.cx, rect.cy);
   const auto where = [&](cv::Point2d q) { return plane ? plane->toPlane(q) : q; };
-  cv::Point2d axis = where(centre + path.axisAt(0)) - where(centre);
-  axis /= cv::norm(axis);
-  const auto position = [&](cv::Point2d q) { return (where(q) - where(centre)).dot(axis); };
+  const auto span = [&](double s0, double s1) {  // signed length from s0 to s1
+    if (!plane) return s1 - s0;
+    if (rect) {
+      const cv::Point2d centre(rect->cx, rect->cy);
+      cv::Point2d axis = where(centre + path.axisAt(0)) - where(centre);
+      axis /= cv::norm(axis);
+      return (where(path.at(s1, 0)) - where(path.at(s0, 0))).dot(axis);
+    }
+    const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(s1 - s0))));
+    double sum = 0.0;
+    for (int i = 0; i < steps; ++i)
+      sum += cv::norm(where(path.at(s0 + (s1 - s0) * (i + 1) / steps, 0)) -
+                      where(path.at(s0 + (s1 - s0) * i / steps, 0)));
+    return s1 >= s0 ? sum : -sum;
+  };
 
   StepResult r;
   r.lengthsInMm = plane.has_value();
   r.values["count"] = static_cast<double>(points.size());
-  r.values["position"] = position(points.front());
-  if (!ends.empty()) r.values["width"] = cv::norm(where(ends[0].second) - where(ends[0].first));
-  if (points.size() >= 2)
-    r.values["spacing"] = (position(points.back()) - position(points.front())) /
-                          static_cast<double>(points.size() - 1);
+  r.values["position"] = span(0.0, along.front());
+  if (!ends.empty()) r.values["width"] = span(ends[0].first, ends[0].second);
+  if (along.size() >= 2)
+    r.values["spacing"] = span(along.front(), along.back()) / static_cast<double>(along.size() - 1);
   r.point = points.front();
   if (m.partial) r.note = "part of the caliper lies outside the image: measured inside only";
 
-  // Each edge as a short line across the rectangle; pair centres as crosses.
-  const double half = rect.width / 2;
+  // Each edge as a short line across the axis; pair centres as crosses.
+  const double half = path.width() / 2;
   if (!p.pairs)
     for (const CaliperEdge& e : m.edges)
       part.overlay.polyline({path.at(e.position, -half), path.at(e.position, half)}, true);

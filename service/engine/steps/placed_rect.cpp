@@ -1,5 +1,6 @@
 #include "service/engine/steps/placed_rect.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "algorithms/geometry/pose2d.hpp"
@@ -20,6 +21,32 @@ MeasuringRect placeRect(const cv::Matx33d& frame, cv::Point2d centre, double len
           .length = length * scale,
           .width = width * scale,
           .angle = degrees(std::atan2(-d.y, d.x))};
+}
+
+MeasuringArc placeArc(const cv::Matx33d& frame, cv::Point2d centre, double radius,
+                      double startAngleDeg, double extentDeg, double width) {
+  const cv::Point2d c = mapPoint(frame, centre);
+  const cv::Point2d d = mapPoint(frame, centre + cv::Point2d(1, 0)) - c;
+  const double scale = cv::norm(d);
+  return {.cx = c.x,
+          .cy = c.y,
+          .radius = radius * scale,
+          .startAngle = startAngleDeg + degrees(std::atan2(-d.y, d.x)),
+          .extent = extentDeg,
+          .width = width * scale};
+}
+
+std::vector<cv::Point2d> arcOutline(const MeasuringArc& arc) {
+  const MeasuringPath path(arc);
+  // About one point per 3 degrees: smooth on screen at any radius a part shows.
+  const int steps = std::max(2, static_cast<int>(std::ceil(std::abs(arc.extent) / 3.0)));
+  std::vector<cv::Point2d> outline;
+  for (const double t : {arc.width / 2, -arc.width / 2})
+    for (int i = 0; i <= steps; ++i) {
+      const double f = static_cast<double>(t > 0 ? i : steps - i) / steps;
+      outline.push_back(path.at((f - 0.5) * path.length(), t));
+    }
+  return outline;
 }
 
 std::vector<cv::Point2d> rectCorners(const MeasuringRect& rect) {

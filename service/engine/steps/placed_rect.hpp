@@ -2,6 +2,7 @@
 // A measuring rectangle as a recipe writes it (caliper, line, blob): centre, length, width and
 // angle in the frame of the relative_to step (pixels of its reference, degrees counter-clockwise
 // on screen), placed in the live image by that step's pose, so that the tool follows the part.
+// The caliper's arc likewise: centre, radius, start angle, extent and radial width.
 
 #include <optional>
 #include <string>
@@ -36,6 +37,14 @@ void addMeasuringRect(config::StepFields<P>& f, const std::string& lengthDoc,
 // scaled as the frame does at the centre.
 MeasuringRect placeRect(const cv::Matx33d& frame, cv::Point2d centre, double length, double width,
                         double angleDeg);
+
+// The arc in the live image: the centre through `frame`, the start angle turned and the radius
+// and width scaled as the frame does at the centre.
+MeasuringArc placeArc(const cv::Matx33d& frame, cv::Point2d centre, double radius,
+                      double startAngleDeg, double extentDeg, double width);
+
+// The outline of the arc's band (outer edge, then inner edge back), for the overlay.
+std::vector<cv::Point2d> arcOutline(const MeasuringArc& arc);
 
 // The four corners, for the overlay and for inside tests.
 std::vector<cv::Point2d> rectCorners(const MeasuringRect& rect);
