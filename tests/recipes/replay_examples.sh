@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # Every example recipe, replayed by facetd over its recorded demo folder, must give the verdict
 # recorded with each image (the sidecars' expected_verdict), and every image must be inspected.
+# Each part's line (--print-parts, what the demo shows) is whole: a failed part says its cause
+# and the recording's defect, and the bracket's bad parts fail by the measurement of their
+# defect, not by an alignment lost to it.
 #   replay_examples.sh FACETD
 set -euo pipefail
 facetd=$1
@@ -30,6 +33,20 @@ for run in 1:bracket_registration 2:bracket_shape 3:fiducial_board 4:scan_offset
   fi
   if [ "$inspected" -ne "$files" ]; then
     echo "FAIL: recipe $id inspected $inspected of $files files"; status=1
+  fi
+  if grep '^part ' "$work/recipe-$id.log" | grep -v ' ms\]$' | grep -q .; then
+    echo "FAIL: recipe $id: a part's line is cut (no time at its end)"; status=1
+  fi
+  if grep '^part .* fail ' "$work/recipe-$id.log" | grep -v '  cause: .*  recorded: fail (.*)  values: ' | grep -q .; then
+    echo "FAIL: recipe $id: a failed part's line lacks its cause, recorded defect or values:"
+    grep '^part .* fail ' "$work/recipe-$id.log"; status=1
+  fi
+done
+for expect in 'BR_003  fail  cause: big_bore.diameter = 1.2 mm' \
+              'BR_007  fail  cause: small_bore.position = 0.49' \
+              'BR_011  fail  cause: big_bore.diameter = 0.849'; do
+  if ! grep -qF -- "$expect" "$work/recipe-1.log" && ! grep -q -- "${expect/0.49/0.50}" "$work/recipe-1.log"; then
+    echo "FAIL: recipe 1 does not say '$expect...':"; grep "${expect%%  *}" "$work/recipe-1.log"; status=1
   fi
 done
 exit $status
