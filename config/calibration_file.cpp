@@ -194,6 +194,17 @@ class CalibrationReader {
   Diagnostics& out_;
 };
 
+// OpenCV reads a !!opencv-matrix by allocating rows x cols first: a mangled header (a byte for
+// `cols`) asked for 17 GB (found by the calibration fuzzer). A calibration's matrices are small:
+// their size is checked before OpenCV reads them. Nodes of another form are left to OpenCV.
+bool smallOpenCvMatrix(const cv::FileNode& node) {
+  if (!node.isMap()) return true;
+  const cv::FileNode rows = node["rows"], cols = node["cols"];
+  if (!rows.isInt() || !cols.isInt()) return false;
+  const long long r = static_cast<int>(rows), c = static_cast<int>(cols);
+  return r >= 0 && c >= 0 && r * c <= 64;
+}
+
 // OpenCV FileStorage files as written before facet had its own format.
 std::optional<CalibrationData> readOpenCvFile(const std::filesystem::path& file, Diagnostics& out) {
   CalibrationData d;
@@ -205,6 +216,12 @@ std::optional<CalibrationData> readOpenCvFile(const std::filesystem::path& file,
       out.error({file}, "cannot be opened by OpenCV");
       return std::nullopt;
     }
+    for (const char* key : {"camera_matrix", "distortion_coefficients"})
+      if (!smallOpenCvMatrix(fs[key])) {
+        out.error({file}, std::string("'") + key +
+                              "' is not a small matrix (integer rows and cols, at most 64 values)");
+        return std::nullopt;
+      }
     fs["camera_matrix"] >> K;
     fs["distortion_coefficients"] >> D;
     if (!fs["mm_per_pixel"].empty()) d.mmPerPixel = static_cast<double>(fs["mm_per_pixel"]);

@@ -78,6 +78,26 @@ TEST_F(CalibrationFileTest, OpenCvFileStorageFilesAreStillRead) {
   EXPECT_EQ(d->kind(), "lens model, scale only");
 }
 
+// An OpenCV matrix whose header asks for a huge size (a byte for `cols`: OpenCV allocated 17 GB
+// for it) is refused before OpenCV reads it; a matrix of a sane size but too big for a
+// calibration likewise.
+TEST_F(CalibrationFileTest, OpenCvMatrixOfAHugeOrNonNumericSizeIsRefused) {
+  Diagnostics out;
+  EXPECT_FALSE(readCalibrationFile(std::filesystem::path(FACET_SOURCE_DIR) /
+                                       "tests/fuzz/calibration/regressions/"
+                                       "opencv_matrix_cols_not_a_number.yaml",
+                                   out));
+  EXPECT_NE(out.text().find("'distortion_coefficients' is not a small matrix"), std::string::npos)
+      << out.text();
+  const auto big = write("big.yaml",
+                         "%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: 100000\n"
+                         "   cols: 100000\n   dt: d\n   data: [ 1. ]\n");
+  Diagnostics bigOut;
+  EXPECT_FALSE(readCalibrationFile(big, bigOut));
+  EXPECT_NE(bigOut.text().find("'camera_matrix' is not a small matrix"), std::string::npos)
+      << bigOut.text();
+}
+
 TEST_F(CalibrationFileTest, TruncatedFileIsReportedAtItsLine) {
   std::string text = calibrationFileText(sample(), "");
   text = text.substr(0, text.find("distortion:") + 18);  // cut inside the distortion list
