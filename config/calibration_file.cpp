@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <iomanip>
+#include <iterator>
 #include <set>
 #include <sstream>
 
@@ -205,8 +206,65 @@ bool smallOpenCvMatrix(const cv::FileNode& node) {
   return r >= 0 && c >= 0 && r * c <= 64;
 }
 
+// OpenCV's YAML reader (4.6) never returns on some malformed files (found by the calibration
+// fuzzer: a block map followed by a less indented line of flow values). yaml-cpp reads an OpenCV
+// YAML file first, past OpenCV's own "%YAML:1.0" line, and the file goes to OpenCV only when it
+// is a map whose camera_matrix and distortion_coefficients are small matrices (rows, cols and
+// that many data values); otherwise it is reported, at its line where there is one.
+bool wellFormedOpenCvYaml(const std::filesystem::path& file, Diagnostics& out) {
+  std::ifstream in(file, std::ios::binary);
+  std::string first;
+  std::getline(in, first);
+  if (first.rfind("%YAML", 0) != 0) return true;  // XML: OpenCV's own reader
+  const std::string rest((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  YAML::Node root;
+  try {
+    root = YAML::Load(rest);
+  } catch (const YAML::Exception& e) {
+    out.error(
+        {file, e.mark.is_null() ? 0 : e.mark.line + 2, e.mark.is_null() ? 0 : e.mark.column + 1},
+        "not valid YAML: " + e.msg);
+    return false;
+  }
+  if (!root.IsMap()) {
+    out.error({file}, "an OpenCV calibration file is a map (camera_matrix, ...)");
+    return false;
+  }
+  for (const char* key : {"camera_matrix", "distortion_coefficients"}) {
+    bool small = false;
+    try {
+      const YAML::Node& map = root;
+      const YAML::Node m = map[key];
+      if (!m) {  // what the reading after would say
+        out.error({file}, std::string(key) == "camera_matrix"
+                              ? "needs a 3x3 'camera_matrix'"
+                              : "needs 'distortion_coefficients' with 4, 5, 8, 12 or 14 values");
+        return false;
+      }
+      if (m.IsMap()) {
+        long long rows = -1, cols = -1;
+        if (const auto r = readInteger(m["rows"])) rows = *r;
+        if (const auto c = readInteger(m["cols"])) cols = *c;
+        const YAML::Node data = m["data"];
+        small = rows >= 0 && cols >= 0 && rows * cols <= 64 && data && data.IsSequence() &&
+                static_cast<long long>(data.size()) == rows * cols;
+      }
+    } catch (const YAML::Exception&) {
+      small = false;
+    }
+    if (!small) {
+      out.error({file}, std::string("'") + key +
+                            "' is not a small matrix (integer rows and cols, at most 64 values, "
+                            "that many data)");
+      return false;
+    }
+  }
+  return true;
+}
+
 // OpenCV FileStorage files as written before facet had its own format.
 std::optional<CalibrationData> readOpenCvFile(const std::filesystem::path& file, Diagnostics& out) {
+  if (!wellFormedOpenCvYaml(file, out)) return std::nullopt;
   CalibrationData d;
   CameraModel camera;
   cv::Mat K, D;
