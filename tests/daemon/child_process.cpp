@@ -19,30 +19,43 @@ namespace facet::daemon_test {
 ChildProcess::ChildProcess(std::vector<std::string> argv,
                            std::map<std::string, std::string> environment, std::string stderrFile)
     : stderrFile_(stderrFile) {
+  // Everything the child needs is built before fork: the test's reader threads may hold the
+  // allocator's lock at the fork, and a child that allocates before exec then hangs for ever.
+  std::vector<char*> args;
+  for (auto& a : argv) args.push_back(a.data());
+  args.push_back(nullptr);
+  std::vector<std::string> envStrings;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry = *e;
+    if (!environment.count(entry.substr(0, entry.find('=')))) envStrings.push_back(entry);
+  }
+  for (const auto& [key, value] : environment) envStrings.push_back(key + "=" + value);
+  std::vector<char*> envp;
+  for (auto& e : envStrings) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int errFd =
+      stderrFile.empty() ? -1
+                         : ::open(stderrFile.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   int out[2];
   if (::pipe2(out, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
   ::signal(SIGPIPE, SIG_IGN);
+  sigset_t none;
+  sigemptyset(&none);
   pid_ = ::fork();
   if (pid_ < 0) throw std::runtime_error("fork failed");
   if (pid_ == 0) {
+    // Only async-signal-safe calls from here to exec.
     ::prctl(PR_SET_PDEATHSIG, SIGKILL);  // a crashed test leaves no camera or daemon behind
     ::dup2(out[1], STDOUT_FILENO);
-    if (!stderrFile.empty()) {
-      const int fd = ::open(stderrFile.c_str(), O_WRONLY | O_CREAT | O_APPEND, 0644);
-      if (fd >= 0) ::dup2(fd, STDERR_FILENO);
-    }
+    if (errFd >= 0) ::dup2(errFd, STDERR_FILENO);
     // The test's blocked signals must not stay blocked in the child.
-    sigset_t none;
-    sigemptyset(&none);
     ::sigprocmask(SIG_SETMASK, &none, nullptr);
-    for (const auto& [key, value] : environment) ::setenv(key.c_str(), value.c_str(), 1);
-    std::vector<char*> args;
-    for (auto& a : argv) args.push_back(a.data());
-    args.push_back(nullptr);
-    ::execv(args[0], args.data());
-    std::perror(args[0]);
+    ::execve(args[0], args.data(), envp.data());
+    static const char kFailed[] = "exec of the child process failed\n";
+    [[maybe_unused]] const auto written = ::write(STDERR_FILENO, kFailed, sizeof kFailed - 1);
     ::_exit(127);
   }
+  if (errFd >= 0) ::close(errFd);
   ::close(out[1]);
   reader_ = std::thread([this, fd = out[0]] { readLoop(fd); });
 }
