@@ -1,8 +1,8 @@
 #pragma once
 // StepUnit: one kind of recipe step, whole. Its parameters and their table, reading and
 // preparing (config::StepKind), and run(): what it does on one part. A new kind is its own files
-// in service/engine/steps/ plus one line in builtin_steps.cpp; nothing else changes
-// (docs/architecture.md walks through it).
+// in service/engine/steps/ (usually a TableStep, table_step.hpp) plus one line in
+// builtin_steps.cpp; nothing else changes (docs/architecture.md walks through it).
 //
 // What steps give and how later steps use it (the contract between units):
 // - A step whose result has a pose (offers().pose: align, fiducials, shape) sets refToImage, the

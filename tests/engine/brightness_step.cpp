@@ -6,21 +6,14 @@
 
 namespace facet::test {
 
-BrightnessStep::BrightnessStep() {
+BrightnessStep::BrightnessStep() : TableStep({}) {
   fields_.rect("region", &BrightnessParams::region,
                "[x, y, width, height] of the live image, pixels; default: all of it.");
   checks_ = {"brightness checks",
              "",
              {config::checkField("level", config::Quantity::Score,
                                  "Mean grey level of the region, 0 (black) .. 1 (white).", 0.0)}};
-  format_ = config::stepFormat("brightness", "Mean grey level of a region (a test-only kind).",
-                               fields_.specs(), checks_);
-}
-
-std::shared_ptr<const config::StepParams> BrightnessStep::read(config::StepReading& in) const {
-  auto p = std::make_shared<BrightnessParams>();
-  fields_.read(*p, in);
-  return p;
+  describe("brightness", "Mean grey level of a region (a test-only kind).");
 }
 
 service::StepResult BrightnessStep::run(const config::Step& step,

@@ -5,8 +5,7 @@
 
 #include <optional>
 
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::test {
 
@@ -14,20 +13,11 @@ struct BrightnessParams : config::StepParams {
   std::optional<cv::Rect2d> region;  // pixels of the live image; empty = all of it
 };
 
-class BrightnessStep : public service::StepUnit {
+class BrightnessStep : public service::TableStep<BrightnessParams> {
  public:
   BrightnessStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override { return {}; }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] service::StepResult run(const config::Step& step,
                                         service::StepContext& part) const override;
-
- private:
-  config::StepFields<BrightnessParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
 };
 
 // facet's kinds and BrightnessStep.

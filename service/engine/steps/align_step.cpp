@@ -36,7 +36,7 @@ StepResult withPoseValues(StepResult r, cv::Point2d home) {
 
 }  // namespace
 
-AlignStep::AlignStep() {
+AlignStep::AlignStep() : TableStep({.point = true, .pose = true, .line = true}) {
   using M = AlignParams::Method;
   fields_.choice(
       "method", &AlignParams::method, {{"registration", M::Registration}, {"shape", M::Shape}},
@@ -58,20 +58,16 @@ AlignStep::AlignStep() {
               config::checkField("y", Quantity::Length, yDoc),
               config::checkField("angle", Quantity::Angle, "Rotation of the part, degrees."),
               config::checkField("score", Quantity::Score, "Match score, 0..1.", 0.0)}};
-  format_ = config::stepFormat("align",
-                               "Finds the part and gives the pose later steps follow: log-polar "
-                               "registration to a reference image, or a shape match.",
-                               fields_.specs(), checks_);
+  describe("align",
+           "Finds the part and gives the pose later steps follow: log-polar "
+           "registration to a reference image, or a shape match.");
 }
 
-std::shared_ptr<const config::StepParams> AlignStep::read(config::StepReading& in) const {
-  auto a = std::make_shared<AlignParams>();
-  fields_.read(*a, in);
-  if (in["model"] && a->method != AlignParams::Method::Shape)
+void AlignStep::crossCheck(const AlignParams& a, config::StepReading& in) const {
+  if (in["model"] && a.method != AlignParams::Method::Shape)
     in.warning(in["model"], "'model' is only used with method shape");
-  if (!in["model"] && a->method == AlignParams::Method::Shape && in["method"])
+  if (!in["model"] && a.method == AlignParams::Method::Shape && in["method"])
     in.error(in["method"], "method shape needs a 'model' file (written by `facet recipe train`)");
-  return a;
 }
 
 std::shared_ptr<const config::StepResources> AlignStep::prepare(const config::Step& step,

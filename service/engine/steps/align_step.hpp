@@ -7,8 +7,7 @@
 
 #include <opencv2/core.hpp>
 
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -23,24 +22,16 @@ struct AlignParams : config::StepParams {
   config::AngleRange angleRange;
 };
 
-class AlignStep : public StepUnit {
+class AlignStep : public TableStep<AlignParams> {
  public:
   AlignStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override {
-    return {.point = true, .pose = true, .line = true};
-  }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] std::shared_ptr<const config::StepResources> prepare(
       const config::Step& step, config::StepReading& in) const override;
   [[nodiscard]] std::vector<config::TrainedModel> train(const config::Step& step) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
 
  private:
-  config::StepFields<AlignParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
+  void crossCheck(const AlignParams& params, config::StepReading& in) const override;
 };
 
 }  // namespace facet::service

@@ -11,7 +11,7 @@ namespace facet::service {
 
 using config::Quantity;
 
-BlobStep::BlobStep() {
+BlobStep::BlobStep() : TableStep({.point = true}) {
   addRelativeTo(fields_);
   addMeasuringRect(fields_, "Length of the searched rectangle along its axis, pixels.",
                    "Width of the searched rectangle across its axis, pixels.");
@@ -49,16 +49,12 @@ BlobStep::BlobStep() {
       {config::checkField("count", Quantity::Count, "Number of blobs found.", 0.0),
        config::checkField("presence", Quantity::Count, "1 when a blob is found, else 0.", 0.0),
        config::checkField("area", Quantity::Area, "Area of the largest blob.", 0.0)}};
-  format_ = config::stepFormat("blob", "Dark or light blobs in a rectangle: presence, count, area.",
-                               fields_.specs(), checks_);
+  describe("blob", "Dark or light blobs in a rectangle: presence, count, area.");
 }
 
-std::shared_ptr<const config::StepParams> BlobStep::read(config::StepReading& in) const {
-  auto b = std::make_shared<BlobStepParams>();
-  fields_.read(*b, in);
-  if (b->maxArea < b->minArea)
+void BlobStep::crossCheck(const BlobStepParams& b, config::StepReading& in) const {
+  if (b.maxArea < b.minArea)
     in.error(in["max_area"] ? in["max_area"] : in["min_area"], "'max_area' is below 'min_area'");
-  return b;
 }
 
 StepResult BlobStep::run(const config::Step& step, StepContext& part) const {

@@ -7,8 +7,7 @@
 #include <string>
 
 #include "algorithms/measure/blob_analysis.hpp"
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -28,19 +27,13 @@ struct BlobStepParams : config::StepParams {
   bool required = true;
 };
 
-class BlobStep : public StepUnit {
+class BlobStep : public TableStep<BlobStepParams> {
  public:
   BlobStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override { return {.point = true}; }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
 
  private:
-  config::StepFields<BlobStepParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
+  void crossCheck(const BlobStepParams& params, config::StepReading& in) const override;
 };
 
 }  // namespace facet::service

@@ -13,9 +13,9 @@ namespace facet::service {
 using config::Quantity;
 using Measure = CaliperStepParams::Measure;
 
-CaliperStep::CaliperStep() {
+CaliperStep::CaliperStep() : TableStep({.point = true}) {
   addRelativeTo(fields_);
-  // A rectangle (length, angle) or an arc (radius, start_angle, extent): read() takes one.
+  // A rectangle (length, angle) or an arc (radius, start_angle, extent): crossCheck() wants one.
   fields_.point("centre", &CaliperStepParams::centre,
                 "Centre [x, y] of the rectangle or of the arc's circle, pixels of the relative_to "
                 "step's reference image.",
@@ -72,14 +72,11 @@ CaliperStep::CaliperStep() {
                           "Mean distance between neighbouring selected edges (or pair centres); "
                           "needs two.",
                           0.0)}};
-  format_ = config::stepFormat(
-      "caliper", "Edges or edge pairs along a rectangle: positions, widths, counts and spacing.",
-      fields_.specs(), checks_);
+  describe("caliper",
+           "Edges or edge pairs along a rectangle: positions, widths, counts and spacing.");
 }
 
-std::shared_ptr<const config::StepParams> CaliperStep::read(config::StepReading& in) const {
-  auto c = std::make_shared<CaliperStepParams>();
-  fields_.read(*c, in);
+void CaliperStep::crossCheck(const CaliperStepParams& c, config::StepReading& in) const {
   if (in["radius"] && in["length"])
     in.error(in["radius"], "'radius' (an arc) and 'length' (a rectangle) exclude each other");
   else if (!in["radius"] && !in["length"])
@@ -88,16 +85,15 @@ std::shared_ptr<const config::StepParams> CaliperStep::read(config::StepReading&
     if (in["angle"])
       in.error(in["angle"], "'angle' turns a rectangle; an arc begins at 'start_angle'");
     if (!in["extent"]) in.error(in["radius"], "an arc needs 'extent' (degrees)");
-    if (in["extent"] && c->extent && *c->extent == 0.0)
+    if (in["extent"] && c.extent && *c.extent == 0.0)
       in.error(in["extent"], "'extent' must not be 0");
   } else {
     for (const char* key : {"start_angle", "extent"})
       if (in[key]) in.error(in[key], std::string("'") + key + "' needs 'radius' (an arc)");
   }
   if (const YAML::Node checks = in["checks"];
-      checks && checks.IsMap() && checks["width"] && c->measure != Measure::Pairs)
+      checks && checks.IsMap() && checks["width"] && c.measure != Measure::Pairs)
     in.error(checks["width"], "check 'width' needs 'measure: pairs'");
-  return c;
 }
 
 StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {

@@ -7,8 +7,7 @@
 #include <string>
 
 #include "algorithms/measure/caliper.hpp"
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -29,19 +28,13 @@ struct CaliperStepParams : config::StepParams {
   double minAmplitude = 20.0;  // grey levels (8-bit scale)
 };
 
-class CaliperStep : public StepUnit {
+class CaliperStep : public TableStep<CaliperStepParams> {
  public:
   CaliperStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override { return {.point = true}; }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
 
  private:
-  config::StepFields<CaliperStepParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
+  void crossCheck(const CaliperStepParams& params, config::StepReading& in) const override;
 };
 
 }  // namespace facet::service

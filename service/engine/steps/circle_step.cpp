@@ -12,7 +12,7 @@ namespace facet::service {
 
 using config::Quantity;
 
-CircleStep::CircleStep() {
+CircleStep::CircleStep() : TableStep({.point = true}) {
   addRelativeTo(fields_);
   fields_.point("centre", &CircleParams::centre,
                 "Nominal centre [x, y], pixels of the relative_to step's reference image.", true);
@@ -37,21 +37,16 @@ CircleStep::CircleStep() {
                                  0.0),
               config::checkField("roundness", Quantity::Length,
                                  "Largest minus smallest radius of the edge points.", 0.0)}};
-  format_ =
-      config::stepFormat("circle", "Measures a circle in an annulus around its nominal position.",
-                         fields_.specs(), checks_);
+  describe("circle", "Measures a circle in an annulus around its nominal position.");
 }
 
-std::shared_ptr<const config::StepParams> CircleStep::read(config::StepReading& in) const {
-  auto c = std::make_shared<CircleParams>();
-  fields_.read(*c, in);
+void CircleStep::crossCheck(const CircleParams& c, config::StepReading& in) const {
   using config::formatNumber;
-  if (c->nominalDiameter > 0 && c->searchWidth >= c->nominalDiameter)
-    in.error(in["search_width"], "'search_width' " + formatNumber(c->searchWidth) +
+  if (c.nominalDiameter > 0 && c.searchWidth >= c.nominalDiameter)
+    in.error(in["search_width"], "'search_width' " + formatNumber(c.searchWidth) +
                                      " mm must be smaller than 'nominal_diameter' " +
-                                     formatNumber(c->nominalDiameter) +
+                                     formatNumber(c.nominalDiameter) +
                                      " mm: the search annulus would cover the centre");
-  return c;
 }
 
 StepResult CircleStep::run(const config::Step& step, StepContext& part) const {

@@ -5,8 +5,7 @@
 #include <string>
 
 #include "algorithms/circle/circle_measure.hpp"
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -18,19 +17,13 @@ struct CircleParams : config::StepParams {
   CirclePolarity polarity = CirclePolarity::Any;
 };
 
-class CircleStep : public StepUnit {
+class CircleStep : public TableStep<CircleParams> {
  public:
   CircleStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override { return {.point = true}; }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
 
  private:
-  config::StepFields<CircleParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
+  void crossCheck(const CircleParams& params, config::StepReading& in) const override;
 };
 
 }  // namespace facet::service

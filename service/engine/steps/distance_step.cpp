@@ -38,8 +38,8 @@ bool gives(Measure m, const std::string& check) {
 
 }  // namespace
 
-DistanceStep::DistanceStep() {
-  // `from` and `to` are read in read(): what they must offer depends on `measure`.
+DistanceStep::DistanceStep() : TableStep({.point = true}) {
+  // `from` and `to` are read after `measure`: what they must offer depends on it.
   fields_.choice("measure", &DistanceParams::measure,
                  {{"centre_to_centre", Measure::CentreToCentre},
                   {"point_to_line", Measure::PointToLine},
@@ -78,28 +78,24 @@ DistanceStep::DistanceStep() {
        config::checkField("angle", Quantity::Angle,
                           "angle, line_to_line and intersection: the angle from `from`'s "
                           "line to `to`'s, counter-clockwise on screen.")}};
-  format_ = config::stepFormat("distance",
-                               "A distance, angle or crossing between the results of two earlier "
-                               "steps.",
-                               fields_.specs(), checks_);
+  describe("distance",
+           "A distance, angle or crossing between the results of two earlier "
+           "steps.");
 }
 
-std::shared_ptr<const config::StepParams> DistanceStep::read(config::StepReading& in) const {
-  auto d = std::make_shared<DistanceParams>();
-  fields_.read(*d, in);
-  if (!d->from.empty() && d->from == d->to)
-    in.error(in["to"], "'from' and 'to' are the same step '" + d->to + "'");
+void DistanceStep::crossCheck(const DistanceParams& d, config::StepReading& in) const {
+  if (!d.from.empty() && d.from == d.to)
+    in.error(in["to"], "'from' and 'to' are the same step '" + d.to + "'");
   // The check must be a quantity the measure gives.
   if (const YAML::Node checks = in["checks"]; checks && checks.IsMap() && in["measure"]) {
     for (const auto& entry : checks) {
       const std::string name = entry.first.Scalar();
-      if ((name == "angle" || name == "distance") && !gives(d->measure, name))
+      if ((name == "angle" || name == "distance") && !gives(d.measure, name))
         in.error(entry.first, "check '" + name + "' does not fit measure '" +
                                   in["measure"].Scalar() + "'; use '" +
                                   (name == "angle" ? "distance" : "angle") + "'");
     }
   }
-  return d;
 }
 
 StepResult DistanceStep::run(const config::Step& step, StepContext& part) const {

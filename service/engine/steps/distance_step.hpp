@@ -7,8 +7,7 @@
 
 #include <string>
 
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -19,20 +18,14 @@ struct DistanceParams : config::StepParams {
   std::string to;    // step id: a point (CentreToCentre) or a line
 };
 
-class DistanceStep : public StepUnit {
+class DistanceStep : public TableStep<DistanceParams> {
  public:
   DistanceStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override { return {.point = true}; }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
   [[nodiscard]] bool needsImage() const override { return false; }
 
  private:
-  config::StepFields<DistanceParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
+  void crossCheck(const DistanceParams& params, config::StepReading& in) const override;
 };
 
 }  // namespace facet::service

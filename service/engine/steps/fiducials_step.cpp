@@ -17,7 +17,7 @@ using config::Quantity;
 
 }  // namespace
 
-FiducialsStep::FiducialsStep() {
+FiducialsStep::FiducialsStep() : TableStep({.point = true, .pose = true, .line = true}) {
   addRelativeTo(fields_);
   fields_.points("marks", &FiducialsParams::marks,
                  "Nominal mark centres [x, y], pixels; at least two.", 2);
@@ -35,19 +35,15 @@ FiducialsStep::FiducialsStep() {
               config::checkField("angle", Quantity::Angle, "Rotation of the marks, degrees."),
               config::checkField("spacing", Quantity::Length,
                                  "Distance between the first two marks.", 0.0)}};
-  format_ = config::stepFormat("fiducials", "Finds round marks near their nominal positions.",
-                               fields_.specs(), checks_);
+  describe("fiducials", "Finds round marks near their nominal positions.");
 }
 
-std::shared_ptr<const config::StepParams> FiducialsStep::read(config::StepReading& in) const {
-  auto f = std::make_shared<FiducialsParams>();
-  fields_.read(*f, in);
-  for (std::size_t i = 0; i < f->marks.size(); ++i)
+void FiducialsStep::crossCheck(const FiducialsParams& f, config::StepReading& in) const {
+  for (std::size_t i = 0; i < f.marks.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
-      if (cv::norm(f->marks[i] - f->marks[j]) < 1e-9)
+      if (cv::norm(f.marks[i] - f.marks[j]) < 1e-9)
         in.error(in["marks"][i],
                  "mark " + std::to_string(i + 1) + " lies on mark " + std::to_string(j + 1));
-  return f;
 }
 
 StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const {

@@ -7,8 +7,7 @@
 #include <vector>
 
 #include "algorithms/circle/circle_measure.hpp"
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -20,21 +19,13 @@ struct FiducialsParams : config::StepParams {
   CirclePolarity polarity = CirclePolarity::Any;
 };
 
-class FiducialsStep : public StepUnit {
+class FiducialsStep : public TableStep<FiducialsParams> {
  public:
   FiducialsStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override {
-    return {.point = true, .pose = true, .line = true};
-  }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
 
  private:
-  config::StepFields<FiducialsParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
+  void crossCheck(const FiducialsParams& params, config::StepReading& in) const override;
 };
 
 }  // namespace facet::service

@@ -13,7 +13,7 @@ namespace facet::service {
 
 using config::Quantity;
 
-LineStep::LineStep() {
+LineStep::LineStep() : TableStep({.point = true, .line = true}) {
   addRelativeTo(fields_);
   addMeasuringRect(fields_, "Length of the rectangle along the expected line, pixels.",
                    "Width across the line, pixels: the edge is searched over it.");
@@ -35,15 +35,7 @@ LineStep::LineStep() {
                                  "Largest deviation of an edge point from the fitted line.", 0.0),
               config::checkField("rms", Quantity::Length,
                                  "RMS distance of the edge points from the fitted line.", 0.0)}};
-  format_ = config::stepFormat(
-      "line", "A straight edge in a rectangle laid along it: angle, straightness, RMS.",
-      fields_.specs(), checks_);
-}
-
-std::shared_ptr<const config::StepParams> LineStep::read(config::StepReading& in) const {
-  auto l = std::make_shared<LineStepParams>();
-  fields_.read(*l, in);
-  return l;
+  describe("line", "A straight edge in a rectangle laid along it: angle, straightness, RMS.");
 }
 
 StepResult LineStep::run(const config::Step& step, StepContext& part) const {

@@ -18,7 +18,7 @@ struct ReferenceScan : config::StepResources {
 
 }  // namespace
 
-ScanAlignStep::ScanAlignStep() {
+ScanAlignStep::ScanAlignStep() : TableStep({}) {
   fields_.path("reference", &ScanAlignParams::reference,
                "Reference scan (CSV rows \"x,y\" in metres), relative to the recipe.", true);
   fields_.choice("method", &ScanAlignParams::method,
@@ -34,14 +34,7 @@ ScanAlignStep::ScanAlignStep() {
              {config::checkField("x", Quantity::Length, "Offset of the scan along x."),
               config::checkField("y", Quantity::Length, "Offset of the scan along y."),
               config::checkField("angle", Quantity::Angle, "Rotation of the scan, degrees.")}};
-  format_ = config::stepFormat("scan_align", "Registers a live 2D range scan to a reference scan.",
-                               fields_.specs(), checks_);
-}
-
-std::shared_ptr<const config::StepParams> ScanAlignStep::read(config::StepReading& in) const {
-  auto s = std::make_shared<ScanAlignParams>();
-  fields_.read(*s, in);
-  return s;
+  describe("scan_align", "Registers a live 2D range scan to a reference scan.");
 }
 
 std::shared_ptr<const config::StepResources> ScanAlignStep::prepare(const config::Step& step,

@@ -4,8 +4,7 @@
 
 #include <filesystem>
 
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -17,22 +16,13 @@ struct ScanAlignParams : config::StepParams {
   double maxDistance = 5.0;  // mm, correspondences farther apart are ignored
 };
 
-class ScanAlignStep : public StepUnit {
+class ScanAlignStep : public TableStep<ScanAlignParams> {
  public:
   ScanAlignStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override { return {}; }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] std::shared_ptr<const config::StepResources> prepare(
       const config::Step& step, config::StepReading& in) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
   [[nodiscard]] bool needsImage() const override { return false; }
-
- private:
-  config::StepFields<ScanAlignParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
 };
 
 }  // namespace facet::service

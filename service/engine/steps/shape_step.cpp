@@ -20,7 +20,7 @@ ShapeTraining trainingOf(const ShapeParams& s) {
 
 }  // namespace
 
-ShapeStep::ShapeStep() {
+ShapeStep::ShapeStep() : TableStep({.point = true, .pose = true, .line = true}) {
   addRelativeTo(fields_);
   fields_.path("template", &ShapeParams::templateImage,
                "Image the model is trained from, relative to the recipe.", true);
@@ -42,14 +42,7 @@ ShapeStep::ShapeStep() {
               config::checkField("y", Quantity::Length, yDoc),
               config::checkField("angle", Quantity::Angle, "Rotation of the best match, degrees."),
               config::checkField("score", Quantity::Score, "Score of the best match, 0..1.", 0.0)}};
-  format_ = config::stepFormat("shape", "Finds a trained shape model and checks count and pose.",
-                               fields_.specs(), checks_);
-}
-
-std::shared_ptr<const config::StepParams> ShapeStep::read(config::StepReading& in) const {
-  auto s = std::make_shared<ShapeParams>();
-  fields_.read(*s, in);
-  return s;
+  describe("shape", "Finds a trained shape model and checks count and pose.");
 }
 
 std::shared_ptr<const config::StepResources> ShapeStep::prepare(const config::Step& step,

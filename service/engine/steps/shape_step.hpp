@@ -5,8 +5,7 @@
 #include <optional>
 #include <string>
 
-#include "config/step_fields.hpp"
-#include "service/engine/step_unit.hpp"
+#include "service/engine/table_step.hpp"
 
 namespace facet::service {
 
@@ -22,24 +21,13 @@ struct ShapeParams : config::StepParams {
   double maxOverlap = 0.5;
 };
 
-class ShapeStep : public StepUnit {
+class ShapeStep : public TableStep<ShapeParams> {
  public:
   ShapeStep();
-  [[nodiscard]] const config::StepKindSpec& format() const override { return format_; }
-  [[nodiscard]] config::StepOffers offers() const override {
-    return {.point = true, .pose = true, .line = true};
-  }
-  [[nodiscard]] std::shared_ptr<const config::StepParams> read(
-      config::StepReading& in) const override;
   [[nodiscard]] std::shared_ptr<const config::StepResources> prepare(
       const config::Step& step, config::StepReading& in) const override;
   [[nodiscard]] std::vector<config::TrainedModel> train(const config::Step& step) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
-
- private:
-  config::StepFields<ShapeParams> fields_;
-  config::ObjectSpec checks_;
-  config::StepKindSpec format_;
 };
 
 }  // namespace facet::service
