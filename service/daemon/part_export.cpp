@@ -67,14 +67,17 @@ std::string toCsv(const std::vector<PartResult>& parts) {
     return q + "\"";
   };
   std::ostringstream out;
-  out << "part_id,time,recipe_id,recipe,frame_id,serial,verdict,failed_checks,error,inspection_ms";
+  // expected_verdict and defect (of recorded parts) came later: after the first ten columns, so
+  // that a script reading columns by position still finds those where they were.
+  out << "part_id,time,recipe_id,recipe,frame_id,serial,verdict,failed_checks,error,inspection_ms,"
+         "expected_verdict,defect";
   for (const auto& n : names) out << ',' << quote(n);
   out << '\n';
   for (const auto& p : parts) {
     out << p.partId << ',' << isoTime(p.time) << ',' << p.recipeId << ',' << quote(p.recipeName)
         << ',' << p.frameId << ',' << quote(p.serial) << ',' << verdictName(p.verdict) << ','
         << quote(joinedChecks(p.failedChecks, ';')) << ',' << quote(p.error) << ','
-        << p.inspectionMs;
+        << p.inspectionMs << ',' << quote(p.expectedVerdict) << ',' << quote(p.recordedDefect);
     std::map<std::string, double> byName;
     for (const auto& m : p.measurements) byName[m.name] = m.value;
     for (const auto& n : names) {

@@ -35,6 +35,8 @@ PartResult partFromFleetMessage(const nlohmann::json& message, std::string* stat
     p.source = message.at("source").get<std::string>();
     p.serial = message.at("serial").get<std::string>();
     p.expectedVerdict = message.at("expected_verdict").get<std::string>();
+    // Messages queued by a facetd from before `defect` have none.
+    p.recordedDefect = message.value("defect", std::string());
     const std::string verdict = message.at("verdict").get<std::string>();
     p.verdict = verdict == "pass"   ? Verdict::Pass
                 : verdict == "fail" ? Verdict::Fail

@@ -205,8 +205,14 @@ TEST(ResultsStore, UnwritableLocationNamesTheFile) {
 }
 
 TEST(ResultsExport, CsvHasOneColumnPerMeasurement) {
-  const std::string csv = toCsv({part(1, Verdict::Pass, 10.01), part(2, Verdict::Fail, 10.2)});
-  EXPECT_NE(csv.find("bore.diameter,align.score"), std::string::npos) << csv;
+  auto recorded = part(2, Verdict::Fail, 10.2);
+  recorded.expectedVerdict = "fail";
+  recorded.recordedDefect = "bore, oversize";  // a comma: quoted
+  const std::string csv = toCsv({part(1, Verdict::Pass, 10.01), recorded});
+  EXPECT_NE(csv.find("inspection_ms,expected_verdict,defect,bore.diameter,align.score"),
+            std::string::npos)
+      << csv;
+  EXPECT_NE(csv.find(",fail,\"bore, oversize\","), std::string::npos) << csv;
   EXPECT_NE(csv.find(",fail,bore.diameter,"), std::string::npos) << csv;
   const auto j = toJson(part(2, Verdict::Fail, 10.2));
   EXPECT_EQ(j["verdict"], "fail");

@@ -82,6 +82,7 @@ TEST(FleetMessage, RoundTripsThePart) {
   EXPECT_EQ(back.recipeVersion, part.recipeVersion);
   EXPECT_EQ(back.verdict, part.verdict);
   EXPECT_EQ(back.failedChecks, part.failedChecks);
+  EXPECT_EQ(back.recordedDefect, "bore_oversize");
   ASSERT_EQ(back.measurements.size(), 2u);
   const auto& d = back.measurements.front();
   EXPECT_EQ(d.name, "bore.diameter");
@@ -90,6 +91,10 @@ TEST(FleetMessage, RoundTripsThePart) {
   EXPECT_EQ(d.tolPlus, 0.04);
   EXPECT_TRUE(d.checked);
   EXPECT_FALSE(back.measurements.back().checked);
+  // A message queued before parts had a defect reads as a part without one.
+  auto old = service::fleetMessage("cam1", part);
+  old.erase("defect");
+  EXPECT_EQ(service::partFromFleetMessage(old, &station).recordedDefect, "");
   EXPECT_THROW(service::partFromFleetMessage(nlohmann::json{{"station", "x"}}, &station),
                std::runtime_error);
 }

@@ -44,8 +44,10 @@ TEST(PostgresSink, WritesTheResultsStoreTablesWithTheStation) {
   EXPECT_EQ(db.query("SELECT count(*) FROM parts WHERE station = 'cam1'"), "10");
   EXPECT_EQ(db.query("SELECT count(*) FROM measurements"), "20");
   EXPECT_EQ(db.query("SELECT verdict || ' ' || failed_checks || ' ' || serial || ' ' || "
-                     "recipe_name || ' ' || recipe_version FROM parts WHERE part_id = 7"),
-            "fail bore.diameter SN7 flange 9c1e55aa");
+                     "recipe_name || ' ' || recipe_version || ' ' || defect "
+                     "FROM parts WHERE part_id = 7"),
+            "fail bore.diameter SN7 flange 9c1e55aa bore_oversize");
+  EXPECT_EQ(db.query("SELECT count(*) FROM parts WHERE defect = ''"), "9");
   EXPECT_EQ(db.query("SELECT value || ' ' || unit || ' ' || nominal || ' ' || tol_minus || ' ' || "
                      "tol_plus || ' ' || checked || ' ' || pass FROM measurements "
                      "WHERE part_id = 7 AND name = 'bore.diameter'"),
@@ -146,6 +148,35 @@ TEST(PostgresSink, DatabaseDownAtStartBuffersUntilItIsThere) {
       << sink.status().lastError;
   EXPECT_EQ(db.query("SELECT count(*) FROM parts"), "30");
   EXPECT_FALSE(sink.status().degraded());
+}
+
+// A database written by an earlier facetd, whose parts table has no `defect`, gains the column
+// and keeps its rows.
+TEST(PostgresSink, ADatabaseFromBeforeDefectGainsTheColumn) {
+  daemon_test::TempDir dir;
+  PostgresCluster db(dir.path());
+  ASSERT_EQ(
+      db.query(
+          "CREATE TABLE parts (station TEXT NOT NULL, part_id BIGINT NOT NULL, time_us BIGINT NOT "
+          "NULL, time_utc TIMESTAMPTZ NOT NULL, recipe_id INTEGER NOT NULL, recipe_name TEXT NOT "
+          "NULL, recipe_version TEXT NOT NULL, frame_id BIGINT NOT NULL, source TEXT NOT NULL, "
+          "serial "
+          "TEXT NOT NULL, expected TEXT NOT NULL, verdict TEXT NOT NULL, failed_checks TEXT NOT "
+          "NULL, "
+          "error TEXT NOT NULL, inspection_ms DOUBLE PRECISION NOT NULL, timings_json TEXT NOT "
+          "NULL, "
+          "PRIMARY KEY (station, part_id, time_us)); INSERT INTO parts VALUES ('old', 1, 0, now(), "
+          "1, "
+          "'r', 'v', 1, 's', '', '', 'pass', '', '', 1.0, '[]'); SELECT 1"),
+      "1");
+  PostgresSink sink(settingsFor(db, dir.path()), "cam1");
+  sink.start();
+  sink.submit(samplePart(7));
+  ASSERT_TRUE(waitUntil([&] { return sink.status().delivered == 1; }, 30s))
+      << sink.status().lastError;
+  EXPECT_EQ(
+      db.query("SELECT string_agg(station || ':' || defect, ' ' ORDER BY station) FROM parts"),
+      "cam1:bore_oversize old:");
 }
 
 }  // namespace

@@ -21,6 +21,7 @@ inline service::PartResult samplePart(std::uint64_t id) {
   const bool bad = id % 7 == 0;
   p.verdict = bad ? service::Verdict::Fail : service::Verdict::Pass;
   if (bad) p.failedChecks = {"bore.diameter"};
+  if (bad) p.recordedDefect = "bore_oversize";  // a recorded part with a known fault
   p.measurements.push_back({.name = "bore.diameter",
                             .value = bad ? 12.07 : 12.0 + 0.001 * static_cast<double>(id % 10),
                             .unit = "mm",
