@@ -86,13 +86,12 @@ std::vector<MergedInput> mergeResults(const std::vector<std::filesystem::path>& 
                                    "file twice?)");
         MergedInput m{in};
         db.exec("BEGIN", out);
-        // A shard written before parts had `defect` gives '' for it.
-        const bool withDefect =
-            db.number(
-                "SELECT count(*) FROM pragma_table_info('parts', 'source') WHERE name = "
-                "'defect'") > 0;
+        // A shard written before parts had a later column gives '' for it.
         std::string columns = kStoredPartColumns;
-        if (!withDefect) columns.replace(columns.rfind("defect"), 6, "''");
+        for (const std::string column : kLaterPartColumns)
+          if (db.number("SELECT count(*) FROM pragma_table_info('parts', 'source') WHERE name = '" +
+                        column + "'") == 0)
+            columns.replace(columns.rfind(column), column.size(), "''");
         db.exec(std::string("INSERT INTO main.parts (") + kStoredPartColumns + ") SELECT " +
                     columns + " FROM source.parts",
                 in);

@@ -49,6 +49,7 @@ nlohmann::json toJson(const PartResult& p) {
           {"verdict", verdictName(p.verdict)},
           {"failed_checks", p.failedChecks},
           {"error", p.error},
+          {"notes", p.notes},
           {"inspection_ms", p.inspectionMs},
           {"values", values},
           {"timings_ms", timings}};

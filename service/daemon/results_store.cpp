@@ -98,7 +98,8 @@ CREATE TABLE IF NOT EXISTS parts (
   error          TEXT NOT NULL,
   inspection_ms  REAL NOT NULL,
   timings_json   TEXT NOT NULL,
-  defect         TEXT NOT NULL DEFAULT ''
+  defect         TEXT NOT NULL DEFAULT '',
+  notes          TEXT NOT NULL DEFAULT ''  -- one note a line
 );
 CREATE INDEX IF NOT EXISTS parts_time ON parts(time_us);
 CREATE TABLE IF NOT EXISTS measurements (
@@ -141,9 +142,14 @@ ResultsStore::ResultsStore(const std::filesystem::path& file, RetentionPolicy re
     // consistent file. synchronous=NORMAL is durable across process crashes in WAL mode.
     exec(db_, "PRAGMA journal_mode=WAL; PRAGMA synchronous=NORMAL; PRAGMA foreign_keys=ON;", file_);
     exec(db_, kSchema, file_);
-    // A store written before parts had `defect` (the recorded part's known fault) gains it.
-    if (!hasColumn(db_, "parts", "defect", file_))
-      exec(db_, "ALTER TABLE parts ADD COLUMN defect TEXT NOT NULL DEFAULT ''", file_);
+    // A store written before parts had `defect` (the recorded part's known fault) or `notes`
+    // gains them.
+    for (const char* column : kLaterPartColumns)
+      if (!hasColumn(db_, "parts", column, file_))
+        exec(db_,
+             (std::string("ALTER TABLE parts ADD COLUMN ") + column + " TEXT NOT NULL DEFAULT ''")
+                 .c_str(),
+             file_);
   } catch (...) {
     sqlite3_close(db_);
     db_ = nullptr;
@@ -161,7 +167,7 @@ void ResultsStore::store(const PartResult& part) {
     Statement insert(db_,
                      "INSERT INTO parts (" + std::string(kStoredPartColumns) +
                          ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, "
-                         "?15, ?16)",
+                         "?15, ?16, ?17)",
                      file_);
     nlohmann::json timings = nlohmann::json::array();
     for (const auto& t : part.timings) timings.push_back({{"step", t.step}, {"ms", t.ms}});
@@ -181,6 +187,7 @@ void ResultsStore::store(const PartResult& part) {
     insert.bind(14, part.inspectionMs);
     insert.bind(15, timings.dump());
     insert.bind(16, part.recordedDefect);
+    insert.bind(17, joinedChecks(part.notes, '\n'));
     insert.step();
     Statement value(db_, "INSERT INTO measurements VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9)",
                     file_);
@@ -261,7 +268,8 @@ std::vector<PartResult> ResultsStore::select(const std::string& where, const std
                                              std::int64_t bind, std::size_t limit) const {
   std::string sql =
       "SELECT part_id, time_us, recipe_id, recipe_name, recipe_version, frame_id, source, serial, "
-      "expected, verdict, failed_checks, error, inspection_ms, timings_json, defect FROM parts " +
+      "expected, verdict, failed_checks, error, inspection_ms, timings_json, defect, notes FROM "
+      "parts " +
       where + " ORDER BY part_id " + order;
   if (limit > 0) sql += " LIMIT " + std::to_string(limit);
   Statement q(db_, sql, file_);
@@ -286,6 +294,7 @@ std::vector<PartResult> ResultsStore::select(const std::string& where, const std
     for (const auto& t : nlohmann::json::parse(q.text(13), nullptr, false))
       if (t.is_object()) p.timings.push_back({t.value("step", ""), t.value("ms", 0.0)});
     p.recordedDefect = q.text(14);
+    p.notes = split(q.text(15), '\n');
     index[static_cast<std::int64_t>(p.partId)] = parts.size();
     parts.push_back(std::move(p));
   }

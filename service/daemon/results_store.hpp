@@ -22,7 +22,11 @@ namespace facet::service {
 // copies them by name).
 inline constexpr const char* kStoredPartColumns =
     "part_id, time_us, time_utc, recipe_id, recipe_name, recipe_version, frame_id, source, "
-    "serial, expected, verdict, failed_checks, error, inspection_ms, timings_json, defect";
+    "serial, expected, verdict, failed_checks, error, inspection_ms, timings_json, defect, notes";
+
+// Columns added after the first stores were written (TEXT, '' by default): an older store gains
+// them when opened, and the merge reads '' from an older shard.
+inline constexpr const char* kLaterPartColumns[] = {"defect", "notes"};
 
 struct RetentionPolicy {
   std::optional<std::chrono::seconds> maxAge;  // parts older than this are deleted (none = keep)

@@ -131,6 +131,7 @@ InspectionOutcome inspectPart(const PartInput& part, const PreparedRecipe& prepa
             *result.point + cv::Point2d(8, -8),
             labelText(step.id, values) + (result.note.empty() ? "" : " (" + result.note + ")"),
             stepPass);
+      if (!result.note.empty()) out.notes.push_back(step.id + ": " + result.note);
       out.measurements.insert(out.measurements.end(), values.begin(), values.end());
       done.emplace(step.id, std::move(result));
     }
@@ -148,6 +149,7 @@ void recordOutcome(PartResult& part, const InspectionOutcome& outcome) {
   part.measurements = outcome.measurements;
   part.failedChecks = outcome.failedChecks;
   part.error = outcome.error;
+  part.notes = outcome.notes;
   part.timings = outcome.timings;
   part.inspectionMs = outcome.totalMs;
 }

@@ -36,6 +36,7 @@ struct InspectionOutcome {
   std::vector<Measurement> measurements;
   std::vector<std::string> failedChecks;  // "<step>.<check>" or "<step>: <cause>"
   std::string error;                      // set with Verdict::Error
+  std::vector<std::string> notes;         // "<step>: <reservation>" for results that stand
   std::vector<StepTiming> timings;
   double totalMs = 0;
   Overlay overlay;
@@ -63,8 +64,8 @@ std::shared_ptr<const PreparedRecipe> prepareRecipe(std::shared_ptr<const config
 // Never throws: faults become Verdict::Error with the cause. Safe to call from several threads.
 [[nodiscard]] InspectionOutcome inspectPart(const PartInput& part, const PreparedRecipe& recipe);
 
-// Copies an inspection's verdict, measurements, failed checks, error and timings into the part
-// (facetd's store and the replay report keep the same record of a part).
+// Copies an inspection's verdict, measurements, failed checks, error, notes and timings into the
+// part (facetd's store and the replay report keep the same record of a part).
 void recordOutcome(PartResult& part, const InspectionOutcome& outcome);
 
 }  // namespace facet::service

@@ -52,6 +52,9 @@ struct PartResult {
   Verdict verdict = Verdict::Error;
   std::vector<std::string> failedChecks;  // measurement names (or step names) that failed
   std::string error;                      // why the verdict is Error
+  // "<step>: <reservation>" of results that stand with one ("part of the caliper lies outside
+  // the image: measured inside only"), so that a reviewer sees them without the picture.
+  std::vector<std::string> notes;
   std::vector<Measurement> measurements;
   std::vector<StepTiming> timings;
   double inspectionMs = 0;

@@ -37,6 +37,7 @@ PartResult partFromFleetMessage(const nlohmann::json& message, std::string* stat
     p.expectedVerdict = message.at("expected_verdict").get<std::string>();
     // Messages queued by a facetd from before `defect` have none.
     p.recordedDefect = message.value("defect", std::string());
+    p.notes = message.value("notes", std::vector<std::string>());
     const std::string verdict = message.at("verdict").get<std::string>();
     p.verdict = verdict == "pass"   ? Verdict::Pass
                 : verdict == "fail" ? Verdict::Fail

@@ -33,10 +33,13 @@ CREATE TABLE IF NOT EXISTS parts (
   inspection_ms  DOUBLE PRECISION NOT NULL,
   timings_json   TEXT NOT NULL,
   defect         TEXT NOT NULL DEFAULT '',
+  notes          TEXT NOT NULL DEFAULT '',
   PRIMARY KEY (station, part_id, time_us)
 );
--- A database made before parts had `defect` (a recorded part's known fault) gains it.
+-- A database made before parts had `defect` (a recorded part's known fault) or `notes` (one a
+-- line) gains them.
 ALTER TABLE parts ADD COLUMN IF NOT EXISTS defect TEXT NOT NULL DEFAULT '';
+ALTER TABLE parts ADD COLUMN IF NOT EXISTS notes TEXT NOT NULL DEFAULT '';
 CREATE INDEX IF NOT EXISTS parts_time ON parts(time_utc);
 CREATE TABLE IF NOT EXISTS measurements (
   station   TEXT NOT NULL,
@@ -108,7 +111,7 @@ bool ok(const Result& r) {
 
 constexpr const char* kInsertPart =
     "INSERT INTO parts VALUES ($1, $2, $3, to_timestamp($3::bigint / 1000000.0::float8), $4, $5, "
-    "$6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16) ON CONFLICT DO NOTHING";
+    "$6, $7, $8, $9, $10, $11, $12, $13, $14, $15, $16, $17) ON CONFLICT DO NOTHING";
 constexpr const char* kInsertValue =
     "INSERT INTO measurements VALUES ($1, $2, $3, $4, $5, $6, $7, $8, $9, $10, $11)";
 
@@ -229,12 +232,12 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
     const std::string partId = std::to_string(p.partId);
     const std::string timeUs = std::to_string(
         std::chrono::duration_cast<std::chrono::microseconds>(p.time.time_since_epoch()).count());
-    const Result part =
-        execute(conn_, kInsertPart,
-                {station, partId, timeUs, std::to_string(p.recipeId), p.recipeName, p.recipeVersion,
-                 std::to_string(p.frameId), p.source, p.serial, p.expectedVerdict,
-                 std::string(verdictName(p.verdict)), failed, p.error,
-                 fmt::format("{}", p.inspectionMs), timings.dump(), p.recordedDefect});
+    const Result part = execute(
+        conn_, kInsertPart,
+        {station, partId, timeUs, std::to_string(p.recipeId), p.recipeName, p.recipeVersion,
+         std::to_string(p.frameId), p.source, p.serial, p.expectedVerdict,
+         std::string(verdictName(p.verdict)), failed, p.error, fmt::format("{}", p.inspectionMs),
+         timings.dump(), p.recordedDefect, joinedChecks(p.notes, '\n')});
     if (!ok(part)) {
       spdlog::error("postgres: part {}: {}", p.partId, trimmed(PQerrorMessage(conn_)));
       rollback();

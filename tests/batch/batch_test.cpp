@@ -109,20 +109,23 @@ TEST(ResultsMerge, CarriesRecordedDefectsAndTakesAShardWithoutTheColumn) {
     ResultsStore a(dir / "a.db"), b(dir / "b.db");
     auto bad = sinks_test::samplePart(1);
     bad.recordedDefect = "big hole";
+    bad.notes = {"edge: measured inside only"};
     a.store(bad);
     b.store(sinks_test::samplePart(2));
   }
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open((dir / "b.db").c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db, "ALTER TABLE parts DROP COLUMN defect", nullptr, nullptr, nullptr),
-            SQLITE_OK)
-      << sqlite3_errmsg(db);
+  for (const char* drop :
+       {"ALTER TABLE parts DROP COLUMN defect", "ALTER TABLE parts DROP COLUMN notes"})
+    ASSERT_EQ(sqlite3_exec(db, drop, nullptr, nullptr, nullptr), SQLITE_OK) << sqlite3_errmsg(db);
   sqlite3_close(db);
   mergeResults({dir / "a.db", dir / "b.db"}, dir / "all.db");
   const auto parts = ResultsStore(dir / "all.db").query({});
   ASSERT_EQ(parts.size(), 2u);
   EXPECT_EQ(parts[0].recordedDefect, "big hole");
   EXPECT_EQ(parts[1].recordedDefect, "");
+  EXPECT_EQ(parts[0].notes, std::vector<std::string>{"edge: measured inside only"});
+  EXPECT_TRUE(parts[1].notes.empty());
 }
 
 TEST(GoldenSet, ReportsVerdictAndValueMismatches) {

@@ -81,6 +81,10 @@ TEST_F(MeasuringSteps, CaliperPartlyOutsideMeasuresInsideAndSaysSo) {
   ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
   EXPECT_NEAR(value(out, "edge.position").value, 5.0, 0.002);
   EXPECT_TRUE(labelSays(out, "outside the image"));
+  // ... and in the part's record, for whoever reviews it without the picture.
+  EXPECT_EQ(out.notes,
+            std::vector<std::string>{
+                "edge: part of the caliper lies outside the image: measured inside only"});
 }
 
 TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {

@@ -77,8 +77,23 @@ TEST(ResultsStore, StoresAndReadsBackEveryField) {
   EXPECT_EQ(store.integrityCheck(), "ok");
 }
 
-// A store written before parts had the recorded defect: opened, it gains the column, keeps its
-// parts (defect '') and stores new ones with theirs.
+TEST(ResultsStore, KeepsTheStepsNotes) {
+  const fs::path file = freshFile("notes.sqlite");
+  ResultsStore store(file);
+  auto p = part(1, Verdict::Pass, 10.0);
+  p.notes = {"edge: part of the caliper lies outside the image: measured inside only",
+             "bore: found off its nominal place"};
+  store.store(p);
+  store.store(part(2, Verdict::Pass, 10.0));
+  const auto parts = store.latest(10);
+  ASSERT_EQ(parts.size(), 2u);
+  EXPECT_EQ(parts[0].notes, p.notes);
+  EXPECT_TRUE(parts[1].notes.empty());
+  EXPECT_EQ(toJson(parts[0]).at("notes").size(), 2u);
+}
+
+// A store written before parts had the recorded defect and notes: opened, it gains the columns,
+// keeps its parts (defect '') and stores new ones with theirs.
 TEST(ResultsStore, StoreWithoutTheDefectColumnGainsItAndKeepsItsParts) {
   const fs::path file = freshFile("old.sqlite");
   {
@@ -89,6 +104,9 @@ TEST(ResultsStore, StoreWithoutTheDefectColumnGainsItAndKeepsItsParts) {
     sqlite3* db = nullptr;
     ASSERT_EQ(sqlite3_open(file.c_str(), &db), SQLITE_OK);
     ASSERT_EQ(sqlite3_exec(db, "ALTER TABLE parts DROP COLUMN defect", nullptr, nullptr, nullptr),
+              SQLITE_OK)
+        << sqlite3_errmsg(db);
+    ASSERT_EQ(sqlite3_exec(db, "ALTER TABLE parts DROP COLUMN notes", nullptr, nullptr, nullptr),
               SQLITE_OK)
         << sqlite3_errmsg(db);
     sqlite3_close(db);

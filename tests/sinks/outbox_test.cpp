@@ -83,6 +83,11 @@ TEST(FleetMessage, RoundTripsThePart) {
   EXPECT_EQ(back.verdict, part.verdict);
   EXPECT_EQ(back.failedChecks, part.failedChecks);
   EXPECT_EQ(back.recordedDefect, "bore_oversize");
+  EXPECT_EQ(
+      service::partFromFleetMessage(
+          nlohmann::json::parse(service::fleetMessage("cam1", samplePart(5)).dump()), &station)
+          .notes,
+      samplePart(5).notes);
   ASSERT_EQ(back.measurements.size(), 2u);
   const auto& d = back.measurements.front();
   EXPECT_EQ(d.name, "bore.diameter");
@@ -94,7 +99,9 @@ TEST(FleetMessage, RoundTripsThePart) {
   // A message queued before parts had a defect reads as a part without one.
   auto old = service::fleetMessage("cam1", part);
   old.erase("defect");
+  old.erase("notes");
   EXPECT_EQ(service::partFromFleetMessage(old, &station).recordedDefect, "");
+  EXPECT_TRUE(service::partFromFleetMessage(old, &station).notes.empty());
   EXPECT_THROW(service::partFromFleetMessage(nlohmann::json{{"station", "x"}}, &station),
                std::runtime_error);
 }

@@ -48,6 +48,8 @@ TEST(PostgresSink, WritesTheResultsStoreTablesWithTheStation) {
                      "FROM parts WHERE part_id = 7"),
             "fail bore.diameter SN7 flange 9c1e55aa bore_oversize");
   EXPECT_EQ(db.query("SELECT count(*) FROM parts WHERE defect = ''"), "9");
+  EXPECT_EQ(db.query("SELECT notes FROM parts WHERE part_id = 5"),
+            "locate: found off its nominal place");
   EXPECT_EQ(db.query("SELECT value || ' ' || unit || ' ' || nominal || ' ' || tol_minus || ' ' || "
                      "tol_plus || ' ' || checked || ' ' || pass FROM measurements "
                      "WHERE part_id = 7 AND name = 'bore.diameter'"),
@@ -150,8 +152,8 @@ TEST(PostgresSink, DatabaseDownAtStartBuffersUntilItIsThere) {
   EXPECT_FALSE(sink.status().degraded());
 }
 
-// A database written by an earlier facetd, whose parts table has no `defect`, gains the column
-// and keeps its rows.
+// A database written by an earlier facetd, whose parts table has no `defect` and `notes`, gains
+// the columns and keeps its rows.
 TEST(PostgresSink, ADatabaseFromBeforeDefectGainsTheColumn) {
   daemon_test::TempDir dir;
   PostgresCluster db(dir.path());
@@ -175,8 +177,9 @@ TEST(PostgresSink, ADatabaseFromBeforeDefectGainsTheColumn) {
   ASSERT_TRUE(waitUntil([&] { return sink.status().delivered == 1; }, 30s))
       << sink.status().lastError;
   EXPECT_EQ(
-      db.query("SELECT string_agg(station || ':' || defect, ' ' ORDER BY station) FROM parts"),
-      "cam1:bore_oversize old:");
+      db.query("SELECT string_agg(station || ':' || defect || ':' || notes, ' ' ORDER BY station) "
+               "FROM parts"),
+      "cam1:bore_oversize: old::");
 }
 
 }  // namespace

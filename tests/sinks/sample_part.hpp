@@ -22,6 +22,7 @@ inline service::PartResult samplePart(std::uint64_t id) {
   p.verdict = bad ? service::Verdict::Fail : service::Verdict::Pass;
   if (bad) p.failedChecks = {"bore.diameter"};
   if (bad) p.recordedDefect = "bore_oversize";  // a recorded part with a known fault
+  if (id % 5 == 0) p.notes = {"locate: found off its nominal place"};
   p.measurements.push_back({.name = "bore.diameter",
                             .value = bad ? 12.07 : 12.0 + 0.001 * static_cast<double>(id % 10),
                             .unit = "mm",

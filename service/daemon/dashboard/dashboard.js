@@ -77,6 +77,8 @@ function renderLast(parts) {
                                ' · ' + last.verdict + ' · ' + last.inspection_ms.toFixed(1) + ' ms';
   const failed = last.error ? last.error : (last.failed_checks || []).join(', ');
   $('last-failed').textContent = failed ? 'failed: ' + failed : '';
+  // Reservations about results that stand (a tool partly outside the image).
+  $('last-notes').textContent = (last.notes || []).join(' · ');
   if (last.part_id !== state.lastPartId) {
     state.lastPartId = last.part_id;
     $('last-image').src = '/api/last.png?part=' + last.part_id;
