@@ -300,7 +300,8 @@ void benchHoles(const CameraModel& calibrated, std::uint64_t seed, bool smoke) {
       const auto m = measureCircle(image, p);
       const auto w = circleInPlane(m, mapping);
       if (!w) {
-        std::printf("hole at (%.0f, %.0f) mm not measured: %s\n", h.x, h.y, m.message.c_str());
+        std::printf("hole at (%.0f, %.0f) mm not measured: %s\n", h.x, h.y,
+                    m.status.message.c_str());
         continue;
       }
       const double ec = cv::norm(w->centreMm - h) * 1000, ed = (w->diameterMm - 6.0) * 1000;
