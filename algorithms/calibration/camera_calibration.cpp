@@ -82,15 +82,17 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
   for (std::size_t i = 0; i < views.size(); ++i) {
     ViewFit fit;
     fit.name = views[i].name;
-    fit.why = views[i].detection.why;
+    fit.status = views[i].detection.status;
     fit.points = views[i].detection.points;
-    if (views[i].detection.found) used.push_back(i);
+    if (views[i].detection.status.ok()) used.push_back(i);
     out.views.push_back(std::move(fit));
   }
   if (static_cast<int>(used.size()) < options.minViews) {
-    out.why = "the pattern was found in " + std::to_string(used.size()) + " of " +
-              std::to_string(views.size()) + " images; at least " +
-              std::to_string(options.minViews) + " are needed";
+    out.status = Status<CalibrationFailure>::failed(
+        CalibrationFailure::TooFewViews, "the pattern was found in " + std::to_string(used.size()) +
+                                             " of " + std::to_string(views.size()) +
+                                             " images; at least " +
+                                             std::to_string(options.minViews) + " are needed");
     return out;
   }
   std::vector<std::vector<cv::Point2d>> points, outlines;
@@ -100,8 +102,10 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
   }
   out.coverage = coveredShare(coveredField(imageSize, outlines));
   if (out.coverage < options.minCoverage) {
-    out.why = "the views cover " + percent(out.coverage) + " of the image; at least " +
-              percent(options.minCoverage) + " are needed (move the plate into the corners)";
+    out.status = Status<CalibrationFailure>::failed(
+        CalibrationFailure::CoverageTooSmall,
+        "the views cover " + percent(out.coverage) + " of the image; at least " +
+            percent(options.minCoverage) + " are needed (move the plate into the corners)");
     return out;
   }
   if (out.coverage < options.warnCoverage)
@@ -144,21 +148,22 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
     fit.rmsPx = std::sqrt(sum / static_cast<double>(plate.size()));
   }
   if (out.rmsPx > options.maxRmsPx) {
-    out.why = "the RMS reprojection error is " + std::to_string(out.rmsPx) +
-              " px, above the limit of " + std::to_string(options.maxRmsPx) +
-              " px (wrong square size, a bent plate, or motion blur?)";
+    out.status = Status<CalibrationFailure>::failed(
+        CalibrationFailure::RmsTooLarge,
+        "the RMS reprojection error is " + std::to_string(out.rmsPx) + " px, above the limit of " +
+            std::to_string(options.maxRmsPx) +
+            " px (wrong square size, a bent plate, or motion blur?)");
     return out;
   }
-  out.ok = true;
   return out;
 }
 
-bool estimatePlanePose(const BoardSpec& board, const CameraModel& camera, const PlateView& view,
-                       double offsetMm, PlanePose& pose, std::string& why) {
-  if (!view.detection.found) {
-    why = view.name + ": " + view.detection.why;
-    return false;
-  }
+Status<CalibrationFailure> estimatePlanePose(const BoardSpec& board, const CameraModel& camera,
+                                             const PlateView& view, double offsetMm,
+                                             PlanePose& pose) {
+  if (!view.detection.status.ok())
+    return Status<CalibrationFailure>::failed(CalibrationFailure::PatternNotFound,
+                                              view.name + ": " + view.detection.status.message);
   std::vector<cv::Point2d> points = view.detection.points;
   cv::Mat rvec, tvec;
   std::vector<cv::Point3d> plate = board.platePoints();
@@ -174,7 +179,7 @@ bool estimatePlanePose(const BoardSpec& board, const CameraModel& camera, const 
   pose.rotation = rotationOf(rvec);
   pose.translationMm = cv::Vec3d(tvec.ptr<double>());
   pose.offsetMm = offsetMm;
-  return true;
+  return {};
 }
 
 }  // namespace facet

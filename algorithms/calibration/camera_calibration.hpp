@@ -12,16 +12,18 @@
 #include <opencv2/core.hpp>
 
 #include "algorithms/calibration/board_spec.hpp"
+#include "algorithms/calibration/calibration_failure.hpp"
 #include "algorithms/calibration/camera_model.hpp"
 #include "algorithms/calibration/pattern_detection.hpp"
 #include "algorithms/calibration/world_mapping.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
 // One image of the plate as detected.
 struct PlateView {
   std::string name;                            // file name, for messages
-  PatternDetection detection;                  // found, why, points
+  PatternDetection detection;                  // status, points
   std::vector<std::vector<cv::Point2d>> rims;  // circle grids: each mark's rim points
 };
 
@@ -42,7 +44,7 @@ struct CalibrationOptions {
 struct ViewFit {
   std::string name;
   bool used = false;
-  std::string why;                            // not used: the reason
+  Status<CalibrationFailure> status;          // PatternNotFound: why it cannot be used
   double rmsPx = 0;                           // reprojection RMS of this view's points
   std::vector<cv::Point2d> points;            // detected points
   std::vector<cv::Point2d> residuals;         // detected - reprojected, pixels
@@ -51,9 +53,8 @@ struct ViewFit {
 };
 
 struct CameraCalibration {
-  bool ok = false;
-  std::string why;      // refused: the reason
-  std::string warning;  // accepted with a reservation (coverage)
+  Status<CalibrationFailure> status;  // refused: the cause and the reason
+  std::string warning;                // accepted with a reservation (coverage)
   CameraModel camera;
   double rmsPx = 0;
   double coverage = 0;  // covered share of the image, 0..1
@@ -66,8 +67,9 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
 
 // The measuring plane from one view of the plate lying where the parts lie (solvePnP on the
 // view's points with the calibrated camera); `offsetMm` lifts the plane towards the camera.
-// Returns false with `why` when the view has no pattern.
-bool estimatePlanePose(const BoardSpec& board, const CameraModel& camera, const PlateView& view,
-                       double offsetMm, PlanePose& pose, std::string& why);
+// Fails with PatternNotFound (`pose` untouched) when the view has no pattern.
+Status<CalibrationFailure> estimatePlanePose(const BoardSpec& board, const CameraModel& camera,
+                                             const PlateView& view, double offsetMm,
+                                             PlanePose& pose);
 
 }  // namespace facet

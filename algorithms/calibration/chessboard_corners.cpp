@@ -128,8 +128,8 @@ std::optional<cv::Point2d> intersect(const EdgeCurve& u, const EdgeCurve& v, cv:
 
 }  // namespace
 
-bool refineChessboardCorners(const cv::Mat& image, int cols, int rows,
-                             std::vector<cv::Point2d>& corners, std::string& why) {
+Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int cols, int rows,
+                                                   std::vector<cv::Point2d>& corners) {
   auto at = [&](int c, int r) { return corners[static_cast<std::size_t>(r * cols + c)]; };
   std::vector<cv::Point2d> refined(corners.size());
   for (int r = 0; r < rows; ++r) {
@@ -154,9 +154,10 @@ bool refineChessboardCorners(const cv::Mat& image, int cols, int rows,
       const double inner = (6.75 + 3.0 * edges.blurSigma) / sine + 1.0;
       const double outer = spacing - inner;
       if (outer < inner + 4.0) {
-        why = "squares too small for the blur and the view angle (" + std::to_string(spacing) +
-              " px between corners, edge blur sigma " + std::to_string(edges.blurSigma) + " px)";
-        return false;
+        return Status<CalibrationFailure>::failed(
+            CalibrationFailure::PatternNotFound,
+            "squares too small for the blur and the view angle (" + std::to_string(spacing) +
+                " px between corners, edge blur sigma " + std::to_string(edges.blurSigma) + " px)");
       }
       const int half = static_cast<int>(std::ceil(outer)) + 1;
       if (half > probe) {
@@ -178,15 +179,16 @@ bool refineChessboardCorners(const cv::Mat& image, int cols, int rows,
       std::optional<cv::Point2d> q;
       if (fitCurve(onX, lx) && fitCurve(onY, ly)) q = intersect(lx, ly, p);
       if (!q || cv::norm(*q - p) > 2.0) {
-        why = "corner (" + std::to_string(c) + ", " + std::to_string(r) +
-              ") has too few clean edge points on its two lines (blurred or partly hidden?)";
-        return false;
+        return Status<CalibrationFailure>::failed(
+            CalibrationFailure::PatternNotFound,
+            "corner (" + std::to_string(c) + ", " + std::to_string(r) +
+                ") has too few clean edge points on its two lines (blurred or partly hidden?)");
       }
       refined[static_cast<std::size_t>(r * cols + c)] = *q;
     }
   }
   corners = std::move(refined);
-  return true;
+  return {};
 }
 
 PatternDetection detectChessboard(const cv::Mat& image, const BoardSpec& board) {
@@ -206,21 +208,22 @@ PatternDetection detectChessboard(const cv::Mat& image, const BoardSpec& board) 
   if (ok && halve)
     for (auto& f : found) f = f * 2.0f + cv::Point2f(0.5f, 0.5f);
   if (!ok) {
-    out.why = "no chessboard of " + std::to_string(board.cols) + "x" + std::to_string(board.rows) +
-              " inner corners found (wrong board spec, board partly outside the image, or too "
-              "blurred)";
+    out.status.message =
+        "no chessboard of " + std::to_string(board.cols) + "x" + std::to_string(board.rows) +
+        " inner corners found (wrong board spec, board partly outside the image, or too "
+        "blurred)";
     return out;
   }
   out.points.assign(found.begin(), found.end());
   if (squaresBeyondBorder(image8, board.cols, board.rows, out.points)) {
     out.points.clear();
-    out.why = "the plate has more squares than " + std::to_string(board.cols) + "x" +
-              std::to_string(board.rows) + " inner corners (is the board spec right?)";
+    out.status.message = "the plate has more squares than " + std::to_string(board.cols) + "x" +
+                         std::to_string(board.rows) + " inner corners (is the board spec right?)";
     return out;
   }
   toPlateOrder(image8, board.cols, board.rows, out.points);
-  out.found = refineChessboardCorners(image, board.cols, board.rows, out.points, out.why);
-  if (!out.found) out.points.clear();
+  out.status = refineChessboardCorners(image, board.cols, board.rows, out.points);
+  if (!out.status.ok()) out.points.clear();
   return out;
 }
 

@@ -15,16 +15,18 @@
 #include <opencv2/core.hpp>
 
 #include "algorithms/calibration/board_spec.hpp"
+#include "algorithms/calibration/calibration_failure.hpp"
 #include "algorithms/calibration/pattern_detection.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
 // `image`: 8-bit or 16-bit grey.
 PatternDetection detectChessboard(const cv::Mat& image, const BoardSpec& board);
 
-// Refines coarse corners (plate order, cols x rows) in place; false with `why` set when a
+// Refines coarse corners (plate order, cols x rows) in place; fails with PatternNotFound when a
 // corner has too few clean edge points on either line (blur too wide for the square size).
-bool refineChessboardCorners(const cv::Mat& image, int cols, int rows,
-                             std::vector<cv::Point2d>& corners, std::string& why);
+Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int cols, int rows,
+                                                   std::vector<cv::Point2d>& corners);
 
 }  // namespace facet

@@ -47,10 +47,10 @@ CircleMarks detectCircleMarks(const cv::Mat& image, const BoardSpec& board) {
       cv::findCirclesGrid(image8, cv::Size(board.cols, board.rows), found,
                           cv::CALIB_CB_SYMMETRIC_GRID, cv::SimpleBlobDetector::create(blobs));
   if (!ok) {
-    out.detection.why = "no grid of " + std::to_string(board.cols) + "x" +
-                        std::to_string(board.rows) +
-                        " circular marks found (wrong board spec, grid partly outside the image, "
-                        "or too blurred)";
+    out.detection.status.message =
+        "no grid of " + std::to_string(board.cols) + "x" + std::to_string(board.rows) +
+        " circular marks found (wrong board spec, grid partly outside the image, "
+        "or too blurred)";
     return out;
   }
   std::vector<cv::Point2d> coarse(found.begin(), found.end());
@@ -82,15 +82,16 @@ CircleMarks detectCircleMarks(const cv::Mat& image, const BoardSpec& board) {
       }
       const auto conic = robustConic(rim);
       if (!conic || rim.size() < 12) {
-        out.detection.why = "mark (" + std::to_string(c) + ", " + std::to_string(r) +
-                            ") has no clean rim (blurred, partly hidden or touching another)";
+        out.detection.status.message =
+            "mark (" + std::to_string(c) + ", " + std::to_string(r) +
+            ") has no clean rim (blurred, partly hidden or touching another)";
         out.rims.clear();
         return out;
       }
       const cv::Point2d centre = conicPole(*conic, {0, 0, 1});
       if (cv::norm(centre - p) > 3.0) {
-        out.detection.why = "mark (" + std::to_string(c) + ", " + std::to_string(r) +
-                            ") rim does not fit an ellipse around its blob";
+        out.detection.status.message = "mark (" + std::to_string(c) + ", " + std::to_string(r) +
+                                       ") rim does not fit an ellipse around its blob";
         out.rims.clear();
         return out;
       }
@@ -98,7 +99,7 @@ CircleMarks detectCircleMarks(const cv::Mat& image, const BoardSpec& board) {
       out.rims.push_back(std::move(rim));
     }
   }
-  out.detection.found = true;
+  out.detection.status = {};
   return out;
 }
 

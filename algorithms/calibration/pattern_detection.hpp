@@ -1,16 +1,18 @@
 #pragma once
 // PatternDetection: where a calibration plate's points lie in one image.
 
-#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/calibration/calibration_failure.hpp"
+#include "algorithms/status/status.hpp"
+
 namespace facet {
 
 struct PatternDetection {
-  bool found = false;
-  std::string why;                  // when not found: the reason, for the user
+  // Not found until a detector has found it; PatternNotFound with the reason for the user.
+  Status<CalibrationFailure> status{CalibrationFailure::PatternNotFound, {}};
   std::vector<cv::Point2d> points;  // image pixels, in BoardSpec::platePoints() order
 };
 

@@ -49,7 +49,7 @@ std::optional<PlaneCircle> fitCircle(const std::vector<cv::Point2d>& points) {
 }
 
 std::optional<PlaneCircle> circleInPlane(const CircleMeasurement& m, const WorldMapping& mapping) {
-  if (!m.ok() || m.inlierPoints.size() < 3) return std::nullopt;
+  if (!m.status.ok() || m.inlierPoints.size() < 3) return std::nullopt;
   // The edge points' own circle in the image, for the outward direction of each point.
   const auto edges = fitCircle(m.inlierPoints);
   if (!edges) return std::nullopt;

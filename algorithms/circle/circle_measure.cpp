@@ -31,8 +31,7 @@ using circle_fit::residual;
 using circle_fit::robustWeight;
 
 CircleMeasurement failed(CircleMeasurement m, CircleFailure f, std::string message) {
-  m.failures |= static_cast<std::uint32_t>(f);
-  if (m.message.empty()) m.message = std::move(message);
+  m.status = Status<CircleFailure>::failed(f, std::move(message));
   m.centre = {kNaN, kNaN};
   m.radius = m.diameter = kNaN;
   return m;
@@ -184,30 +183,22 @@ struct Candidate {
 
 }  // namespace
 
-const char* circleFailureName(CircleFailure failure) {
+std::string_view toString(CircleFailure failure) {
   switch (failure) {
     case CircleFailure::None:
       return "";
+    case CircleFailure::BadInput:
+      return "bad_input";
+    case CircleFailure::AnnulusOutsideImage:
+      return "annulus_outside_image";
     case CircleFailure::TooFewPoints:
       return "too_few_points";
     case CircleFailure::CoverageTooSmall:
       return "coverage_too_small";
     case CircleFailure::FitTooPoor:
       return "fit_too_poor";
-    case CircleFailure::AnnulusOutsideImage:
-      return "annulus_outside_image";
-    case CircleFailure::BadInput:
-      return "bad_input";
   }
   return "";
-}
-
-std::string circleFailureCause(std::uint32_t failures) {
-  for (CircleFailure f :
-       {CircleFailure::BadInput, CircleFailure::AnnulusOutsideImage, CircleFailure::TooFewPoints,
-        CircleFailure::CoverageTooSmall, CircleFailure::FitTooPoor})
-    if (failures & static_cast<std::uint32_t>(f)) return circleFailureName(f);
-  return {};
 }
 
 CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams& params) {

@@ -23,17 +23,19 @@
 //      fit repeated.
 // RMS, roundness, inliers and coverage always describe the edge points of step 5.
 //
-// Failures are reported as flags with a cause and a message, never as a bogus circle: when
-// `ok()` is false the centre, radius and diameter are NaN.
+// Failures are reported as a cause and a message (Status<CircleFailure>), never as a bogus
+// circle: when `status.ok()` is false the centre, radius and diameter are NaN.
 //
 // Coordinates: x right, y down, centre of pixel (0,0) at (0,0). Lengths in pixels.
 
-#include <cstdint>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include <opencv2/core.hpp>
+
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
@@ -96,20 +98,23 @@ struct CircleMeasureParams {
   double radiusBiasK = 1.1;
 };
 
-// Failure causes; CircleMeasurement::failures is a bit set of these.
-enum class CircleFailure : std::uint32_t {
-  None = 0,
-  TooFewPoints = 1u << 0,         // fewer than minInliers edge points / inliers
-  CoverageTooSmall = 1u << 1,     // inliers cover less than minCoverageDeg
-  FitTooPoor = 1u << 2,           // RMS of the inliers above maxRms, or the fit did not converge
-  AnnulusOutsideImage = 1u << 3,  // the search annulus does not lie (enough) inside the image
-  BadInput = 1u << 4,             // empty image, wrong type, radius <= 0, width <= 0, NaN, ...
+// Why a circle was not measured, most fundamental first: a measurement stops at the first.
+enum class CircleFailure {
+  None,                 // measured
+  BadInput,             // empty image, wrong type, radius <= 0, width <= 0, NaN, ...
+  AnnulusOutsideImage,  // the search annulus does not lie (enough) inside the image
+  TooFewPoints,         // fewer than minInliers edge points / inliers
+  CoverageTooSmall,     // inliers cover less than minCoverageDeg
+  FitTooPoor,           // RMS of the inliers above maxRms, or the fit did not converge
 };
 
+// Machine-readable snake_case name of a cause ("too_few_points", ...); "" for None.
+[[nodiscard]] std::string_view toString(CircleFailure failure);
+
 struct CircleMeasurement {
-  cv::Point2d centre{};       // pixels; NaN when !ok()
-  double radius = 0.0;        // pixels; NaN when !ok()
-  double diameter = 0.0;      // pixels; NaN when !ok()
+  cv::Point2d centre{};       // pixels; NaN when !status.ok()
+  double radius = 0.0;        // pixels; NaN when !status.ok()
+  double diameter = 0.0;      // pixels; NaN when !status.ok()
   double roundness = 0.0;     // max minus min signed radial deviation of the inliers, pixels
   double rms = 0.0;           // RMS of the inliers' orthogonal residuals, pixels
   int edgePoints = 0;         // subpixel edge points found in the annulus
@@ -122,22 +127,11 @@ struct CircleMeasurement {
   double highThreshold = 0.0;
   std::vector<cv::Point2d> inlierPoints;  // subpixel edge points of the fit, for display
 
-  std::uint32_t failures = 0;  // bit set of CircleFailure
-  std::string message;         // human-readable cause when !ok()
-
-  [[nodiscard]] bool ok() const { return failures == 0; }
-  [[nodiscard]] bool has(CircleFailure f) const {
-    return (failures & static_cast<std::uint32_t>(f)) != 0;
-  }
+  Status<CircleFailure> status;  // NaN centre, radius and diameter when !ok()
 };
 
-// Machine-readable snake_case name of one failure cause ("too_few_points", ...).
-const char* circleFailureName(CircleFailure failure);
-// Name of the first (most fundamental) cause in a failure bit set; "" when there is none.
-std::string circleFailureCause(std::uint32_t failures);
-
 // Measures one circle in an 8-bit or 16-bit single-channel image. Never throws for bad input:
-// the result carries BadInput and a message instead.
+// the result's status carries BadInput and a message instead.
 CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams& params);
 
 }  // namespace facet

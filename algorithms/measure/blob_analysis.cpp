@@ -11,8 +11,7 @@ namespace {
 
 BlobResult failed(MeasureFailure cause, std::string message, bool partial) {
   BlobResult r;
-  r.failure = cause;
-  r.message = std::move(message);
+  r.status = Status<MeasureFailure>::failed(cause, std::move(message));
   r.partial = partial;
   return r;
 }

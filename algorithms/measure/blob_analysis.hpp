@@ -16,6 +16,7 @@
 #include <opencv2/core.hpp>
 
 #include "algorithms/measure/measure_failure.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
@@ -50,9 +51,7 @@ struct BlobResult {
   std::vector<Blob> blobs;  // sorted by area, largest first
   double threshold = 0;     // the grey level used (8-bit scale)
   bool partial = false;     // the region was clipped to the image
-  MeasureFailure failure = MeasureFailure::None;
-  std::string message;
-  [[nodiscard]] bool ok() const { return failure == MeasureFailure::None; }
+  Status<MeasureFailure> status;
 };
 
 // CV_8UC1 / CV_16UC1 image (other types throw std::invalid_argument).

@@ -21,8 +21,7 @@ std::vector<T> choose(std::vector<T> items, EdgeSelect select, Strength strength
 
 CaliperResult failed(MeasureFailure cause, std::string message, bool partial = false) {
   CaliperResult r;
-  r.failure = cause;
-  r.message = std::move(message);
+  r.status = Status<MeasureFailure>::failed(cause, std::move(message));
   r.partial = partial;
   return r;
 }

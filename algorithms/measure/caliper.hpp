@@ -16,6 +16,7 @@
 #include "algorithms/measure/measure_failure.hpp"
 #include "algorithms/measure/measuring_path.hpp"
 #include "algorithms/measure/profile_edges.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
@@ -48,9 +49,7 @@ struct CaliperResult {
   std::vector<CaliperEdge> edges;  // selected edges, sorted by position
   std::vector<CaliperPair> pairs;  // selected pairs (when asked), sorted by position
   bool partial = false;            // part of the path lay outside the image
-  MeasureFailure failure = MeasureFailure::None;
-  std::string message;  // why, when failure != None
-  [[nodiscard]] bool ok() const { return failure == MeasureFailure::None; }
+  Status<MeasureFailure> status;
 };
 
 // Measures along `path` in a CV_8UC1 / CV_16UC1 image (other types throw std::invalid_argument).

@@ -8,8 +8,7 @@ namespace {
 
 LineMeasurement failed(MeasureFailure cause, std::string message, bool partial) {
   LineMeasurement m;
-  m.failure = cause;
-  m.message = std::move(message);
+  m.status = Status<MeasureFailure>::failed(cause, std::move(message));
   m.partial = partial;
   return m;
 }

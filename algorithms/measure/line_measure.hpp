@@ -16,6 +16,8 @@
 
 #include "algorithms/measure/caliper.hpp"
 #include "algorithms/measure/line_fit.hpp"
+#include "algorithms/measure/measure_failure.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
@@ -40,9 +42,7 @@ struct LineMeasurement {
   int stations = 0;         // cross calipers inside the image
   std::vector<cv::Point2d> edgePoints;  // every edge point found (inliers and outliers)
   bool partial = false;                 // part of the rectangle lay outside the image
-  MeasureFailure failure = MeasureFailure::None;
-  std::string message;
-  [[nodiscard]] bool ok() const { return failure == MeasureFailure::None; }
+  Status<MeasureFailure> status;
 };
 
 LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,

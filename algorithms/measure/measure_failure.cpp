@@ -2,7 +2,7 @@
 
 namespace facet {
 
-std::string measureFailureCause(MeasureFailure failure) {
+std::string_view toString(MeasureFailure failure) {
   switch (failure) {
     case MeasureFailure::None:
       return "none";

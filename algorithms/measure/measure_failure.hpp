@@ -1,8 +1,9 @@
 #pragma once
 // Why a measuring tool gave no result. A tool never reports a made-up position: when it cannot
-// measure, it says why with one of these causes and a sentence for the engineer.
+// measure, its Status<MeasureFailure> (algorithms/status) says why with one of these causes and
+// a sentence for the engineer.
 
-#include <string>
+#include <string_view>
 
 namespace facet {
 
@@ -18,6 +19,6 @@ enum class MeasureFailure {
 };
 
 // snake_case name for JSON and logs ("zero_size", "outside_image", ...).
-std::string measureFailureCause(MeasureFailure failure);
+[[nodiscard]] std::string_view toString(MeasureFailure failure);
 
 }  // namespace facet

@@ -8,14 +8,14 @@ FiducialResult locateFiducials(const cv::Mat& ref, const std::vector<cv::Point2d
                                const cv::Mat& image, RegistrationParams params) {
   FiducialResult out;
   if (refMarks.size() < 2) {
-    out.failureCause = "too_few_fiducials";
-    out.message = "at least two reference marks are needed to give a rotation";
+    out.status = Status<RegistrationFailure>::failed(
+        RegistrationFailure::TooFewFiducials,
+        "at least two reference marks are needed to give a rotation");
     return out;
   }
   const RegistrationResult r = registerImages(ref, image, params);
-  if (!r.ok) {
-    out.failureCause = r.failureCause;
-    out.message = r.message;
+  if (!r.status.ok()) {
+    out.status = r.status;
     return out;
   }
   out.H = r.H;
@@ -24,13 +24,12 @@ FiducialResult locateFiducials(const cv::Mat& ref, const std::vector<cv::Point2d
   // is the part's rotation.
   const auto similarity = fitSimilarity(refMarks, out.marks);
   if (!similarity) {
-    out.failureCause = "too_few_fiducials";
-    out.message = "the reference marks coincide";
+    out.status = Status<RegistrationFailure>::failed(RegistrationFailure::TooFewFiducials,
+                                                     "the reference marks coincide");
     return out;
   }
   out.rotationDeg = similarity->rotationDeg;
   out.scale = similarity->scale;
-  out.ok = true;
   return out;
 }
 

@@ -9,15 +9,15 @@
 #include <opencv2/core.hpp>
 
 #include "algorithms/registration/register_images.hpp"
+#include "algorithms/registration/registration_failure.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
 struct FiducialResult {
-  bool ok = false;
-  std::string failureCause;  // as RegistrationResult, or "too_few_fiducials"
-  std::string message;
-  std::vector<cv::Point2d> marks;  // image positions, same order as the reference marks
-  double rotationDeg = 0;          // part rotation, counter-clockwise on screen (Pose2D)
+  Status<RegistrationFailure> status;  // as RegistrationResult's, or TooFewFiducials
+  std::vector<cv::Point2d> marks;      // image positions, same order as the reference marks
+  double rotationDeg = 0;              // part rotation, counter-clockwise on screen (Pose2D)
   double scale = 1;
   cv::Matx33d H = cv::Matx33d::eye();  // reference -> image
 };

@@ -204,10 +204,8 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
   return out;
 }
 
-RegistrationResult failure(RegistrationResult r, std::string cause, std::string message) {
-  r.ok = false;
-  r.failureCause = std::move(cause);
-  r.message = std::move(message);
+RegistrationResult failure(RegistrationResult r, RegistrationFailure cause, std::string message) {
+  r.status = Status<RegistrationFailure>::failed(cause, std::move(message));
   return r;
 }
 
@@ -216,7 +214,7 @@ struct GlobalStage {
   std::vector<int> inliers;  // indices into matches
   cv::Matx33d H = cv::Matx33d::eye();
   int refCorners = 0, imageCorners = 0;
-  std::string failureCause, message;  // empty when a transform was found
+  Status<RegistrationFailure> status;  // ok when a transform was found
 };
 
 // All-pairs window matching of the first `count` corners of each image, pruning by the matches'
@@ -238,9 +236,10 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
   g.refCorners = static_cast<int>(a.windows.size());
   g.imageCorners = static_cast<int>(b.windows.size());
   if (a.windows.size() < 4 || b.windows.size() < 4) {
-    g.failureCause = "too_few_corners";
-    g.message = "fewer than 4 usable corners (reference " + std::to_string(a.windows.size()) +
-                ", image " + std::to_string(b.windows.size()) + ")";
+    g.status.cause = RegistrationFailure::TooFewCorners;
+    g.status.message = "fewer than 4 usable corners (reference " +
+                       std::to_string(a.windows.size()) + ", image " +
+                       std::to_string(b.windows.size()) + ")";
     return g;
   }
   NccMatchParams mp = params.matching;
@@ -269,9 +268,9 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
                                                                  : 4;
   const int needed = std::max(minimal, params.minInliers);
   if (static_cast<int>(src.size()) < needed) {
-    g.failureCause = "too_few_matches";
-    g.message = std::to_string(src.size()) + " consistent matches, at least " +
-                std::to_string(needed) + " needed";
+    g.status.cause = RegistrationFailure::TooFewMatches;
+    g.status.message = std::to_string(src.size()) + " consistent matches, at least " +
+                       std::to_string(needed) + " needed";
     return g;
   }
   TransformFitParams fp;
@@ -279,14 +278,14 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
   fp.inlierThreshold = params.inlierThreshold;
   const auto fit = fitTransformWithLocalMaps(src, dst, keptMaps, fp);
   if (!fit) {
-    g.failureCause = "degenerate_transform";
-    g.message = "no non-degenerate transform fits the matches";
+    g.status.cause = RegistrationFailure::DegenerateTransform;
+    g.status.message = "no non-degenerate transform fits the matches";
     return g;
   }
   if (static_cast<int>(fit->inliers.size()) < params.minInliers) {
-    g.failureCause = "too_few_inliers";
-    g.message = std::to_string(fit->inliers.size()) + " inliers, at least " +
-                std::to_string(params.minInliers) + " needed";
+    g.status.cause = RegistrationFailure::TooFewInliers;
+    g.status.message = std::to_string(fit->inliers.size()) + " inliers, at least " +
+                       std::to_string(params.minInliers) + " needed";
     return g;
   }
   g.H = fit->H;
@@ -308,13 +307,15 @@ RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& i
   RegistrationResult result;
   result.stage = params.affineRegions ? "harris-affine" : "harris";
   if (refImage.empty() || image.empty())
-    return failure(result, "empty_image",
+    return failure(result, RegistrationFailure::EmptyImage,
                    refImage.empty() ? "the reference image is empty" : "the image is empty");
   const cv::Mat ref = unitGrey(refImage), img = unitGrey(image);
   if (isBlank(ref))
-    return failure(result, "blank_image", "the reference image is uniform: no corners to register");
+    return failure(result, RegistrationFailure::BlankImage,
+                   "the reference image is uniform: no corners to register");
   if (isBlank(img))
-    return failure(result, "blank_image", "the image is uniform: no corners to register");
+    return failure(result, RegistrationFailure::BlankImage,
+                   "the image is uniform: no corners to register");
 
   const std::vector<cv::Mat> refPyramid = buildSamplingPyramid(ref);
   const std::vector<cv::Mat> imgPyramid = buildSamplingPyramid(img);
@@ -334,14 +335,16 @@ RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& i
     describeUpTo(fi, imgPyramid, params, params.escalateCorners);
     GlobalStage wider =
         matchGlobally(fr, fi, params.escalateCorners, params.escalateMinScore, params);
-    if (wider.inliers.size() > stage.inliers.size() ||
-        (!stage.failureCause.empty() && wider.failureCause.empty()))
+    if (wider.inliers.size() > stage.inliers.size() || (!stage.status.ok() && wider.status.ok()))
       stage = std::move(wider);
   }
   result.refCorners = stage.refCorners;
   result.imageCorners = stage.imageCorners;
   result.matches = std::move(stage.matches);
-  if (!stage.failureCause.empty()) return failure(result, stage.failureCause, stage.message);
+  if (!stage.status.ok()) {
+    result.status = std::move(stage.status);
+    return result;
+  }
   result.H = stage.H;
   result.inliers = stage.inliers;
 
@@ -379,13 +382,12 @@ RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& i
     // A transform resting on very few global matches must be confirmed by the re-matching.
     if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
         static_cast<int>(result.inliers.size()) < params.confirmInliers)
-      return failure(result, "too_few_inliers",
+      return failure(result, RegistrationFailure::TooFewInliers,
                      std::to_string(globalInliers) +
                          " global inliers, not confirmed by re-matching (" +
                          std::to_string(result.inliers.size()) + " inliers, " +
                          std::to_string(params.confirmInliers) + " needed)");
   }
-  result.ok = true;
   return result;
 }
 

@@ -16,7 +16,9 @@
 #include "algorithms/registration/harris_corners.hpp"
 #include "algorithms/registration/log_polar_window.hpp"
 #include "algorithms/registration/ncc_matcher.hpp"
+#include "algorithms/registration/registration_failure.hpp"
 #include "algorithms/registration/transform_fit.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet {
 
@@ -76,11 +78,7 @@ struct FeatureMatch {
 };
 
 struct RegistrationResult {
-  bool ok = false;
-  // Machine-readable cause when !ok: "empty_image", "blank_image", "too_few_corners",
-  // "too_few_matches", "too_few_inliers", "degenerate_transform"; empty when ok.
-  std::string failureCause;
-  std::string message;                 // human-readable explanation
+  Status<RegistrationFailure> status;
   cv::Matx33d H = cv::Matx33d::eye();  // reference -> image, H(2,2) == 1
   std::vector<FeatureMatch> matches;   // final putative matches
   std::vector<int> inliers;            // indices into `matches` consistent with H

@@ -46,14 +46,15 @@ RegistrationResult registerStages(const cv::Mat& ref, const cv::Mat& image,
                                   const RegistrationParams& params) {
   RegistrationResult fast = registerSingleStage(ref, image, params);
   if (params.affineRegions || !params.escalateToAffine ||
-      (fast.ok && fast.globalInliers >= params.affineBelowInliers))
+      (fast.status.ok() && fast.globalInliers >= params.affineBelowInliers))
     return fast;
   RegistrationParams affine = params;
   affine.affineRegions = true;
   RegistrationResult adapted = registerSingleStage(ref, image, affine);
   adapted.escalated = fast.escalated = true;
-  if (!adapted.ok && fast.ok) return fast;
-  if (adapted.ok && fast.ok && adapted.globalInliers <= fast.globalInliers) return fast;
+  if (!adapted.status.ok() && fast.status.ok()) return fast;
+  if (adapted.status.ok() && fast.status.ok() && adapted.globalInliers <= fast.globalInliers)
+    return fast;
   return adapted;
 }
 
@@ -62,7 +63,7 @@ RegistrationResult registerStages(const cv::Mat& ref, const cv::Mat& image,
 RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
                                   const RegistrationParams& params) {
   RegistrationResult r = registerStages(ref, image, params);
-  if (r.ok && params.model == TransformModel::Homography && params.refineIterations > 0 &&
+  if (r.status.ok() && params.model == TransformModel::Homography && params.refineIterations > 0 &&
       params.polishHomography)
     polishHomography(r, params);
   return r;

@@ -109,13 +109,13 @@ LoopOutcome runRegistration(const ScanSurface& reference, const ScanSurface& sca
     trim(pairs, params.trimFraction, params.minCorrespondences, out.pose, settings.pointToLine);
     out.correspondences = static_cast<int>(pairs.size());
     if (out.correspondences < params.minCorrespondences) {
-      out.cause = MatchCause::TooFewCorrespondences;
+      out.status.cause = MatchCause::TooFewCorrespondences;
       return out;
     }
     out.rms = pairRms(pairs, out.pose, settings.pointToLine);
     if (settings.residualTolerance > 0.0 && gateSettled && previousRms >= 0.0 &&
         std::abs(previousRms - out.rms) < settings.residualTolerance) {
-      out.cause = MatchCause::ResidualSettled;
+      out.status.cause = MatchCause::ResidualSettled;
       return out;
     }
     previousRms = out.rms;
@@ -134,13 +134,12 @@ LoopOutcome runRegistration(const ScanSurface& reference, const ScanSurface& sca
     gateSettled = gate >= out.gate * 0.999;
     out.gate = gate;
     if (gateSettled && std::min(moved, back) < params.poseTolerance) {
-      out.converged = true;
-      out.cause = MatchCause::PoseSettled;
+      out.status.cause = MatchCause::PoseSettled;  // converged
       out.rms = pairRms(pairs, out.pose, settings.pointToLine);
       return out;
     }
   }
-  out.cause = MatchCause::MaxIterations;
+  out.status.cause = MatchCause::MaxIterations;
   return out;
 }
 

@@ -24,8 +24,8 @@ struct LoopOutcome {
   double rms = 0.0;
   int correspondences = 0;
   double gate = 0.0;  // the gate reached, to start a following phase with
-  bool converged = false;
-  MatchCause cause = MatchCause::MaxIterations;
+  // ok(): converged (PoseSettled); ResidualSettled is a hand-over, not converged
+  Status<MatchCause> status{MatchCause::MaxIterations, {}};
 };
 
 [[nodiscard]] LoopOutcome runRegistration(const ScanSurface& reference, const ScanSurface& scan,

@@ -16,8 +16,7 @@ ScanSurface fullSurface(const Scan& scan, const ScanMatchParams& params) {
 }
 
 ScanMatchResult toResult(const LoopOutcome& outcome, int iterations) {
-  return {outcome.pose,      iterations,   outcome.rms, outcome.correspondences,
-          outcome.converged, outcome.cause};
+  return {outcome.pose, iterations, outcome.rms, outcome.correspondences, outcome.status};
 }
 
 // IDCP BoC: DCP on the cluster-reduced scans until the residual settles (fast, and the reduced
@@ -41,7 +40,7 @@ ScanMatchResult matchIdcpBoc(const Scan& reference, const Scan& scan, const Scan
                                                 params.maxIterations, params.initialGate},
                                                params);
     used = coarse.iterations;
-    if (coarse.cause != MatchCause::TooFewCorrespondences) {
+    if (coarse.status.cause != MatchCause::TooFewCorrespondences) {
       start = coarse.pose;
       gate = coarse.gate;
     }
@@ -56,10 +55,10 @@ ScanMatchResult matchIdcpBoc(const Scan& reference, const Scan& scan, const Scan
 
 std::string_view toString(MatchCause cause) {
   switch (cause) {
-    case MatchCause::ResidualSettled:
-      return "residual_settled";
     case MatchCause::PoseSettled:
       return "pose_settled";
+    case MatchCause::ResidualSettled:
+      return "residual_settled";
     case MatchCause::MaxIterations:
       return "max_iterations";
     case MatchCause::TooFewCorrespondences:
@@ -90,7 +89,7 @@ ScanMatchResult matchScans(const Scan& reference, const Scan& scan, const ScanPo
   if (reference.size() < minimum || scan.size() < minimum) {
     ScanMatchResult empty;
     empty.pose = initial;
-    empty.cause = MatchCause::EmptyScan;
+    empty.status.cause = MatchCause::EmptyScan;
     return empty;
   }
   if (params.method == ScanMatchMethod::IdcpBoc)

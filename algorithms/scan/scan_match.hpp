@@ -21,6 +21,7 @@
 #include "algorithms/scan/scan.hpp"
 #include "algorithms/scan/scan_pose.hpp"
 #include "algorithms/scan/scan_segmentation.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet::scan {
 
@@ -59,10 +60,11 @@ struct ScanMatchParams {
   double reductionSpacing = 0.2;    // metres; IDCP BoC keeps about one point per spacing of cluster
 };
 
+// Why a match stopped; PoseSettled (0) is the one that counts as converged (Status::ok()).
 enum class MatchCause {
+  PoseSettled,            // converged: the pose stopped moving (poseTolerance)
   ResidualSettled,        // the reduced phase of IDCP BoC handed over (change of rms below
                           // reducedResidualTolerance); never the cause of a final result
-  PoseSettled,            // converged: the pose stopped moving (poseTolerance)
   MaxIterations,          // not converged
   TooFewCorrespondences,  // not converged: fewer than minCorrespondences pairs within the gate
   EmptyScan,              // not converged: a scan had fewer than minCorrespondences points
@@ -77,12 +79,11 @@ struct ScanMatchResult {
   double rms = 0.0;         // metres; rms error (point-to-line distance for the line metric) of the
                             // pairs used in the last round
   int correspondences = 0;  // pairs used in the last round (both directions for DCP)
-  bool converged = false;
-  MatchCause cause = MatchCause::MaxIterations;
+  Status<MatchCause> status{MatchCause::MaxIterations, {}};  // ok(): converged
 };
 
 // Aligns `scan` to `reference`, starting from `initial` (scan -> reference). Never throws on
-// degenerate data: empty scans give converged = false with cause EmptyScan.
+// degenerate data: empty scans give a status with cause EmptyScan (not converged).
 [[nodiscard]] ScanMatchResult matchScans(const Scan& reference, const Scan& scan,
                                          const ScanPose& initial = {},
                                          const ScanMatchParams& params = {});

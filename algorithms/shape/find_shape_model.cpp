@@ -160,12 +160,13 @@ struct Finisher {
     shape_detail::Refined r =
         shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, fitScale);
     const bool scaleMisfit =
-        !scaleRange && r.ok && std::abs(r.pose.scale / start.scale - 1.0) > tolerance;
+        !scaleRange && r.status.ok() && std::abs(r.pose.scale / start.scale - 1.0) > tolerance;
     if (scaleMisfit)
       r = shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, false);
     // A refinement that wanders off by more than the search's own uncertainty has locked onto
     // something else.
-    if (!r.ok || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0) return interpolated;
+    if (!r.status.ok() || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0)
+      return interpolated;
     const Finished refined{r.pose, scoreAt(r.pose), r.residual};
     // Where the refinement fitted the part fully (its scale too, within the tolerance), it is
     // kept unless it lays the model on the image's edges less well than its start: the score

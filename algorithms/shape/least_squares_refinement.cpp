@@ -13,7 +13,7 @@ namespace facet::shape_detail {
 Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Rect roi, Pose2D pose,
                            Polarity polarity, bool withScale) {
   const Pose2D start = pose;
-  Refined result{pose, 0.0, false};
+  Refined result{pose, 0.0, {RefinementFailure::TooFewCorrespondences, {}}};
   roi &= cv::Rect(0, 0, image.cols, image.rows);
   if (roi.width < 3 || roi.height < 3) return result;
   EdgeParams edgeParams;
@@ -137,11 +137,11 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
     pose.y += delta[1];
     pose.angle += delta[2];
     if (withScale) pose.scale += delta[3];
-    result = {pose, std::sqrt(sumSq / weightSum), true};
+    result = {pose, std::sqrt(sumSq / weightSum), {}};
     if (iteration >= 3 && std::hypot(delta[0], delta[1]) < 1e-4 && std::abs(delta[2]) < 1e-6) break;
   }
   result.pose.angle = wrapAngle(result.pose.angle);
-  if (result.ok) {
+  if (result.status.ok()) {
     result.support = support(result.pose);
     result.startSupport = support(start);
   }

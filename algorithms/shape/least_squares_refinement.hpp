@@ -8,13 +8,20 @@
 #include "algorithms/geometry/pose2d.hpp"
 #include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model.hpp"
+#include "algorithms/status/status.hpp"
 
 namespace facet::shape_detail {
+
+// Internal to the search, never reported: no name for logs.
+enum class RefinementFailure {
+  None,
+  TooFewCorrespondences,  // too few model points met image edges; the pose is the start pose
+};
 
 struct Refined {
   Pose2D pose;
   double residual = 0.0;  // weighted RMS point-to-line distance, pixels
-  bool ok = false;        // false: too few correspondences, the pose is the start pose
+  Status<RefinementFailure> status;
   // How well the model's points lie on image edges (each weighted by its distance across the
   // edge, 1 on it, 0 from a pixel away) at the refined pose and at the start: a refinement
   // that lowers it has made the pose worse.

@@ -175,12 +175,12 @@ std::vector<Row> benchBoard(const BoardSpec& board, int count, std::uint64_t see
     }
     row.locationRms = std::sqrt(sum / std::max(n, 1));
     row.reprojRms = c.rmsPx;
-    if (c.ok) {
+    if (c.status.ok()) {
       row.camera = c.camera;
       row.modelRms = modelError(c.camera, trueCamera(), covered);
       facetCamera = c.camera;
     } else {
-      std::printf("facet calibration refused: %s\n", c.why.c_str());
+      std::printf("facet calibration refused: %s\n", c.status.message.c_str());
     }
     rows.push_back(row);
   }
@@ -263,10 +263,10 @@ void benchHoles(const CameraModel& calibrated, std::uint64_t seed, bool smoke) {
     plate.lensBlurSigma = lensBlur, plate.noiseSigma = 2,
     plate.seed = seed * 31 + static_cast<std::uint64_t>(k);
     PlanePose pose;
-    std::string why;
-    if (!estimatePlanePose(board, calibrated, detectPlate(plate.render(), board, "plane"), 0, pose,
-                           why)) {
-      std::printf("plane not found: %s\n", why.c_str());
+    const auto plane =
+        estimatePlanePose(board, calibrated, detectPlate(plate.render(), board, "plane"), 0, pose);
+    if (!plane.ok()) {
+      std::printf("plane not found: %s\n", plane.message.c_str());
       return;
     }
     const WorldMapping mapping(calibrated, pose);
@@ -300,7 +300,8 @@ void benchHoles(const CameraModel& calibrated, std::uint64_t seed, bool smoke) {
       const auto m = measureCircle(image, p);
       const auto w = circleInPlane(m, mapping);
       if (!w) {
-        std::printf("hole at (%.0f, %.0f) mm not measured: %s\n", h.x, h.y, m.message.c_str());
+        std::printf("hole at (%.0f, %.0f) mm not measured: %s\n", h.x, h.y,
+                    m.status.message.c_str());
         continue;
       }
       const double ec = cv::norm(w->centreMm - h) * 1000, ed = (w->diameterMm - 6.0) * 1000;

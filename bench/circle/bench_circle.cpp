@@ -341,7 +341,7 @@ int main(int argc, char** argv) {
       for (int s = 0; s < scenes; ++s) {
         const Trial t = makeTrial(radius, kind, s % 2 == 1, subrows, rng);
         const facet::CircleMeasurement m = facet::measureCircle(t.image, paramsFor(t));
-        if (m.ok())
+        if (m.status.ok())
           row.ours.add(m.centre, m.radius, t);
         else
           ++row.ours.failed;
@@ -353,9 +353,10 @@ int main(int argc, char** argv) {
               "  %s r=%.0f scene %d %s: %s c err (%.4f, %.4f) r err %.4f inliers %d/%d "
               "cov %.0f rms %.3f refined %d bound c %.4f %s\n",
               caseName(kind), radius, s, t.hole ? "hole" : "disc",
-              m.ok() ? "ok" : facet::circleFailureCause(m.failures).c_str(),
+              m.status.ok() ? "ok" : std::string(facet::toString(m.status.cause)).c_str(),
               m.centre.x - t.centre.x, m.centre.y - t.centre.y, m.radius - t.radius, m.inliers,
-              m.candidates, m.coverageDeg, m.rms, m.greyRefined, b.centre, m.message.c_str());
+              m.candidates, m.coverageDeg, m.rms, m.greyRefined, b.centre,
+              m.status.message.c_str());
         cv::Point2d c;
         double r = 0;
         if (hough(t, cv::HOUGH_GRADIENT, &c, &r))
@@ -428,7 +429,7 @@ int main(int argc, char** argv) {
     const double t2 = cpuMs();
     hough(t, cv::HOUGH_GRADIENT_ALT, &c, &r);
     const double t3 = cpuMs();
-    if (!m.ok()) std::printf("timing scene failed: %s\n", m.message.c_str());
+    if (!m.status.ok()) std::printf("timing scene failed: %s\n", m.status.message.c_str());
     ours.push_back(t1 - t0);
     hgT.push_back(t2 - t1);
     altT.push_back(t3 - t2);

@@ -79,9 +79,9 @@ Outcome runOurs(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth,
     const cv::Point2d q = facet::mapPoint(truth, m.ref);
     if (std::hypot(q.x - m.image.x, q.y - m.image.y) < 3.0) ++o.correct;
   }
-  o.ok = r.ok;
+  o.ok = r.status.ok();
   o.stage = r.stage + (r.escalated ? "+" : "");
-  if (r.ok) {
+  if (r.status.ok()) {
     o.inliers = static_cast<int>(r.inliers.size());
     o.cornerError = cornerError(r.H, truth, a.size());
   }
@@ -226,14 +226,15 @@ void syntheticTable(const std::string& dir, int count) {
     const facet::RegistrationResult r = facet::registerImages(ref, image, p);
     const double ms = msSince(t0);
     totalMs += ms;
-    const double err = r.ok ? cornerError(r.H, truth, ref.size()) : 1e9;
+    const double err = r.status.ok() ? cornerError(r.H, truth, ref.size()) : 1e9;
     worst = std::max(worst, std::min(err, 1e9));
     if (err <= 2.0)
       ++success;
     else
       std::printf("  synthetic %d failed: angle %.1f deg scale %.2f -> %s %s corner error %.2f\n",
-                  k, a * 180 / CV_PI, s, r.ok ? "ok" : r.failureCause.c_str(), r.message.c_str(),
-                  err);
+                  k, a * 180 / CV_PI, s,
+                  r.status.ok() ? "ok" : std::string(facet::toString(r.status.cause)).c_str(),
+                  r.status.message.c_str(), err);
   }
   std::printf(
       "\n== Synthetic similarity pairs (graf img1 crops 256x256 -> 320x320, any angle, scale "

@@ -89,7 +89,7 @@ void caliperTable(int scenes, Timing& time) {
         const auto c = classicCaliper(s.image, s.rect);
         const double t2 = cpuMs();
         time.facet.push_back(ms(t0, t1)), time.classic.push_back(ms(t1, t2));
-        if (r.ok() && r.edges.size() == 1 && std::abs(r.edges[0].position - s.position) < 2)
+        if (r.status.ok() && r.edges.size() == 1 && std::abs(r.edges[0].position - s.position) < 2)
           ef.push_back(r.edges[0].position - s.position);
         else
           ++mf;
@@ -125,7 +125,7 @@ void pairTable(int scenes) {
           p.select = EdgeSelect::Strongest;
           p.polarity = s.light ? EdgePolarity::Rising : EdgePolarity::Falling;
           const CaliperResult r = measureCaliper(s.image, MeasuringPath(s.rect), p);
-          if (r.ok() && r.pairs.size() == 1 && std::abs(r.pairs[0].width - s.width) < 2) {
+          if (r.status.ok() && r.pairs.size() == 1 && std::abs(r.pairs[0].width - s.width) < 2) {
             ew.push_back(r.pairs[0].width - s.width);
             ecen.push_back(r.pairs[0].position - s.centre);
           } else {
@@ -169,7 +169,7 @@ void lineTable(int scenes, Timing& time) {
         const double t2 = cpuMs();
         time.facet.push_back(ms(t0, t1)), time.classic.push_back(ms(t1, t2));
         const cv::Point2d nrm(-s.direction.y, s.direction.x);
-        if (m.ok()) {
+        if (m.status.ok()) {
           double da = m.angle - s.angleDeg;
           da = std::remainder(da, 360.0);
           af.push_back(da);

@@ -75,7 +75,9 @@ void run(const BlobOptions& o) {
   const BlobResult r = analyseBlobs(image, p);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (!r.ok()) throw MeasurementFailure(measureFailureCause(r.failure), o.image + ": " + r.message);
+  if (!r.status.ok())
+    throw MeasurementFailure(std::string(toString(r.status.cause)),
+                             o.image + ": " + r.status.message);
 
   if (o.json) {
     nlohmann::json blobs = nlohmann::json::array();

@@ -63,7 +63,7 @@ nlohmann::json viewsJson(const CameraCalibration& c) {
     views.push_back({{"file", v.name},
                      {"rms_px", v.used ? nlohmann::json(v.rmsPx) : nlohmann::json()},
                      {"used", v.used},
-                     {"why", v.why}});
+                     {"why", v.status.message}});
   return views;
 }
 
@@ -74,7 +74,8 @@ nlohmann::json viewsJson(const CameraCalibration& c) {
         {{"error", {{"cause", "calibration_refused"}, {"message", why}}}, {"views", viewsJson(c)}});
   } else {
     for (const auto& v : c.views)
-      if (!v.used && !v.why.empty()) std::cerr << v.name << ": " << v.why << "\n";
+      if (!v.used && !v.status.message.empty())
+        std::cerr << v.name << ": " << v.status.message << "\n";
     std::cerr << "facet: calibration_refused: " << why << "\n";
   }
   std::cout.flush();
@@ -97,7 +98,7 @@ void run(const CalibrateOptions& o) {
     if (image.empty()) {
       PlateView v;
       v.name = name;
-      v.detection.why = "cannot read the image (unknown format or corrupt)";
+      v.detection.status.message = "cannot read the image (unknown format or corrupt)";
       views.push_back(std::move(v));
       continue;
     }
@@ -114,7 +115,7 @@ void run(const CalibrateOptions& o) {
   if (size.empty()) throw InputError(o.images + ": none of the images could be read");
 
   CameraCalibration c = calibrateCamera(*board, size, views, o.limits);
-  if (!c.ok) refuse(o, c, c.why);
+  if (!c.status.ok()) refuse(o, c, c.status.message);
 
   config::CalibrationData data;
   data.board = board->text();
@@ -130,8 +131,9 @@ void run(const CalibrateOptions& o) {
     PlanePose pose;
     const PlateView view =
         detectPlate(image, *board, std::filesystem::path(o.plane).filename().string());
-    if (!estimatePlanePose(*board, c.camera, view, o.planeOffsetMm, pose, why))
-      refuse(o, c, "--plane " + why);
+    if (const auto plane = estimatePlanePose(*board, c.camera, view, o.planeOffsetMm, pose);
+        !plane.ok())
+      refuse(o, c, "--plane " + plane.message);
     data.plane = pose;
     mapping.emplace(c.camera, pose);
     data.mmPerPixel = mapping->mmPerPixelAt({(size.width - 1) / 2.0, (size.height - 1) / 2.0});
@@ -172,7 +174,7 @@ void run(const CalibrateOptions& o) {
     if (v.used)
       std::cout << v.name << ": used, RMS " << v.rmsPx << " px\n";
     else
-      std::cout << v.name << ": not used: " << v.why << "\n";
+      std::cout << v.name << ": not used: " << v.status.message << "\n";
   }
   if (!c.warning.empty()) std::cerr << "facet: warning: " << c.warning << "\n";
   std::cout << "RMS reprojection error " << c.rmsPx << " px, field covered "

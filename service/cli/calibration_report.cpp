@@ -71,7 +71,8 @@ void writeCalibrationReport(const std::string& file, const BoardSpec& board, cv:
        "not</th></tr>";
   for (const auto& v : c.views)
     h << "<tr><td>" << escape(v.name) << "</td><td>" << (v.used ? "yes" : "no") << "</td><td>"
-      << (v.used ? std::to_string(v.rmsPx) : "") << "</td><td>" << escape(v.why) << "</td></tr>";
+      << (v.used ? std::to_string(v.rmsPx) : "") << "</td><td>" << escape(v.status.message)
+      << "</td></tr>";
   h << "</table></body></html>\n";
   std::ofstream out(file);
   out << h.str();

@@ -38,7 +38,9 @@ void run(const CaliperOptions& o) {
   const CaliperResult r = measureCaliper(image, path, p);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (!r.ok()) throw MeasurementFailure(measureFailureCause(r.failure), o.image + ": " + r.message);
+  if (!r.status.ok())
+    throw MeasurementFailure(std::string(toString(r.status.cause)),
+                             o.image + ": " + r.status.message);
 
   if (o.json) {
     nlohmann::json edges = nlohmann::json::array(), pairs = nlohmann::json::array();

@@ -54,8 +54,11 @@ void run(const CircleOptions& o) {
   const CircleMeasurement m = measureCircle(image, p);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (m.has(CircleFailure::BadInput)) throw InputError(o.image + ": " + m.message);
-  if (!m.ok()) throw MeasurementFailure(circleFailureCause(m.failures), o.image + ": " + m.message);
+  if (m.status.cause == CircleFailure::BadInput)
+    throw InputError(o.image + ": " + m.status.message);
+  if (!m.status.ok())
+    throw MeasurementFailure(std::string(toString(m.status.cause)),
+                             o.image + ": " + m.status.message);
 
   const nlohmann::json world =
       o.calibration.empty() ? nlohmann::json() : worldCircle(o.calibration, image.size(), m);

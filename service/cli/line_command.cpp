@@ -28,7 +28,9 @@ void run(const LineOptions& o) {
   const LineMeasurement m = measureLine(image, rect, p);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (!m.ok()) throw MeasurementFailure(measureFailureCause(m.failure), o.image + ": " + m.message);
+  if (!m.status.ok())
+    throw MeasurementFailure(std::string(toString(m.status.cause)),
+                             o.image + ": " + m.status.message);
 
   if (o.json) {
     printJson(

@@ -34,8 +34,9 @@ void run(const RegisterOptions& o) {
   const RegistrationResult r = registerImages(ref, image, p);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (!r.ok)
-    throw MeasurementFailure(r.failureCause, o.image + " against " + o.ref + ": " + r.message);
+  if (!r.status.ok())
+    throw MeasurementFailure(std::string(toString(r.status.cause)),
+                             o.image + " against " + o.ref + ": " + r.status.message);
 
   const std::vector<cv::Vec4d> pairs = r.pairs();
   if (o.json) {

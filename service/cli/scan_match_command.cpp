@@ -64,11 +64,11 @@ void run(const ScanMatchOptions& options) {
   const scan::ScanMatchResult r = scan::matchScans(reference, scan, initial, params);
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  if (r.cause == scan::MatchCause::EmptyScan)
+  if (r.status.cause == scan::MatchCause::EmptyScan)
     throw MeasurementFailure("empty_scan", "too few points to match: reference has " +
                                                std::to_string(reference.size()) + ", scan has " +
                                                std::to_string(scan.size()));
-  if (r.cause == scan::MatchCause::TooFewCorrespondences)
+  if (r.status.cause == scan::MatchCause::TooFewCorrespondences)
     throw MeasurementFailure("too_few_correspondences",
                              "the scans do not overlap enough from the initial pose");
   const double thetaDeg = r.pose.theta * 180.0 / std::numbers::pi;
@@ -79,8 +79,8 @@ void run(const ScanMatchOptions& options) {
                {"iterations", r.iterations},
                {"rms", r.rms},
                {"correspondences", r.correspondences},
-               {"converged", r.converged},
-               {"cause", std::string(scan::toString(r.cause))},
+               {"converged", r.status.ok()},
+               {"cause", std::string(scan::toString(r.status.cause))},
                {"method", options.method},
                {"time_ms", ms}});
     return;
@@ -88,8 +88,8 @@ void run(const ScanMatchOptions& options) {
   std::cout << "pose: x " << r.pose.x << " m, y " << r.pose.y << " m, theta " << thetaDeg
             << " deg\n"
             << "iterations " << r.iterations << ", rms " << r.rms << " m, correspondences "
-            << r.correspondences << ", " << (r.converged ? "converged" : "not converged") << " ("
-            << scan::toString(r.cause) << "), " << ms << " ms\n";
+            << r.correspondences << ", " << (r.status.ok() ? "converged" : "not converged") << " ("
+            << scan::toString(r.status.cause) << "), " << ms << " ms\n";
 }
 
 }  // namespace

@@ -36,7 +36,7 @@ cv::Mat covered(const CameraCalibration& c, cv::Size size) {
 }
 
 void expectCamera(const CameraCalibration& c, const scene::LensCamera& truth) {
-  ASSERT_TRUE(c.ok) << c.why;
+  ASSERT_TRUE(c.status.ok()) << c.status.message;
   EXPECT_LT(c.rmsPx, 0.1);
   EXPECT_NEAR(c.camera.cameraMatrix(0, 0), truth.fx, 0.005 * truth.fx);
   EXPECT_NEAR(c.camera.cameraMatrix(1, 1), truth.fy, 0.005 * truth.fy);
@@ -71,9 +71,9 @@ TEST(CameraCalibration, RefusesTooFewViewsNamingTheCount) {
   const auto camera = test::testCamera();
   const auto c = calibrateCamera(test::chessboard(), camera.size,
                                  renderViews(test::chessboard(), camera, 5, 23));
-  EXPECT_FALSE(c.ok);
-  EXPECT_NE(c.why.find("5 of 5"), std::string::npos) << c.why;
-  EXPECT_NE(c.why.find("at least 8"), std::string::npos) << c.why;
+  EXPECT_FALSE(c.status.ok());
+  EXPECT_NE(c.status.message.find("5 of 5"), std::string::npos) << c.status.message;
+  EXPECT_NE(c.status.message.find("at least 8"), std::string::npos) << c.status.message;
 }
 
 TEST(CameraCalibration, RefusesAnRmsAboveTheLimit) {
@@ -82,8 +82,8 @@ TEST(CameraCalibration, RefusesAnRmsAboveTheLimit) {
   strict.maxRmsPx = 1e-6;
   const auto c = calibrateCamera(test::chessboard(), camera.size,
                                  renderViews(test::chessboard(), camera, 8, 24), strict);
-  EXPECT_FALSE(c.ok);
-  EXPECT_NE(c.why.find("RMS"), std::string::npos) << c.why;
+  EXPECT_FALSE(c.status.ok());
+  EXPECT_NE(c.status.message.find("RMS"), std::string::npos) << c.status.message;
 }
 
 }  // namespace

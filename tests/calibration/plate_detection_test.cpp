@@ -23,7 +23,7 @@ TEST(PlateDetection, ChessboardCornersInPlateOrderAndSubpixel) {
     const auto s = test::plateScene(board, test::testCamera(), 11, i);
     const auto truth = scene::patternImagePoints(s, board.cols, board.rows, board.pitchMm);
     const PlateView view = detectPlate(s.render(), board, "view");
-    ASSERT_TRUE(view.detection.found) << view.detection.why;
+    ASSERT_TRUE(view.detection.status.ok()) << view.detection.status.message;
     ASSERT_EQ(view.detection.points.size(), truth.size());
     // Plate order: the first point is the origin, not a corner of the other end.
     EXPECT_LT(cv::norm(view.detection.points[0] - truth[0]), 0.5);
@@ -41,7 +41,7 @@ TEST(PlateDetection, CircleCentresArePerspectiveCorrectWithTheTrueCamera) {
     const auto truth = scene::patternImagePoints(s, board.cols, board.rows, board.pitchMm);
     const cv::Mat image = s.render();
     const CircleMarks marks = detectCircleMarks(image, board);
-    ASSERT_TRUE(marks.detection.found) << marks.detection.why;
+    ASSERT_TRUE(marks.detection.status.ok()) << marks.detection.status.message;
     EXPECT_LT(cv::norm(marks.detection.points[0] - truth[0]), 1.0);
     const double ellipseRms = rmsError(marks.detection.points, truth);
     CameraModel model{camera.matrix(), camera.distortion(), camera.size};
@@ -60,8 +60,9 @@ TEST(PlateDetection, WrongBoardSpecIsNotFoundWithAReason) {
   wrong.cols = 9, wrong.rows = 6;
   const PlateView view = detectPlate(s.render(), wrong, "view");
   // OpenCV may find a 9x6 part of the 11x8 board; the squares beyond its border give it away.
-  EXPECT_FALSE(view.detection.found);
-  EXPECT_NE(view.detection.why.find("9x6"), std::string::npos) << view.detection.why;
+  EXPECT_FALSE(view.detection.status.ok());
+  EXPECT_NE(view.detection.status.message.find("9x6"), std::string::npos)
+      << view.detection.status.message;
 }
 
 TEST(PlateDetection, HeavilyBlurredBoardIsSkippedWithAReason) {
@@ -69,8 +70,8 @@ TEST(PlateDetection, HeavilyBlurredBoardIsSkippedWithAReason) {
   s.lensBlurSigma = 12;
   s.fineFactor = 1;  // blur on the pixel grid: this test is about the refusal, not the model
   const PlateView view = detectPlate(s.render(), test::chessboard(), "view");
-  EXPECT_FALSE(view.detection.found);
-  EXPECT_FALSE(view.detection.why.empty());
+  EXPECT_FALSE(view.detection.status.ok());
+  EXPECT_FALSE(view.detection.status.message.empty());
 }
 
 }  // namespace

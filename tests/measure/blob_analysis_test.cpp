@@ -25,7 +25,7 @@ scene::Scene discs(double background, double grey, double noise = 2.0) {
 TEST(BlobAnalysis, CountsDiscsAndMeasuresTheirAreaToSubpixelPrecision) {
   const scene::Scene s = discs(50, 170);
   const BlobResult r = analyseBlobs(s.render());
-  ASSERT_TRUE(r.ok()) << r.message;
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
   ASSERT_EQ(r.blobs.size(), 3u);
   // Largest first.
   const double radii[] = {27.3, 12.45, 6.2};
@@ -61,7 +61,7 @@ TEST(BlobAnalysis, FindsDarkBlobsWithEveryThresholdMode) {
     p.mode = mode;
     p.threshold = mode == BlobThreshold::Fixed ? 130.0 : 70.0;
     const BlobResult r = analyseBlobs(image, p);
-    ASSERT_TRUE(r.ok()) << r.message;
+    ASSERT_TRUE(r.status.ok()) << r.status.message;
     EXPECT_EQ(r.blobs.size(), 3u) << static_cast<int>(mode);
     if (mode == BlobThreshold::RelativeToMedian) {
       EXPECT_NEAR(r.threshold, 200 - 70, 3);
@@ -102,7 +102,7 @@ TEST(BlobAnalysis, FiltersByAreaAndRoundnessAndMeasuresTheEllipse) {
   p.maxArea = 800;
   EXPECT_EQ(analyseBlobs(image, p).blobs.size(), 1u);
   p.maxArea = 100;
-  EXPECT_EQ(analyseBlobs(image, p).failure, MeasureFailure::NoBlob);
+  EXPECT_EQ(analyseBlobs(image, p).status.cause, MeasureFailure::NoBlob);
 }
 
 TEST(BlobAnalysis, WorksInARegionAndFailsWithItsCause) {
@@ -110,20 +110,20 @@ TEST(BlobAnalysis, WorksInARegionAndFailsWithItsCause) {
   BlobParams p;
   p.roi = {0, 0, 110, 120};  // the two smaller discs
   const BlobResult left = analyseBlobs(image, p);
-  ASSERT_TRUE(left.ok());
+  ASSERT_TRUE(left.status.ok());
   EXPECT_EQ(left.blobs.size(), 2u);
   EXPECT_NEAR(left.blobs[0].centroid.x, 80.7, 0.05);  // image coordinates
   p.roi = {150, 0, 100, 120};  // sticks out of the image: clipped, the big disc cut
   const BlobResult clipped = analyseBlobs(image, p);
-  ASSERT_TRUE(clipped.ok());
+  ASSERT_TRUE(clipped.status.ok());
   EXPECT_TRUE(clipped.partial);
   EXPECT_TRUE(clipped.blobs.at(0).touchesBorder);
   p.roi = {300, 300, 50, 50};
-  EXPECT_EQ(analyseBlobs(image, p).failure, MeasureFailure::OutsideImage);
+  EXPECT_EQ(analyseBlobs(image, p).status.cause, MeasureFailure::OutsideImage);
   p.roi = {10, 10, 0, 50};
-  EXPECT_EQ(analyseBlobs(image, p).failure, MeasureFailure::ZeroSize);
+  EXPECT_EQ(analyseBlobs(image, p).status.cause, MeasureFailure::ZeroSize);
   const cv::Mat flat(50, 50, CV_8U, cv::Scalar(100));
-  EXPECT_EQ(analyseBlobs(flat).failure, MeasureFailure::NoContrast);
+  EXPECT_EQ(analyseBlobs(flat).status.cause, MeasureFailure::NoContrast);
 }
 
 }  // namespace

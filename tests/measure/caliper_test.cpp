@@ -18,7 +18,7 @@ TEST(Caliper, FindsAnEdgeAtSubpixelPositionAtAnyAngle) {
     const cv::Mat image =
         test::gridEdgeImage({80, 80}, at, axisOf(angle + 3.0), 50, 170, 1.0, 1.0, 7);
     const CaliperResult r = measureCaliper(image, MeasuringPath(rect));
-    ASSERT_TRUE(r.ok()) << angle << ": " << r.message;
+    ASSERT_TRUE(r.status.ok()) << angle << ": " << r.status.message;
     ASSERT_EQ(r.edges.size(), 1u) << angle;
     EXPECT_NEAR(r.edges[0].position, truth, 0.03) << angle;
     EXPECT_NEAR(r.edges[0].amplitude, 120, 6) << angle;  // rising: light beyond
@@ -40,7 +40,7 @@ TEST(Caliper, IsUnbiasedWhetherTheBlurActsBeforeOrAfterThePixel) {
       const cv::Mat image = lens ? test::lensEdgeImage({64, 64}, at, normal, 40, 190, 0.9)
                                  : test::gridEdgeImage({64, 64}, at, normal, 40, 190, 0.9);
       const CaliperResult r = measureCaliper(image, MeasuringPath(rect));
-      ASSERT_TRUE(r.ok() && r.edges.size() == 1) << k << (lens ? " lens" : " grid");
+      ASSERT_TRUE(r.status.ok() && r.edges.size() == 1) << k << (lens ? " lens" : " grid");
       double& worst = lens ? worstLens : worstGrid;
       worst = std::max(worst, std::abs(r.edges[0].position - truth));
     }
@@ -74,7 +74,7 @@ TEST(Caliper, PairsGiveTheWidthAndCentreOfABarFourPixelsWide) {
   p.pairs = true;
   p.polarity = EdgePolarity::Rising;
   const CaliperResult r = measureCaliper(image, MeasuringPath(rect), p);
-  ASSERT_TRUE(r.ok()) << r.message;
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
   ASSERT_EQ(r.pairs.size(), 1u);
   EXPECT_NEAR(r.pairs[0].width, 4.3, 0.04);
   EXPECT_NEAR(r.pairs[0].position, 1.3, 0.03);
@@ -83,7 +83,7 @@ TEST(Caliper, PairsGiveTheWidthAndCentreOfABarFourPixelsWide) {
   // A light bar has no falling-then-rising pair.
   p.polarity = EdgePolarity::Falling;
   const CaliperResult none = measureCaliper(image, MeasuringPath(rect), p);
-  EXPECT_EQ(none.failure, MeasureFailure::NoPair);
+  EXPECT_EQ(none.status.cause, MeasureFailure::NoPair);
 }
 
 TEST(Caliper, SelectsFirstLastStrongestOrAllOfAComb) {
@@ -100,7 +100,7 @@ TEST(Caliper, SelectsFirstLastStrongestOrAllOfAComb) {
   const MeasuringPath path(MeasuringRect{49.5, 19.5, 90, 10, 0});
   CaliperParams p;
   CaliperResult all = measureCaliper(image, path, p);
-  ASSERT_TRUE(all.ok());
+  ASSERT_TRUE(all.status.ok());
   ASSERT_EQ(all.edges.size(), 6u);
   for (std::size_t i = 0; i < 6; ++i) {
     const double x = teeth[i / 2][0] + (i % 2 ? 8.0 : 0.0);
@@ -133,7 +133,7 @@ TEST(Caliper, ArcMeasuresAlongTheArcLength) {
   const cv::Mat image = test::gridEdgeImage({80, 80}, c, normal, 40, 170, 0.9);
   const MeasuringArc arc{c.x, c.y, 20.0, 0.0, 90.0, 6.0};
   const CaliperResult r = measureCaliper(image, MeasuringPath(arc));
-  ASSERT_TRUE(r.ok()) << r.message;
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
   ASSERT_EQ(r.edges.size(), 1u);
   EXPECT_NEAR(r.edges[0].position, 20.0 * 5.0 * CV_PI / 180.0, 0.03);
   EXPECT_GT(r.edges[0].amplitude, 0);  // dark to light going counter-clockwise
@@ -146,7 +146,7 @@ TEST(Caliper, MeasuresTheInsideOfARectanglePartlyOutsideAndSaysSo) {
   const cv::Mat image = test::gridEdgeImage({60, 60}, {50.4, 30}, {1, 0}, 40, 170, 0.9, 1.0);
   // The caliper runs from x = 30 to x = 70: the part beyond x = 59 is outside the image.
   const CaliperResult r = measureCaliper(image, MeasuringPath(MeasuringRect{50, 30, 40, 10, 0}));
-  ASSERT_TRUE(r.ok()) << r.message;
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
   EXPECT_TRUE(r.partial);
   ASSERT_EQ(r.edges.size(), 1u);
   EXPECT_NEAR(r.edges[0].position, 0.4, 0.05);
@@ -156,7 +156,7 @@ TEST(Caliper, FailsWithItsCauseInsteadOfInventingAnEdge) {
   const cv::Mat edge = test::gridEdgeImage({60, 60}, {30.4, 30}, {1, 0}, 40, 170, 0.9, 1.0);
   const cv::Mat flat(60, 60, CV_8U, cv::Scalar(90));
   auto cause = [](const cv::Mat& im, MeasuringRect rect, CaliperParams p = {}) {
-    return measureCaliper(im, MeasuringPath(rect), p).failure;
+    return measureCaliper(im, MeasuringPath(rect), p).status.cause;
   };
   EXPECT_EQ(cause(edge, {200, 200, 40, 10, 0}), MeasureFailure::OutsideImage);
   EXPECT_EQ(cause(edge, {30, 30, 0, 10, 0}), MeasureFailure::ZeroSize);
@@ -178,7 +178,7 @@ TEST(Caliper, ReadsSixteenBitImagesOnTheEightBitScale) {
   eight.convertTo(sixteen, CV_16U, 256.0);
   const MeasuringPath path(MeasuringRect{30, 30, 30, 10, 0});
   const CaliperResult a = measureCaliper(eight, path), b = measureCaliper(sixteen, path);
-  ASSERT_TRUE(a.ok() && b.ok());
+  ASSERT_TRUE(a.status.ok() && b.status.ok());
   EXPECT_NEAR(a.edges.at(0).position, b.edges.at(0).position, 1e-9);
   EXPECT_NEAR(a.edges.at(0).amplitude, b.edges.at(0).amplitude, 1e-6);
   cv::Mat colour;

@@ -24,7 +24,7 @@ TEST(LineMeasure, GivesAngleAndPositionOfAStraightEdge) {
     // Laid 0.5 degrees off the line and 2 px beside it, as a user would place it.
     const cv::Point2d c = through + 2.0 * across;
     const LineMeasurement m = measureLine(image, {c.x, c.y, 150, 16, angle + 0.5});
-    ASSERT_TRUE(m.ok()) << angle << ": " << m.message;
+    ASSERT_TRUE(m.status.ok()) << angle << ": " << m.status.message;
     EXPECT_NEAR(std::remainder(m.angle - angle, 360.0), 0.0, 0.01) << angle;
     // Noise 1 over 75 points of 150 px: the ends' offsets scatter about 0.01 px.
     EXPECT_NEAR(offset(m.p1, through, dir), 0.0, 0.03) << angle;
@@ -51,27 +51,28 @@ TEST(LineMeasure, IgnoresABurrAndThePolarityItWasNotAskedFor) {
   const cv::Mat image = s.render();
   LineMeasureParams p;
   const LineMeasurement m = measureLine(image, {99.5, 50, 180, 16, 0.0}, p);
-  ASSERT_TRUE(m.ok()) << m.message;
+  ASSERT_TRUE(m.status.ok()) << m.status.message;
   EXPECT_NEAR(m.angle, 0.0, 0.01);
   EXPECT_NEAR(m.p1.y, 50.3, 0.02);
   EXPECT_NEAR(m.p2.y, 50.3, 0.02);
   EXPECT_LT(m.points, 89);  // 90 stations: the burr's points are outliers
   // At angle 0 the across direction points down: dark above, light below is rising.
   p.polarity = EdgePolarity::Falling;
-  EXPECT_EQ(measureLine(image, {99.5, 50, 180, 16, 0.0}, p).failure, MeasureFailure::TooFewPoints);
+  EXPECT_EQ(measureLine(image, {99.5, 50, 180, 16, 0.0}, p).status.cause,
+            MeasureFailure::TooFewPoints);
   p.polarity = EdgePolarity::Rising;
-  EXPECT_TRUE(measureLine(image, {99.5, 50, 180, 16, 0.0}, p).ok());
+  EXPECT_TRUE(measureLine(image, {99.5, 50, 180, 16, 0.0}, p).status.ok());
 }
 
 TEST(LineMeasure, FailsWithItsCause) {
   const cv::Mat edge = test::gridEdgeImage({100, 100}, {50, 50.3}, {0, 1}, 50, 170, 0.9, 1.0);
   const cv::Mat flat(100, 100, CV_8U, cv::Scalar(90));
-  EXPECT_EQ(measureLine(edge, {500, 500, 80, 16, 0}).failure, MeasureFailure::OutsideImage);
-  EXPECT_EQ(measureLine(edge, {50, 50, 80, 0, 0}).failure, MeasureFailure::ZeroSize);
-  EXPECT_EQ(measureLine(flat, {50, 50, 80, 16, 0}).failure, MeasureFailure::NoContrast);
+  EXPECT_EQ(measureLine(edge, {500, 500, 80, 16, 0}).status.cause, MeasureFailure::OutsideImage);
+  EXPECT_EQ(measureLine(edge, {50, 50, 80, 0, 0}).status.cause, MeasureFailure::ZeroSize);
+  EXPECT_EQ(measureLine(flat, {50, 50, 80, 16, 0}).status.cause, MeasureFailure::NoContrast);
   // Partly outside: measured on the inside part, and flagged.
   const LineMeasurement part = measureLine(edge, {90, 50, 80, 16, 0});
-  ASSERT_TRUE(part.ok()) << part.message;
+  ASSERT_TRUE(part.status.ok()) << part.status.message;
   EXPECT_TRUE(part.partial);
   EXPECT_NEAR(part.p1.y, 50.3, 0.03);
 }

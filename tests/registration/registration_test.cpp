@@ -33,7 +33,7 @@ TEST(RegisterImages, RecoversAKnownSimilarity) {
   RegistrationParams p;
   p.model = TransformModel::Similarity;
   const RegistrationResult r = registerImages(ref, image, p);
-  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  ASSERT_TRUE(r.status.ok()) << toString(r.status.cause) << ": " << r.status.message;
   EXPECT_LT(cornerError(r.H, truth, ref.size()), 0.5);
   EXPECT_GE(r.inliers.size(), 30u);
   // The similarity's angle and scale, read back from H in the Pose2D convention.
@@ -52,14 +52,14 @@ TEST(RegisterImages, RecoversAHomographyUnderStrongRotationAndScale) {
                             similarity(-120.0, 0.7, {159.5, 159.5}, {150, 150});
   const cv::Mat image = warp(ref, truth, {300, 300});
   const RegistrationResult r = registerImages(ref, image, {});
-  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  ASSERT_TRUE(r.status.ok()) << toString(r.status.cause) << ": " << r.status.message;
   EXPECT_LT(cornerError(r.H, truth, ref.size()), 1.5);
 }
 
 TEST(RegisterImages, IdenticalImagesGiveTheIdentity) {
   const cv::Mat ref = texturedScene({256, 240}, 3);
   const RegistrationResult r = registerImages(ref, ref, {});
-  ASSERT_TRUE(r.ok) << r.message;
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
   EXPECT_LT(cornerError(r.H, cv::Matx33d::eye(), ref.size()), 0.05);
   for (const FeatureMatch& m : r.matches) {
     EXPECT_NEAR(m.rotationDeg, 0.0, 12.0);
@@ -71,13 +71,13 @@ TEST(RegisterImages, BlankImageIsAClearFailure) {
   const cv::Mat ref = texturedScene({200, 200}, 4);
   const cv::Mat blank(200, 200, CV_8U, cv::Scalar(128));
   const RegistrationResult r = registerImages(ref, blank, {});
-  EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.failureCause, "blank_image");
-  EXPECT_NE(r.message.find("image"), std::string::npos);
+  EXPECT_FALSE(r.status.ok());
+  EXPECT_EQ(toString(r.status.cause), "blank_image");
+  EXPECT_NE(r.status.message.find("image"), std::string::npos);
   const RegistrationResult r2 = registerImages(blank, ref, {});
-  EXPECT_EQ(r2.failureCause, "blank_image");
-  EXPECT_NE(r2.message.find("reference"), std::string::npos);
-  EXPECT_EQ(registerImages(cv::Mat(), ref, {}).failureCause, "empty_image");
+  EXPECT_EQ(toString(r2.status.cause), "blank_image");
+  EXPECT_NE(r2.status.message.find("reference"), std::string::npos);
+  EXPECT_EQ(toString(registerImages(cv::Mat(), ref, {}).status.cause), "empty_image");
 }
 
 TEST(RegisterImages, FewerThanFourCornersIsAClearFailure) {
@@ -88,8 +88,8 @@ TEST(RegisterImages, FewerThanFourCornersIsAClearFailure) {
       ramp.at<uchar>(y, x) = static_cast<uchar>(40 + x / 2 + (y > 100 ? 60 : 0));
   const cv::Mat ref = texturedScene({200, 200}, 8);
   const RegistrationResult r = registerImages(ref, ramp, {});
-  EXPECT_FALSE(r.ok);
-  EXPECT_EQ(r.failureCause, "too_few_corners") << r.message;
+  EXPECT_FALSE(r.status.ok());
+  EXPECT_EQ(toString(r.status.cause), "too_few_corners") << r.status.message;
   EXPECT_LT(r.imageCorners, 4);
 }
 
@@ -99,9 +99,10 @@ TEST(RegisterImages, UnrelatedImagesFailInsteadOfInventingATransform) {
   for (std::uint64_t seed : {21, 23, 25}) {
     const cv::Mat a = texturedScene({240, 240}, seed), b = texturedScene({240, 240}, seed + 1);
     const RegistrationResult r = registerImages(a, b, {});
-    EXPECT_FALSE(r.ok) << seed;
-    EXPECT_TRUE(r.failureCause == "too_few_matches" || r.failureCause == "too_few_inliers")
-        << r.failureCause;
+    EXPECT_FALSE(r.status.ok()) << seed;
+    EXPECT_TRUE(toString(r.status.cause) == "too_few_matches" ||
+                toString(r.status.cause) == "too_few_inliers")
+        << toString(r.status.cause);
   }
 }
 
@@ -116,7 +117,7 @@ TEST(RegisterImages, HarrisAffineRegionsHandleAStrongTilt) {
   RegistrationParams p;
   p.affineRegions = true;
   const RegistrationResult r = registerImages(ref, image, p);
-  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  ASSERT_TRUE(r.status.ok()) << toString(r.status.cause) << ": " << r.status.message;
   EXPECT_LT(cornerError(r.H, truth, ref.size()), 2.0);
 }
 
@@ -134,10 +135,10 @@ TEST(RegisterImages, DefaultsEscalateToHarrisAffineUnderAStrongTilt) {
   EXPECT_EQ(plain.stage, "harris");
   EXPECT_FALSE(plain.escalated);
   // The plain stage has nothing to stand on here, which is what triggers the escalation.
-  ASSERT_TRUE(!plain.ok || plain.globalInliers < RegistrationParams{}.affineBelowInliers)
+  ASSERT_TRUE(!plain.status.ok() || plain.globalInliers < RegistrationParams{}.affineBelowInliers)
       << plain.globalInliers << " global inliers";
   const RegistrationResult r = registerImages(ref, image, {});
-  ASSERT_TRUE(r.ok) << r.failureCause << ": " << r.message;
+  ASSERT_TRUE(r.status.ok()) << toString(r.status.cause) << ": " << r.status.message;
   EXPECT_EQ(r.stage, "harris-affine");
   EXPECT_TRUE(r.escalated);
   EXPECT_LT(cornerError(r.H, truth, ref.size()), 2.0);
@@ -180,7 +181,7 @@ TEST(Fiducials, TwoMarksGivePositionsAndRotation) {
   RegistrationParams p;
   p.model = TransformModel::Similarity;
   const FiducialResult f = locateFiducials(ref, marks, image, p);
-  ASSERT_TRUE(f.ok) << f.failureCause << ": " << f.message;
+  ASSERT_TRUE(f.status.ok()) << toString(f.status.cause) << ": " << f.status.message;
   ASSERT_EQ(f.marks.size(), 2u);
   for (std::size_t i = 0; i < marks.size(); ++i) {
     const cv::Point2d t = mapPoint(truth, marks[i]);
@@ -188,7 +189,7 @@ TEST(Fiducials, TwoMarksGivePositionsAndRotation) {
   }
   EXPECT_NEAR(f.rotationDeg, 25.0, 0.2);
   EXPECT_NEAR(f.scale, 1.0, 0.005);
-  EXPECT_EQ(locateFiducials(ref, {{10, 10}}, image, p).failureCause, "too_few_fiducials");
+  EXPECT_EQ(toString(locateFiducials(ref, {{10, 10}}, image, p).status.cause), "too_few_fiducials");
 }
 
 }  // namespace

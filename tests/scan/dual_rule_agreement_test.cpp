@@ -39,7 +39,7 @@ TEST(DualRuleAgreement, DcpAndIdcpEndAtTheSamePoseOnACleanCorner) {
     idcp.method = ScanMatchMethod::IdcpBoc;
     const ScanMatchResult a = matchScans(reference, scan, {}, dcp);
     const ScanMatchResult b = matchScans(reference, scan, {}, idcp);
-    ASSERT_TRUE(a.converged && b.converged) << trial;
+    ASSERT_TRUE(a.status.ok() && b.status.ok()) << trial;
     const double apart = std::hypot(a.pose.x - b.pose.x, a.pose.y - b.pose.y);
     worst = std::max(worst, apart);
     worstAngle =

@@ -57,7 +57,7 @@ TEST_P(EachMethod, RecoversAKnownTransformInAnEmptyRoom) {
   // point-to-line error does not care where along a wall a beam hit.
   const bool pointToPoint = GetParam() == ScanMatchMethod::IcpPointToPoint;
   const double tolerance = pointToPoint ? 0.05 : 0.02;
-  EXPECT_TRUE(r.converged) << toString(r.cause);
+  EXPECT_TRUE(r.status.ok()) << toString(r.status.cause);
   EXPECT_NEAR(r.pose.x, truth.x, tolerance);
   EXPECT_NEAR(r.pose.y, truth.y, tolerance);
   EXPECT_LT(angleError(r.pose.theta, truth.theta), (pointToPoint ? 1.0 : 0.3) * kDeg);
@@ -70,7 +70,7 @@ TEST_P(EachMethod, IdenticalScansGiveTheIdentityAndConverge) {
   std::mt19937_64 rng(3);
   const Scan s = scan_room::castScan(scan_room::officeRoom(), {6.0, 4.0, 0.3}, {}, rng);
   const ScanMatchResult r = matchScans(s, s, {}, paramsFor(GetParam()));
-  EXPECT_TRUE(r.converged);
+  EXPECT_TRUE(r.status.ok());
   EXPECT_NEAR(r.pose.x, 0.0, 1e-9);
   EXPECT_NEAR(r.pose.y, 0.0, 1e-9);
   EXPECT_NEAR(r.pose.theta, 0.0, 1e-9);
@@ -91,7 +91,7 @@ TEST_P(EachMethod, ExactTransformOfTheSamePointsIsRecoveredExactly) {
   ScanMatchParams params = paramsFor(GetParam());
   params.trimFraction = 1.0;  // every point has its exact partner: nothing to trim
   const ScanMatchResult r = matchScans(reference, scan, {}, params);
-  EXPECT_TRUE(r.converged);
+  EXPECT_TRUE(r.status.ok());
   EXPECT_NEAR(r.pose.x, truth.x, 1e-6);
   EXPECT_NEAR(r.pose.y, truth.y, 1e-6);
   EXPECT_NEAR(r.pose.theta, truth.theta, 1e-6);
@@ -104,15 +104,15 @@ TEST_P(EachMethod, EmptyScansAreReportedNotCrashed) {
   for (const auto& [ref, scan] :
        {std::pair{Scan{}, full}, std::pair{full, Scan{}}, std::pair{Scan{}, Scan{}}}) {
     const ScanMatchResult r = matchScans(ref, scan, initial, paramsFor(GetParam()));
-    EXPECT_FALSE(r.converged);
-    EXPECT_EQ(r.cause, MatchCause::EmptyScan);
+    EXPECT_FALSE(r.status.ok());
+    EXPECT_EQ(r.status.cause, MatchCause::EmptyScan);
     EXPECT_EQ(r.pose.x, initial.x);
     EXPECT_EQ(r.pose.theta, initial.theta);
     EXPECT_EQ(r.correspondences, 0);
   }
   Scan three;
   three.points = {{1, 0}, {1, 1}, {1, 2}};
-  EXPECT_EQ(matchScans(full, three, {}, paramsFor(GetParam())).cause, MatchCause::EmptyScan);
+  EXPECT_EQ(matchScans(full, three, {}, paramsFor(GetParam())).status.cause, MatchCause::EmptyScan);
 }
 
 TEST_P(EachMethod, NanAndInfRangesAreDroppedAndTheRestMatches) {
@@ -198,8 +198,8 @@ TEST(ScanMatch, TooFewCorrespondencesWhenScansAreFarApart) {
   const Scan s = scan_room::castScan(scan_room::officeRoom(), {6.0, 4.0, 0.0}, {}, rng);
   ScanMatchParams p = paramsFor(ScanMatchMethod::IcpPointToPoint);
   const ScanMatchResult r = matchScans(s, s, {100.0, 100.0, 0.0}, p);
-  EXPECT_FALSE(r.converged);
-  EXPECT_EQ(r.cause, MatchCause::TooFewCorrespondences);
+  EXPECT_FALSE(r.status.ok());
+  EXPECT_EQ(r.status.cause, MatchCause::TooFewCorrespondences);
 }
 
 // The benchmark's experiment on a slice of the real intel log (large steps, heavy occlusion):

@@ -87,7 +87,7 @@ TEST(IdcpBoc, ASingleClusterScanIsMatched) {
   const Scan scan = scan_room::castScan(room, newPose, {}, rng);
   ASSERT_EQ(segmentScan(scan).size(), 1u);
   const ScanMatchResult r = matchScans(reference, scan, {}, {});
-  EXPECT_TRUE(r.converged);
+  EXPECT_TRUE(r.status.ok());
   EXPECT_NEAR(r.pose.x, newPose.x, 0.02);
   EXPECT_NEAR(r.pose.y, newPose.y, 0.02);
   EXPECT_NEAR(r.pose.theta, newPose.theta, 0.3 * kDeg);

@@ -128,7 +128,8 @@ StepResult AlignStep::run(const config::Step& step, StepContext& part) const {
   RegistrationParams params;
   params.model = TransformModel::Similarity;
   const RegistrationResult reg = registerImages(ref, live, params);
-  if (!reg.ok) return StepResult::failed("alignment failed: " + reg.failureCause);
+  if (!reg.status.ok())
+    return StepResult::failed("alignment failed: " + std::string(toString(reg.status.cause)));
   r.refToImage = translation(cv::Point2d(search.tl())) * reg.H;
   r.referenceView = cv::Rect2d(region);
   const double score =

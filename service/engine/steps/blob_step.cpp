@@ -80,8 +80,9 @@ StepResult BlobStep::run(const config::Step& step, StepContext& part) const {
   p.maxArea = b.maxArea;
   p.minRoundness = b.minRoundness;
   const BlobResult m = analyseBlobs(part.grey, p);
-  const bool none = m.failure == MeasureFailure::NoBlob || m.failure == MeasureFailure::NoContrast;
-  if (!m.ok() && !none) return StepResult::failed("blobs not searched: " + m.message);
+  const bool none =
+      m.status.cause == MeasureFailure::NoBlob || m.status.cause == MeasureFailure::NoContrast;
+  if (!m.status.ok() && !none) return StepResult::failed("blobs not searched: " + m.status.message);
 
   std::vector<Blob> kept;
   for (const Blob& blob : m.blobs)
@@ -92,7 +93,7 @@ StepResult BlobStep::run(const config::Step& step, StepContext& part) const {
     if (b.required)
       return StepResult::failed(
           "no blob found: " +
-          (m.ok() ? std::string("none has its centre in the rectangle") : m.message));
+          (m.status.ok() ? std::string("none has its centre in the rectangle") : m.status.message));
     r.values["count"] = 0;
     r.values["presence"] = 0;
     r.point = cv::Point2d(rect.cx, rect.cy);

@@ -114,7 +114,7 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
   p.pairs = c.measure == Measure::Pairs;
   const CaliperResult m = measureCaliper(part.grey, path, p);
   part.overlay.polygon(arc ? arcOutline(*arc) : rectCorners(*rect), true, true);
-  if (!m.ok()) return StepResult::failed("caliper not measured: " + m.message);
+  if (!m.status.ok()) return StepResult::failed("caliper not measured: " + m.status.message);
 
   // Where each selected edge or pair lies on the axis (s), and the pairs' ends.
   std::vector<double> along;

@@ -65,7 +65,8 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   part.overlay.circle(expected, std::max(1.0, p.radius - p.width), true, true);
   part.overlay.circle(expected, p.radius + p.width, true, true);
   std::string note;
-  if (!m.ok() && !m.has(CircleFailure::BadInput) && !m.has(CircleFailure::AnnulusOutsideImage)) {
+  if (!m.status.ok() && m.status.cause != CircleFailure::BadInput &&
+      m.status.cause != CircleFailure::AnnulusOutsideImage) {
     // Nothing round in the annulus: a hole drilled off its place is still a hole, and the line
     // must learn how far off it is, not only that the step failed. Look for the disc within one
     // diameter of its nominal place and measure it there; its position check then judges it.
@@ -76,13 +77,14 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
                                                   .minScore = 0.6})) {
       CircleMeasureParams there = p;
       there.centre = found->centre;
-      if (const CircleMeasurement moved = measureCircle(part.grey, there); moved.ok()) {
+      if (const CircleMeasurement moved = measureCircle(part.grey, there); moved.status.ok()) {
         m = moved;
         note = "found off its nominal place";
       }
     }
   }
-  if (!m.ok()) return StepResult::failed("circle not measured: " + circleFailureCause(m.failures));
+  if (!m.status.ok())
+    return StepResult::failed("circle not measured: " + std::string(toString(m.status.cause)));
   StepResult r;
   r.note = note;
   if (plane) {

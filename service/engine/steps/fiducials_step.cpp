@@ -69,8 +69,8 @@ StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const
     p.width = std::max(2.0, 0.35 * radius);
     p.polarity = f.polarity;
     const CircleMeasurement m = measureCircle(part.grey, p);
-    if (!m.ok())
-      return StepResult::failed(where + " not measured: " + circleFailureCause(m.failures));
+    if (!m.status.ok())
+      return StepResult::failed(where + " not measured: " + std::string(toString(m.status.cause)));
     part.overlay.circle(m.centre, m.radius, true);
     nominal.push_back(expected);
     found.push_back(m.centre);

@@ -47,7 +47,7 @@ StepResult LineStep::run(const config::Step& step, StepContext& part) const {
   p.minAmplitude = l.minAmplitude;
   const LineMeasurement m = measureLine(part.grey, rect, p);
   part.overlay.polygon(rectCorners(rect), true, true);
-  if (!m.ok()) return StepResult::failed("line not measured: " + m.message);
+  if (!m.status.ok()) return StepResult::failed("line not measured: " + m.status.message);
 
   // With a lens model and a measuring plane, the angle is taken between the line and the axis as
   // the plane sees them, and deviations use the plane's scale at the line's middle.

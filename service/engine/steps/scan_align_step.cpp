@@ -66,9 +66,9 @@ StepResult ScanAlignStep::run(const config::Step& step, StepContext& part) const
   p.maxIterations = s.maxIterations;
   p.initialGate = s.maxDistance / 1000.0;
   const auto result = scan::matchScans(step.resourcesAs<ReferenceScan>().scan, *part.scan, {}, p);
-  if (!result.converged)
+  if (!result.status.ok())
     return StepResult::failed("scan registration did not converge: " +
-                              std::string(toString(result.cause)));
+                              std::string(toString(result.status.cause)));
   StepResult r;
   r.lengthsInMm = true;
   r.values["x"] = result.pose.x * 1000.0;
