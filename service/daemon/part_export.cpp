@@ -55,7 +55,7 @@ nlohmann::json toJson(const PartResult& p) {
           {"timings_ms", timings}};
 }
 
-std::string toCsv(const std::vector<PartResult>& parts) {
+std::string toCsv(const std::vector<PartResult>& parts, std::span<const std::string> stations) {
   std::vector<std::string> names;
   std::set<std::string> seen;
   for (const auto& p : parts)
@@ -70,11 +70,14 @@ std::string toCsv(const std::vector<PartResult>& parts) {
   std::ostringstream out;
   // expected_verdict and defect (of recorded parts) came later: after the first ten columns, so
   // that a script reading columns by position still finds those where they were.
+  if (!stations.empty()) out << "station,";
   out << "part_id,time,recipe_id,recipe,frame_id,serial,verdict,failed_checks,error,inspection_ms,"
          "expected_verdict,defect";
   for (const auto& n : names) out << ',' << quote(n);
   out << '\n';
-  for (const auto& p : parts) {
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const PartResult& p = parts[i];
+    if (!stations.empty()) out << quote(stations[i]) << ',';
     out << p.partId << ',' << isoTime(p.time) << ',' << p.recipeId << ',' << quote(p.recipeName)
         << ',' << p.frameId << ',' << quote(p.serial) << ',' << verdictName(p.verdict) << ','
         << quote(joinedChecks(p.failedChecks, ';')) << ',' << quote(p.error) << ','

@@ -3,6 +3,7 @@
 // the time format both use.
 
 #include <chrono>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -14,7 +15,9 @@ namespace facet::service {
 
 nlohmann::json toJson(const PartResult& part);
 // CSV with a header row; one column per distinct measurement name across `parts`.
-std::string toCsv(const std::vector<PartResult>& parts);
+// `stations`, when given, holds each part's station (parts from the central database): a first
+// column `station`.
+std::string toCsv(const std::vector<PartResult>& parts, std::span<const std::string> stations = {});
 // The failed checks as one text field, separated by `sep`.
 std::string joinedChecks(const std::vector<std::string>& checks, char sep);
 // ISO 8601 in UTC with milliseconds, e.g. 2026-11-25T20:15:03.123Z.

@@ -15,12 +15,6 @@ namespace facet::service {
 
 namespace {
 
-Verdict verdictFromName(const std::string& s) {
-  if (s == "pass") return Verdict::Pass;
-  if (s == "fail") return Verdict::Fail;
-  return Verdict::Error;
-}
-
 std::int64_t toMicros(std::chrono::system_clock::time_point t) {
   return std::chrono::duration_cast<std::chrono::microseconds>(t.time_since_epoch()).count();
 }

@@ -14,4 +14,10 @@ const char* verdictName(Verdict v) {
   return "error";
 }
 
+Verdict verdictFromName(std::string_view name) {
+  if (name == "pass") return Verdict::Pass;
+  if (name == "fail") return Verdict::Fail;
+  return Verdict::Error;
+}
+
 }  // namespace facet::service

@@ -7,6 +7,7 @@
 #include <map>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace facet::service {
@@ -20,6 +21,8 @@ enum class Verdict {
 };
 
 const char* verdictName(Verdict v);
+// The verdict a stored name stands for; anything but "pass" and "fail" is Error (never good).
+Verdict verdictFromName(std::string_view name);
 
 // One checked (or merely reported) value of a recipe step.
 struct Measurement {

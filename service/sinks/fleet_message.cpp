@@ -38,10 +38,7 @@ PartResult partFromFleetMessage(const nlohmann::json& message, std::string* stat
     // Messages queued by a facetd from before `defect` have none.
     p.recordedDefect = message.value("defect", std::string());
     p.notes = message.value("notes", std::vector<std::string>());
-    const std::string verdict = message.at("verdict").get<std::string>();
-    p.verdict = verdict == "pass"   ? Verdict::Pass
-                : verdict == "fail" ? Verdict::Fail
-                                    : Verdict::Error;
+    p.verdict = verdictFromName(message.at("verdict").get<std::string>());
     p.failedChecks = message.at("failed_checks").get<std::vector<std::string>>();
     p.error = message.at("error").get<std::string>();
     p.inspectionMs = message.at("inspection_ms").get<double>();

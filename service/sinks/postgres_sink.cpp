@@ -11,6 +11,7 @@
 
 #include "service/daemon/results_store.hpp"
 #include "service/sinks/fleet_message.hpp"
+#include "service/sinks/postgres_connection.hpp"
 
 namespace facet::service {
 
@@ -63,50 +64,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
-struct ResultDeleter {
-  void operator()(PGresult* r) const { PQclear(r); }
-};
-using Result = std::unique_ptr<PGresult, ResultDeleter>;
-
-std::string trimmed(std::string s) {
-  while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
-  return s;
-}
-
-// host:port/dbname from the connection string, for messages (never the password).
-std::string peerOf(const std::string& connection) {
-  char* error = nullptr;
-  std::unique_ptr<PQconninfoOption, decltype(&PQconninfoFree)> options(
-      PQconninfoParse(connection.c_str(), &error), &PQconninfoFree);
-  PQfreemem(error);
-  std::string host = "localhost", port = "5432", db;
-  for (auto* o = options.get(); o && o->keyword; ++o) {
-    if (!o->val) continue;
-    const std::string k = o->keyword;
-    if (k == "host" || k == "hostaddr") host = o->val;
-    if (k == "port") port = o->val;
-    if (k == "dbname") db = o->val;
-  }
-  return host + ":" + port + "/" + db;
-}
-
 std::optional<std::string> number(const std::optional<double>& v) {
   if (!v || !std::isfinite(*v)) return std::nullopt;
   return fmt::format("{}", *v);
-}
-
-// PQexecParams with every parameter as text; nullopt is SQL NULL.
-Result execute(pg_conn* conn, const char* sql,
-               const std::vector<std::optional<std::string>>& params) {
-  std::vector<const char*> values;
-  for (const auto& p : params) values.push_back(p ? p->c_str() : nullptr);
-  return Result(PQexecParams(conn, sql, static_cast<int>(values.size()), nullptr, values.data(),
-                             nullptr, nullptr, 0));
-}
-
-bool ok(const Result& r) {
-  const auto s = PQresultStatus(r.get());
-  return s == PGRES_COMMAND_OK || s == PGRES_TUPLES_OK;
 }
 
 constexpr const char* kInsertPart =
@@ -124,7 +84,7 @@ PostgresSink::PostgresSink(config::PostgresSettings settings, std::string statio
               static_cast<std::uint64_t>(settings_.outbox.quotaMb * 1024 * 1024),
               "postgres outbox") {
   status_.name = "postgres";
-  status_.peer = peerOf(settings_.connection);
+  status_.peer = postgresPeer(settings_.connection);
   status_.lastError = "not connected yet";
 }
 
@@ -186,7 +146,7 @@ bool PostgresSink::connect() {
   // expand_dbname = 1: the first value is the whole connection string.
   conn_ = PQconnectdbParams(keys.data(), values.data(), 1);
   if (PQstatus(conn_) != CONNECTION_OK) {
-    std::string why = trimmed(PQerrorMessage(conn_));
+    std::string why = postgresError(conn_);
     if (why.find("password authentication failed") != std::string::npos ||
         why.find("no password supplied") != std::string::npos)
       why += " (check postgres.connection's user and postgres.password)";
@@ -195,9 +155,9 @@ bool PostgresSink::connect() {
     conn_ = nullptr;
     return false;
   }
-  const Result schema(PQexec(conn_, kPostgresSchema));
-  if (!ok(schema)) {
-    setError("cannot create the tables: " + trimmed(PQerrorMessage(conn_)));
+  const PgResult schema(PQexec(conn_, kPostgresSchema));
+  if (!succeeded(schema)) {
+    setError("cannot create the tables: " + postgresError(conn_));
     PQfinish(conn_);
     conn_ = nullptr;
     return false;
@@ -212,7 +172,7 @@ bool PostgresSink::connect() {
 
 bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
   auto rollback = [this] { PQclear(PQexec(conn_, "ROLLBACK")); };
-  if (!ok(Result(PQexec(conn_, "BEGIN")))) return false;
+  if (!succeeded(PgResult(PQexec(conn_, "BEGIN")))) return false;
   std::vector<std::uint64_t> done;
   for (const auto& record : records) {
     std::string station;
@@ -232,28 +192,27 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
     const std::string partId = std::to_string(p.partId);
     const std::string timeUs = std::to_string(
         std::chrono::duration_cast<std::chrono::microseconds>(p.time.time_since_epoch()).count());
-    const Result part = execute(
+    const PgResult part = executeWithText(
         conn_, kInsertPart,
         {station, partId, timeUs, std::to_string(p.recipeId), p.recipeName, p.recipeVersion,
          std::to_string(p.frameId), p.source, p.serial, p.expectedVerdict,
          std::string(verdictName(p.verdict)), failed, p.error, fmt::format("{}", p.inspectionMs),
          timings.dump(), p.recordedDefect, joinedChecks(p.notes, '\n')});
-    if (!ok(part)) {
-      spdlog::error("postgres: part {}: {}", p.partId, trimmed(PQerrorMessage(conn_)));
+    if (!succeeded(part)) {
+      spdlog::error("postgres: part {}: {}", p.partId, postgresError(conn_));
       rollback();
       return false;
     }
     // 0 rows: the part is there already (sent again after a lost COMMIT answer).
     if (std::string(PQcmdTuples(part.get())) == "1") {
       for (const auto& m : p.measurements) {
-        const Result value = execute(
+        const PgResult value = executeWithText(
             conn_, kInsertValue,
             {station, partId, timeUs, m.name, number(m.value), m.unit, number(m.nominal),
              number(m.tolMinus), number(m.tolPlus), std::string(m.checked ? "true" : "false"),
              std::string(m.pass ? "true" : "false")});
-        if (!ok(value)) {
-          spdlog::error("postgres: part {} value {}: {}", p.partId, m.name,
-                        trimmed(PQerrorMessage(conn_)));
+        if (!succeeded(value)) {
+          spdlog::error("postgres: part {} value {}: {}", p.partId, m.name, postgresError(conn_));
           rollback();
           return false;
         }
@@ -261,7 +220,7 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
     }
     done.push_back(record.seq);
   }
-  if (!ok(Result(PQexec(conn_, "COMMIT")))) return false;
+  if (!succeeded(PgResult(PQexec(conn_, "COMMIT")))) return false;
   outbox_.remove(done);
   std::lock_guard lock(statusMutex_);
   status_.delivered += done.size();
@@ -289,7 +248,7 @@ void PostgresSink::run() {
     // Failed: a lost connection is reconnected; a statement the server refused (a bug, a
     // changed table) is logged and retried after the back-off, never silently skipped.
     const bool lost = PQstatus(conn_) != CONNECTION_OK;
-    setError((lost ? "connection lost: " : "write failed: ") + trimmed(PQerrorMessage(conn_)));
+    setError((lost ? "connection lost: " : "write failed: ") + postgresError(conn_));
     PQfinish(conn_);
     conn_ = nullptr;
     sleepFor(backoff);

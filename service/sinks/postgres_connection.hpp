@@ -1,0 +1,33 @@
+#pragma once
+// What the PostgreSQL sink and the results reader share about talking to the server: a result
+// that clears itself, parameters sent as text, and how the server and its errors are named in
+// messages (never with the password).
+
+#include <libpq-fe.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace facet::service {
+
+struct PgResultDeleter {
+  void operator()(PGresult* r) const { PQclear(r); }
+};
+using PgResult = std::unique_ptr<PGresult, PgResultDeleter>;
+
+// PQexecParams with every parameter as text; nullopt is SQL NULL.
+PgResult executeWithText(PGconn* conn, const char* sql,
+                         const std::vector<std::optional<std::string>>& params);
+
+// The command or query succeeded.
+bool succeeded(const PgResult& r);
+
+// host:port/dbname of a connection string, for messages.
+std::string postgresPeer(const std::string& connection);
+
+// libpq's last error of `conn` without its trailing newline.
+std::string postgresError(const PGconn* conn);
+
+}  // namespace facet::service
