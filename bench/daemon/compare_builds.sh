@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs bench_daemon of two builds alternately (A B A B ...) and prints, per build, the median over
-# the rounds of: trigger -> result registers p50 and p99, free-run parts per second and the mean
-# inspect time; then the ratios B / A (> 1 for latency and inspect = B slower; for the free-run
-# rate < 1 = B slower). Alternating spreads a busy machine's load over both builds alike.
+# the rounds of: trigger -> result registers p50 and p99, free-run parts per second, the mean
+# inspect time and the same run's OpenCV baseline of the inspection; then the ratios B / A (> 1
+# for latency and inspect = B slower; for the free-run rate < 1 = B slower). Alternating spreads
+# a busy machine's load over both builds alike.
 #
 #   bench/daemon/compare_builds.sh BASELINE_BENCH_DAEMON NEW_BENCH_DAEMON [ROUNDS] [-- ARGS...]
 #   e.g. compare_builds.sh ../base/build/release/bench/daemon/bench_daemon \
@@ -27,6 +28,9 @@ pats = {
     "p99 ms": r"trigger -> result registers, p99\s*\|\s*([\d.]+) ms",
     "free run /s": r"\| free run\s*\|\s*([\d.]+) /s",
     "inspect ms": r"\| inspect\s*\|\s*([\d.]+) ms \|",
+    # The same run's OpenCV baseline: the same code in both binaries, so its ratio is the
+    # machine's (or the process's) speed, not the build's.
+    "opencv ms": r"\| inspect\s*\|\s*[\d.]+ ms \|\s*([\d.]+) ms matchTemplate",
 }
 med = {}
 for side in "ab":
