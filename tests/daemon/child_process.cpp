@@ -33,9 +33,9 @@ ChildProcess::ChildProcess(std::vector<std::string> argv,
   std::vector<char*> envp;
   for (auto& e : envStrings) envp.push_back(e.data());
   envp.push_back(nullptr);
-  const int errFd =
-      stderrFile.empty() ? -1
-                         : ::open(stderrFile.c_str(), O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  const int errFd = stderrFile.empty() ? -1
+                                       : ::open(stderrFile.c_str(),
+                                                O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
   int out[2];
   if (::pipe2(out, O_CLOEXEC) != 0) throw std::runtime_error("pipe failed");
   ::signal(SIGPIPE, SIG_IGN);
