@@ -94,6 +94,14 @@ std::string toCsv(const std::vector<PartResult>& parts, std::span<const std::str
   return out.str();
 }
 
+std::vector<std::string> splitList(const std::string& text, char sep) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, sep);)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
 std::string joinedChecks(const std::vector<std::string>& items, char sep) {
   std::string out;
   for (const auto& s : items) {

@@ -18,8 +18,10 @@ nlohmann::json toJson(const PartResult& part);
 // `stations`, when given, holds each part's station (parts from the central database): a first
 // column `station`.
 std::string toCsv(const std::vector<PartResult>& parts, std::span<const std::string> stations = {});
-// The failed checks as one text field, separated by `sep`.
+// A list (failed checks, notes) as one text field, separated by `sep`.
 std::string joinedChecks(const std::vector<std::string>& checks, char sep);
+// The items of a list joinedChecks wrote (empty items dropped).
+std::vector<std::string> splitList(const std::string& text, char sep);
 // ISO 8601 in UTC with milliseconds, e.g. 2026-11-25T20:15:03.123Z.
 std::string isoTime(std::chrono::system_clock::time_point t);
 

@@ -110,14 +110,6 @@ CREATE TABLE IF NOT EXISTS measurements (
 );
 )sql";
 
-std::vector<std::string> split(const std::string& s, char sep) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  for (std::string item; std::getline(in, item, sep);)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 }  // namespace
 
 ResultsStore::ResultsStore(const std::filesystem::path& file, RetentionPolicy retention)
@@ -282,13 +274,13 @@ std::vector<PartResult> ResultsStore::select(const std::string& where, const std
     p.serial = q.text(7);
     p.expectedVerdict = q.text(8);
     p.verdict = verdictFromName(q.text(9));
-    p.failedChecks = split(q.text(10), ',');
+    p.failedChecks = splitList(q.text(10), ',');
     p.error = q.text(11);
     p.inspectionMs = sqlite3_column_double(q.get(), 12);
     for (const auto& t : nlohmann::json::parse(q.text(13), nullptr, false))
       if (t.is_object()) p.timings.push_back({t.value("step", ""), t.value("ms", 0.0)});
     p.recordedDefect = q.text(14);
-    p.notes = split(q.text(15), '\n');
+    p.notes = splitList(q.text(15), '\n');
     index[static_cast<std::int64_t>(p.partId)] = parts.size();
     parts.push_back(std::move(p));
   }

@@ -7,19 +7,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "service/daemon/part_export.hpp"
 #include "service/sinks/postgres_connection.hpp"
 
 namespace facet::service {
 
 namespace {
-
-std::vector<std::string> lines(const std::string& text, char sep) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  for (std::string item; std::getline(in, item, sep);)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 std::optional<double> number(const PGresult* r, int row, int column) {
   if (PQgetisnull(r, row, column)) return std::nullopt;
@@ -73,13 +66,13 @@ std::vector<StationPart> readPostgresResults(const std::string& connection,
     p.serial = text(8);
     p.expectedVerdict = text(9);
     p.verdict = verdictFromName(text(10));
-    p.failedChecks = lines(text(11), ',');
+    p.failedChecks = splitList(text(11), ',');
     p.error = text(12);
     p.inspectionMs = std::stod(text(13));
     for (const auto& t : nlohmann::json::parse(text(14), nullptr, false))
       if (t.is_object()) p.timings.push_back({t.value("step", ""), t.value("ms", 0.0)});
     p.recordedDefect = text(15);
-    p.notes = lines(text(16), '\n');
+    p.notes = splitList(text(16), '\n');
     index[{s.station, text(1), text(2)}] = out.size();
     out.push_back(std::move(s));
   }
