@@ -18,6 +18,8 @@ packages=(
   libcpp-httplib-dev libssl-dev libsystemd-dev nlohmann-json3-dev
   # results to a fleet: MQTT (libmosquitto) and PostgreSQL (libpq); broker and server for tests
   libmosquitto-dev mosquitto libpq-dev postgresql
+  # the tests make a throw-away certificate authority for the broker's TLS listener
+  openssl
   # tests and benchmarks
   libgtest-dev libgmock-dev googletest libbenchmark-dev
   python3-pymodbus python3-serial python3-serial-asyncio python3-numpy python3-opencv mbpoll

@@ -66,6 +66,10 @@ MqttPublisher::MqttPublisher(config::MqttSettings settings, std::string station)
     }
     mosquitto_tls_insecure_set(mosq_, settings_.tlsInsecure);
   }
+  mosquitto_log_callback_set(mosq_, [](mosquitto*, void* obj, int level, const char* text) {
+    if ((level & MOSQ_LOG_ERR) && std::strncmp(text, "OpenSSL Error", 13) == 0)
+      self(obj)->tlsError_ = text;
+  });
   mosquitto_connect_callback_set(mosq_,
                                  [](mosquitto*, void* obj, int rc) { self(obj)->connected(rc); });
   mosquitto_publish_callback_set(mosq_,
@@ -107,6 +111,18 @@ void MqttPublisher::setError(std::string error) {
                  outbox_.folder().string());
   status_.lastError = std::move(error);
   status_.connected = false;
+}
+
+std::string MqttPublisher::failure(int rc) {
+  std::string text = errorText(rc);
+  if (settings_.caFile.empty() || tlsError_.empty()) return text;
+  // libmosquitto says only "A TLS error occurred" (or, when the broker rejects the client's
+  // certificate after the handshake, "connection lost"); OpenSSL's reason is in its log.
+  text += " (tls: " + tlsError_ +
+          "; check mqtt.tls.ca_file signed the broker's certificate, the broker's certificate "
+          "names mqtt.host, and mqtt.tls.cert_file / key_file if the broker asks for one)";
+  tlsError_.clear();
+  return text;
 }
 
 void MqttPublisher::connected(int rc) {
@@ -167,7 +183,7 @@ void MqttPublisher::run() {
                                    : mosquitto_connect_async(mosq_, settings_.host.c_str(),
                                                              settings_.port, settings_.keepaliveS);
       if (rc != MOSQ_ERR_SUCCESS) {
-        lose("cannot connect: " + errorText(rc));
+        lose("cannot connect: " + failure(rc));
         continue;
       }
       everConnected = true;  // from now on reconnect_async reuses host, port and keep-alive
@@ -205,9 +221,8 @@ void MqttPublisher::run() {
         std::lock_guard lock(statusMutex_);
         why = status_.lastError;  // a refusal explains itself better than "connection lost"
       }
-      lose(!isConnected() && why.starts_with("broker refused")
-               ? why
-               : "connection lost: " + errorText(rc));
+      lose(!isConnected() && why.starts_with("broker refused") ? why
+                                                               : "connection lost: " + failure(rc));
       continue;
     }
     if (!isConnected() && Clock::now() - attemptStarted > kConnackTimeout) {

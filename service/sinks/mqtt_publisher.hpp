@@ -49,6 +49,8 @@ class MqttPublisher {
   void connected(int rc);
   void published(int mid);
   void setError(std::string error);
+  // libmosquitto's error text for `rc`, with OpenSSL's reason when TLS failed.
+  std::string failure(int rc);
 
   config::MqttSettings settings_;
   std::string station_;
@@ -71,6 +73,7 @@ class MqttPublisher {
   std::optional<InFlight> inFlight_;
   std::optional<int> offlineMid_;  // the goodbye status message, at stop
   bool offlineAcked_ = false;
+  std::string tlsError_;  // OpenSSL's last error as libmosquitto logged it
 
   mutable std::mutex statusMutex_;
   SinkStatus status_;

@@ -60,6 +60,15 @@ MosquittoBroker::MosquittoBroker(std::string folder,
   }
 }
 
+void MosquittoBroker::addTlsListener(const std::string& certFile, const std::string& keyFile,
+                                     const std::string& clientCa) {
+  tlsPort_ = plc::test::freeTcpPort();
+  std::ofstream conf(folder_ + "/mosquitto.conf", std::ios::app);
+  conf << "listener " << tlsPort_ << " 127.0.0.1\ncertfile " << certFile << "\nkeyfile " << keyFile
+       << "\n";
+  if (!clientCa.empty()) conf << "cafile " << clientCa << "\nrequire_certificate true\n";
+}
+
 MosquittoBroker::~MosquittoBroker() {
   process_.reset();
 }
@@ -74,7 +83,7 @@ void MosquittoBroker::start() {
       std::map<std::string, std::string>{}, folder_ + "/mosquitto.stderr");
   const auto until = std::chrono::steady_clock::now() + 10s;
   while (std::chrono::steady_clock::now() < until) {
-    if (accepts(port_)) return;
+    if (accepts(port_) && (tlsPort_ == 0 || accepts(tlsPort_))) return;
     if (process_->wait(0ms)) break;
     std::this_thread::sleep_for(20ms);
   }

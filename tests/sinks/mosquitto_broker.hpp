@@ -23,18 +23,24 @@ class MosquittoBroker {
   MosquittoBroker(std::string folder,
                   std::vector<std::pair<std::string, std::string>> passwords = {});
   ~MosquittoBroker();
+  // A second listener on another free port that speaks TLS only, with the broker's certificate
+  // and key; `clientCa` non-empty: clients must present a certificate it signed. Before start().
+  void addTlsListener(const std::string& certFile, const std::string& keyFile,
+                      const std::string& clientCa = "");
   // Starts the broker and waits until it accepts connections; throws when it does not.
   void start();
   // Writes the broker's sessions to disk now (SIGUSR1): a killed broker restarts from here.
   void saveSessions();
-  void kill();  // SIGKILL: no goodbye, no final save
-  void stop();  // SIGTERM
-  [[nodiscard]] int port() const { return port_; }
+  void kill();                                            // SIGKILL: no goodbye, no final save
+  void stop();                                            // SIGTERM
+  [[nodiscard]] int port() const { return port_; }        // plain MQTT
+  [[nodiscard]] int tlsPort() const { return tlsPort_; }  // 0: no TLS listener
   [[nodiscard]] bool running() const { return process_ != nullptr; }
 
  private:
   std::string folder_;
   int port_;
+  int tlsPort_ = 0;
   std::unique_ptr<daemon_test::ChildProcess> process_;
 };
 

@@ -10,6 +10,7 @@
 #include "service/sinks/mqtt_publisher.hpp"
 #include "tests/sinks/mosquitto_broker.hpp"
 #include "tests/sinks/sample_part.hpp"
+#include "tests/sinks/test_certificates.hpp"
 
 namespace facet::sinks_test {
 namespace {
@@ -283,6 +284,124 @@ TEST(MqttPublisher, FullQuotaDropsTheOldestAndTheRestFollowInOrder) {
   ASSERT_EQ(ids.size(), full.outbox.pending);
   // The newest survive, in order.
   for (std::size_t i = 0; i < ids.size(); ++i) EXPECT_EQ(ids[i], full.outbox.dropped + 1 + i);
+}
+
+// TLS: the broker has a TLS listener beside its plain one; the test's subscriber reads on the
+// plain one what the station sent over TLS.
+TEST(MqttPublisherTls, TheStationsCaAndTheBrokersNameCheckedDeliversOverTls) {
+  daemon_test::TempDir dir;
+  const TestCertificates certificates(dir.path());
+  MosquittoBroker broker(dir.path());
+  broker.addTlsListener(certificates.brokerCertFile, certificates.brokerKeyFile);
+  broker.start();
+  MqttSubscriber results("test-results", broker.port(), "facet/cam1/result");
+  ASSERT_TRUE(results.waitSubscribed(5s));
+  auto settings = settingsFor(broker, dir.path());
+  settings.port = broker.tlsPort();
+  settings.caFile = certificates.caFile;
+  settings.tlsInsecure = false;  // the broker's certificate names 127.0.0.1: checked
+  MqttPublisher publisher(settings, "cam1");
+  publisher.start();
+  for (std::uint64_t id = 1; id <= 3; ++id) publisher.submit(samplePart(id));
+  ASSERT_TRUE(results.waitFor([](const auto& m) { return partIds(m).size() == 3; }, 10s))
+      << publisher.status().lastError;
+  EXPECT_EQ(partIds(results.messages()), (std::vector<std::uint64_t>{1, 2, 3}));
+  EXPECT_FALSE(publisher.status().degraded());
+}
+
+TEST(MqttPublisherTls, ABrokerCertificateNotFromTheConfiguredCaIsAClearErrorAndKeepsTheResults) {
+  daemon_test::TempDir dir;
+  const TestCertificates certificates(dir.path());
+  MosquittoBroker broker(dir.path());
+  broker.addTlsListener(certificates.brokerCertFile, certificates.brokerKeyFile);
+  broker.start();
+  auto settings = settingsFor(broker, dir.path());
+  settings.port = broker.tlsPort();
+  settings.caFile = certificates.foreignCaFile;
+  MqttPublisher publisher(settings, "cam1");
+  publisher.start();
+  publisher.submit(samplePart(1));
+  ASSERT_TRUE(
+      waitUntil([&] { return publisher.status().lastError.find("tls") != std::string::npos; }, 10s))
+      << publisher.status().lastError;
+  const auto s = publisher.status();
+  EXPECT_TRUE(s.degraded());
+  EXPECT_NE(s.lastError.find("certificate verify failed"), std::string::npos) << s.lastError;
+  EXPECT_NE(s.lastError.find("mqtt.tls.ca_file"), std::string::npos) << s.lastError;
+  EXPECT_EQ(s.outbox.pending, 1u);
+  EXPECT_EQ(s.delivered, 0u);
+}
+
+TEST(MqttPublisherTls, ABrokerCertificateForAnotherHostIsRefusedUnlessTlsInsecure) {
+  daemon_test::TempDir dir;
+  const TestCertificates certificates(dir.path());
+  MosquittoBroker broker(dir.path());
+  broker.addTlsListener(certificates.elsewhereCertFile, certificates.elsewhereKeyFile);
+  broker.start();
+  MqttSubscriber results("test-results", broker.port(), "facet/+/result");
+  ASSERT_TRUE(results.waitSubscribed(5s));
+  auto settings = settingsFor(broker, dir.path());
+  settings.port = broker.tlsPort();
+  settings.caFile = certificates.caFile;
+
+  auto checked = settings;
+  checked.clientId = "facet-test-checked";
+  checked.outbox.folder = dir.path() + "/outbox-checked";
+  MqttPublisher refused(checked, "cam2");
+  refused.start();
+  refused.submit(samplePart(1));
+  ASSERT_TRUE(
+      waitUntil([&] { return refused.status().lastError.find("tls") != std::string::npos; }, 10s))
+      << refused.status().lastError;
+  EXPECT_EQ(refused.status().outbox.pending, 1u);
+
+  settings.tlsInsecure = true;  // mqtt.tls.insecure: the CA is checked, the name is not
+  MqttPublisher publisher(settings, "cam1");
+  publisher.start();
+  publisher.submit(samplePart(9));
+  ASSERT_TRUE(results.waitFor([](const auto& m) { return partIds(m).size() == 1; }, 10s))
+      << publisher.status().lastError;
+  EXPECT_EQ(partIds(results.messages()).front(), 9u);
+  EXPECT_EQ(refused.status().delivered, 0u);
+}
+
+TEST(MqttPublisherTls, ABrokerThatRequiresAClientCertificateGetsTheStationsOne) {
+  daemon_test::TempDir dir;
+  const TestCertificates certificates(dir.path());
+  MosquittoBroker broker(dir.path());
+  broker.addTlsListener(certificates.brokerCertFile, certificates.brokerKeyFile,
+                        certificates.caFile);
+  broker.start();
+  MqttSubscriber results("test-results", broker.port(), "facet/+/result");
+  ASSERT_TRUE(results.waitSubscribed(5s));
+  auto settings = settingsFor(broker, dir.path());
+  settings.port = broker.tlsPort();
+  settings.caFile = certificates.caFile;
+
+  // Without one: refused during the handshake, named, kept.
+  auto bare = settings;
+  bare.clientId = "facet-test-no-certificate";
+  bare.outbox.folder = dir.path() + "/outbox-bare";
+  MqttPublisher refused(bare, "cam2");
+  refused.start();
+  refused.submit(samplePart(1));
+  ASSERT_TRUE(
+      waitUntil([&] { return refused.status().lastError.find("tls") != std::string::npos; }, 10s))
+      << refused.status().lastError;
+  EXPECT_NE(refused.status().lastError.find("certificate required"), std::string::npos)
+      << refused.status().lastError;
+  EXPECT_EQ(refused.status().outbox.pending, 1u);
+
+  // With the station's certificate and key: delivered.
+  settings.certFile = certificates.clientCertFile;
+  settings.keyFile = certificates.clientKeyFile;
+  MqttPublisher publisher(settings, "cam1");
+  publisher.start();
+  publisher.submit(samplePart(5));
+  ASSERT_TRUE(results.waitFor([](const auto& m) { return partIds(m).size() == 1; }, 10s))
+      << publisher.status().lastError;
+  EXPECT_EQ(partIds(results.messages()).front(), 5u);
+  EXPECT_EQ(refused.status().delivered, 0u);
 }
 
 }  // namespace
