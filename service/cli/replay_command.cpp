@@ -38,6 +38,8 @@ struct ReplayOptions {
   bool json = false;
   std::string shard;        // batch re-inspection: I/N (replay_shard.hpp)
   std::string resultsFile;  // batch re-inspection: results store to write
+  std::string postgres;     // batch re-inspection: or the central database
+  std::string asStation;    // its station name there
 };
 
 std::string utcNow() {
@@ -197,9 +199,19 @@ void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
   cmd->add_option("--results", opt->resultsFile,
                   "Batch re-inspection: write every part to this results store (SQLite) instead "
                   "of a report");
+  auto* postgres = cmd->add_option(
+      "--postgres", opt->postgres,
+      "Batch re-inspection: write every part to the central PostgreSQL database instead (a libpq "
+      "connection string; the password from PGPASSWORD or ~/.pgpass). Parts the station name "
+      "has there already are skipped: a restarted shard resumes");
+  cmd->add_option("--as-station", opt->asStation,
+                  "With --postgres: the station name of the parts (default: "
+                  "replay-<recipe name>-<first 8 digits of the recipe's hash>)")
+      ->needs(postgres);
   cmd->add_option("--shard", opt->shard,
                   "Batch re-inspection: take share I of N (0-based, by a hash of the file name; "
-                  "default: JOB_COMPLETION_INDEX/JOB_COMPLETIONS when set); needs --results");
+                  "default: JOB_COMPLETION_INDEX/JOB_COMPLETIONS when set); needs --results or "
+                  "--postgres");
   cmd->add_option("--station", opt->stationFile,
                   "Station config: calibration, recipe root and registers");
   cmd->add_option("--mm-per-pixel", opt->mmPerPixel,
@@ -209,10 +221,13 @@ void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
       ->check(CLI::Range(32, 4096));
   cmd->add_flag("--json", opt->json, "Print a summary as one JSON object");
   cmd->callback([opt, &kinds] {
-    if (!opt->resultsFile.empty() || !opt->shard.empty()) {
-      if (opt->resultsFile.empty()) throw InputError("replay --shard: give --results FILE.db");
+    if (!opt->resultsFile.empty() || !opt->postgres.empty() || !opt->shard.empty()) {
+      if (opt->resultsFile.empty() && opt->postgres.empty())
+        throw InputError("replay --shard: give --results FILE.db or --postgres CONNECTION");
+      if (!opt->resultsFile.empty() && !opt->postgres.empty())
+        throw InputError("replay: --results and --postgres exclude each other");
       if (!opt->reportFile.empty())
-        throw InputError("replay: --report and --results exclude each other");
+        throw InputError("replay: --report and --results/--postgres exclude each other");
       runShardedReplay({.recipeFile = opt->recipeFile,
                         .imagesFolder = opt->imagesFolder,
                         .stationFile = opt->stationFile,
@@ -220,6 +235,8 @@ void addReplayCommand(CLI::App& app, const config::StepKindRegistry& kinds) {
                         .glob = opt->glob,
                         .shard = opt->shard,
                         .resultsFile = opt->resultsFile,
+                        .postgres = opt->postgres,
+                        .asStation = opt->asStation,
                         .json = opt->json},
                        kinds);
       return;

@@ -11,6 +11,7 @@
 #include "service/cli/batch_inspection.hpp"
 #include "service/cli/command_line.hpp"
 #include "service/daemon/results_store.hpp"
+#include "service/sinks/postgres_batch_writer.hpp"
 
 namespace facet::cli {
 
@@ -33,37 +34,66 @@ void runShardedReplay(const ShardedReplayOptions& opt, const config::StepKindReg
   } catch (const std::exception& e) {
     throw InputError(e.what());
   }
+  // Where the share goes: a new SQLite file, or the central database (resuming a share that
+  // was partly written there before).
   std::unique_ptr<service::ResultsStore> store;
+  std::unique_ptr<service::PostgresBatchWriter> central;
+  std::string station, destination = opt.resultsFile;
   try {
-    store = std::make_unique<service::ResultsStore>(opt.resultsFile);
+    if (!opt.postgres.empty()) {
+      station = opt.asStation.empty() ? "replay-" + recipe->recipe().name + "-" +
+                                            recipe->recipe().contentHash.substr(0, 8)
+                                      : opt.asStation;
+      central = std::make_unique<service::PostgresBatchWriter>(opt.postgres, station);
+      destination = "postgres " + central->peer() + " station " + station;
+    } else {
+      store = std::make_unique<service::ResultsStore>(opt.resultsFile);
+    }
   } catch (const std::exception& e) {
     throw InputError(e.what());
   }
-  if (store->partCount() > 0)
+  if (store && store->partCount() > 0)
     throw InputError(opt.resultsFile + ": holds parts already; a shard writes a new file");
   const auto sidecars = SidecarMetadata::loadFolder(opt.imagesFolder);
   std::map<std::string, int> counts{{"pass", 0}, {"fail", 0}, {"error", 0}};
+  std::size_t skipped = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  for (const auto& part : share) {
-    const auto result = service::inspectRecordedPart(*recipe, part, sidecars, scans);
-    store->store(result);
-    ++counts[service::verdictName(result.verdict)];
+  try {
+    for (const auto& part : share) {
+      if (central && central->alreadyWritten().contains(part.partId)) {
+        ++skipped;
+        continue;
+      }
+      const auto result = service::inspectRecordedPart(*recipe, part, sidecars, scans);
+      if (central)
+        central->write(result);
+      else
+        store->store(result);
+      ++counts[service::verdictName(result.verdict)];
+    }
+    if (central) central->finish();
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double rate = seconds > 0 ? static_cast<double>(share.size()) / seconds : 0.0;
+  const std::size_t inspected = share.size() - skipped;
+  const double rate = seconds > 0 ? static_cast<double>(inspected) / seconds : 0.0;
   if (opt.json) {
     printJson({{"shard", shard.text()},
                {"images", share.size()},
                {"counts", counts},
                {"seconds", seconds},
+               {"skipped", skipped},
                {"images_per_second", rate},
-               {"results", opt.resultsFile}});
+               {"results", destination}});
     return;
   }
   std::cout << "shard " << shard.text() << ": " << share.size() << " parts, pass " << counts["pass"]
-            << ", fail " << counts["fail"] << ", error " << counts["error"] << " in " << seconds
-            << " s (" << rate << " images/s)\nresults: " << opt.resultsFile << "\n";
+            << ", fail " << counts["fail"] << ", error " << counts["error"];
+  if (skipped > 0) std::cout << ", " << skipped << " already in the database (skipped)";
+  std::cout << " in " << seconds << " s (" << rate << " images/s)\nresults: " << destination
+            << "\n";
 }
 
 }  // namespace facet::cli

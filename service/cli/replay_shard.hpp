@@ -1,6 +1,7 @@
 #pragma once
 // `facet replay --shard I/N --results out.db`: this process's share of a batch re-inspection,
-// written to a results store (SQLite) for `facet results merge`. I/N also come from
+// written to a results store (SQLite) for `facet results merge`, or with `--postgres` to the
+// central database under a station name of the batch's own. I/N also come from
 // JOB_COMPLETION_INDEX / JOB_COMPLETIONS, as a Kubernetes Indexed Job sets them.
 
 #include <string>
@@ -17,6 +18,8 @@ struct ShardedReplayOptions {
   std::string glob;
   std::string shard;        // "I/N"; empty: from the environment, else the whole folder
   std::string resultsFile;  // SQLite file to write (created; must not hold parts yet)
+  std::string postgres;     // or: libpq connection string of the central database
+  std::string asStation;    // the station name the parts get there; empty: replay-<recipe>-<hash>
   bool json = false;
 };
 

@@ -59,6 +59,17 @@ CREATE TABLE IF NOT EXISTS measurements (
 );
 )sql";
 
+bool createPostgresSchema(pg_conn* conn) {
+  // One implicit transaction: the lock is held until the last CREATE is committed. The server's
+  // "already exists, skipping" notices would reach stderr at every connection.
+  const std::string locked =
+      std::string(
+          "SET LOCAL client_min_messages = warning;"
+          "SELECT pg_advisory_xact_lock(hashtext('facet results schema'));") +
+      kPostgresSchema;
+  return succeeded(PgResult(PQexec(conn, locked.c_str())));
+}
+
 namespace {
 
 using Clock = std::chrono::steady_clock;
@@ -155,8 +166,7 @@ bool PostgresSink::connect() {
     conn_ = nullptr;
     return false;
   }
-  const PgResult schema(PQexec(conn_, kPostgresSchema));
-  if (!succeeded(schema)) {
+  if (!createPostgresSchema(conn_)) {
     setError("cannot create the tables: " + postgresError(conn_));
     PQfinish(conn_);
     conn_ = nullptr;

@@ -28,6 +28,11 @@ namespace facet::service {
 // The schema, created when missing (CREATE TABLE IF NOT EXISTS): the results store's columns.
 extern const char* const kPostgresSchema;
 
+// Creates the schema when missing. Stations and replay shards that connect at the same moment
+// are serialised by an advisory lock: two concurrent CREATE TABLE IF NOT EXISTS of one table
+// can otherwise both try to create it and one fails. False: see postgresError(conn).
+bool createPostgresSchema(pg_conn* conn);
+
 class PostgresSink {
  public:
   PostgresSink(config::PostgresSettings settings, std::string station);

@@ -2,7 +2,8 @@
 """Checks deploy/kubernetes/ against what `facet replay --shard` needs (no cluster needed):
 an Indexed Job whose completions equal the JOB_COMPLETIONS it passes, each pod writing its own
 shard file named by JOB_COMPLETION_INDEX, images mounted read-only, the container's user the
-Containerfile's, and a merge Job reading exactly the files the shards write.
+Containerfile's, and a merge Job reading exactly the files the shards write; the PostgreSQL
+variant passes a connection string and a station name, with the password from a Secret.
 Usage: kubernetes_manifests_check.py REPO_ROOT"""
 import re
 import sys
@@ -48,11 +49,36 @@ merge_script = " ".join(merge["spec"]["template"]["spec"]["containers"][0]["args
 check("facet results merge /results/shard-*.db --out /results/all.db" in merge_script,
       "merge-job: must merge every shard file into /results/all.db")
 
+central = load("replay-job-postgres.yaml")
+central_spec = central["spec"]
+central_pod = central_spec["template"]["spec"]
+central_container = central_pod["containers"][0]
+central_env = {e["name"]: e for e in central_container.get("env", [])}
+central_args = central_container.get("args", [])
+check(central_spec.get("completionMode") == "Indexed",
+      "replay-job-postgres: completionMode must be Indexed")
+check(str(central_spec.get("completions")) == central_env.get("JOB_COMPLETIONS", {}).get("value"),
+      "replay-job-postgres: completions != JOB_COMPLETIONS")
+check(central_container.get("command") == ["facet"] and central_args[:1] == ["replay"],
+      "replay-job-postgres: does not run facet replay")
+for flag in ("--postgres", "--as-station", "--recipe", "--images"):
+    check(flag in central_args, f"replay-job-postgres: {flag} missing")
+check("--results" not in central_args and "--shard" not in central_args,
+      "replay-job-postgres: no shard file and no --shard (the Job's environment gives it)")
+check("secretKeyRef" in central_env.get("PGPASSWORD", {}).get("valueFrom", {}),
+      "replay-job-postgres: PGPASSWORD must come from a Secret")
+check(all("password" not in str(e.get("value", "")) for e in central_env.values()),
+      "replay-job-postgres: no password in plain env values")
+for var in re.findall(r"\$\((\w+)\)", " ".join(central_args)):
+    check(var in central_env, f"replay-job-postgres: $({var}) is not set")
+check({m["name"]: m for m in central_container["volumeMounts"]}["images"].get("readOnly") is True,
+      "replay-job-postgres: images must be read-only")
+
 with open(f"{root}/deploy/Containerfile") as f:
     containerfile = f.read()
 uid = re.search(r"useradd [^\n]*--uid (\d+)", containerfile)
 check(uid is not None, "Containerfile: user facet needs a fixed --uid")
-for name, manifest in (("replay-job", job), ("merge-job", merge)):
+for name, manifest in (("replay-job", job), ("merge-job", merge), ("replay-job-postgres", central)):
     user = manifest["spec"]["template"]["spec"]["securityContext"]["runAsUser"]
     check(uid is not None and str(user) == uid.group(1),
           f"{name}: runAsUser {user} is not the Containerfile's uid")
