@@ -8,6 +8,9 @@
 //               both peers down (results buffering on disk). The three runs alternate in blocks
 //               within one run. Each part goes to the sinks the way facetd hands it over: after
 //               the PLC, on the publishing thread (FleetPublishers::submit).
+//   outages     each peers-down block is an outage: the parts it buffered, then the peers are
+//               started again under the same station and the parts they take (MQTT PUBACKs,
+//               rows the database gained) and how long the backlog took to drain.
 //   replay      images per CPU-second (one core) of `facet replay --results` (batch path:
 //               service/batch) over the example recipes' recorded folders, beside the HTML-report
 //               replay (`facet replay --report`: the replay camera and the same inspection) as
@@ -99,9 +102,49 @@ struct Peers {
   sinks_test::PostgresCluster* db;
 };
 
-// `triggers` parts, one at a time; returns trigger -> result registers in ms.
+// One outage: what the sinks buffered while the peers were down, and what reached them after.
+struct Outage {
+  std::uint64_t parts = 0;  // parts inspected during the outage (warm-up included)
+  std::uint64_t bufferedMqtt = 0, bufferedPostgres = 0;
+  std::uint64_t deliveredMqtt = 0, deliveredPostgres = 0;  // after the peers came back
+  std::uint64_t rowsGained = 0;                            // parts table, counted by SQL
+  std::uint64_t dropped = 0;
+  double drainS = 0;  // peers up -> both outboxes empty
+};
+
+std::uint64_t partRows(const Peers& peers) {
+  return std::stoull(peers.db->query("SELECT count(*) FROM parts"));
+}
+
+// The peers are down: counts the backlog, starts them, waits until the backlog is delivered.
+Outage recover(const service::FleetPublishers& fleet, const Peers& peers, std::uint64_t parts) {
+  Outage o;
+  o.parts = parts;
+  auto health = fleet.health();
+  o.bufferedMqtt = health["mqtt"]["buffered"].get<std::uint64_t>();
+  o.bufferedPostgres = health["postgres"]["buffered"].get<std::uint64_t>();
+  peers.broker->start();
+  peers.db->start();
+  const auto rowsBefore = partRows(peers);
+  const auto t0 = Clock::now();
+  while (Clock::now() - t0 < 120s) {
+    health = fleet.health();
+    if (health["mqtt"]["buffered"] == 0 && health["postgres"]["buffered"] == 0) break;
+    std::this_thread::sleep_for(5ms);
+  }
+  o.drainS = std::chrono::duration<double>(Clock::now() - t0).count();
+  o.deliveredMqtt = health["mqtt"]["delivered"].get<std::uint64_t>();
+  o.deliveredPostgres = health["postgres"]["delivered"].get<std::uint64_t>();
+  o.dropped = health["mqtt"]["dropped"].get<std::uint64_t>() +
+              health["postgres"]["dropped"].get<std::uint64_t>();
+  o.rowsGained = partRows(peers) - rowsBefore;
+  return o;
+}
+
+// `triggers` parts, one at a time; returns trigger -> result registers in ms. With the peers
+// down, `outage` gets the backlog and its recovery (the peers are up again afterwards).
 std::vector<double> latencyRun(const fs::path& dir, Sinks sinks, const Peers& peers, int triggers,
-                               std::uint64_t* delivered) {
+                               std::uint64_t* delivered, Outage* outage = nullptr) {
   auto probe = exampleStation(dir / "probe", 1);
   plc::PlcSimulator plc(probe.registerMap, {});
   std::mutex mutex;
@@ -127,7 +170,11 @@ std::vector<double> latencyRun(const fs::path& dir, Sinks sinks, const Peers& pe
   service::FleetPublishers fleet(station);
   fleet.start();
   service::StationOptions options;
-  options.onPart = [&](const service::PartResult& p) { fleet.submit(p); };
+  std::uint64_t parts = 0;
+  options.onPart = [&](const service::PartResult& p) {
+    fleet.submit(p);
+    ++parts;
+  };
   std::vector<double> ms;
   const auto kinds = service::builtinSteps();  // the station keeps a reference
   {
@@ -152,7 +199,8 @@ std::vector<double> latencyRun(const fs::path& dir, Sinks sinks, const Peers& pe
     s.requestStop();
     s.join();
   }
-  fleet.stop(sinks == Sinks::Delivering ? 5000ms : 0ms);
+  if (outage) *outage = recover(fleet, peers, parts);
+  fleet.stop(sinks == Sinks::None ? 0ms : 5000ms);
   const auto health = fleet.health();
   if (delivered && health.contains("mqtt"))
     *delivered = health["mqtt"]["delivered"].get<std::uint64_t>() +
@@ -259,16 +307,19 @@ int main(int argc, char** argv) {
     const Peers peers{&broker, &db};
 
     std::map<Sinks, std::vector<double>> latency;
+    std::vector<Outage> outages;
     std::uint64_t delivered = 0;
     int block = 0;
     for (int round = 0; round < rounds; ++round)
       for (Sinks s : {Sinks::None, Sinks::Delivering, Sinks::PeersDown}) {
         if (s == Sinks::PeersDown) broker.kill(), db.kill();
         std::uint64_t d = 0;
-        const auto ms = latencyRun(dir / ("run" + std::to_string(block++)), s, peers, triggers, &d);
+        Outage outage;
+        const auto ms = latencyRun(dir / ("run" + std::to_string(block++)), s, peers, triggers, &d,
+                                   s == Sinks::PeersDown ? &outage : nullptr);
         latency[s].insert(latency[s].end(), ms.begin(), ms.end());
         if (s == Sinks::Delivering) delivered += d;
-        if (s == Sinks::PeersDown) broker.start(), db.start();
+        if (s == Sinks::PeersDown) outages.push_back(outage);
       }
     std::printf(
         "PLC path: trigger raised -> result registers read, one part at a time, %d parts "
@@ -287,6 +338,27 @@ int main(int argc, char** argv) {
         "\nresults confirmed by broker + database in the peers-up runs: %llu of %d "
         "(MQTT and PostgreSQL each count a part; warm-up parts included)\n\n",
         static_cast<unsigned long long>(delivered), 2 * rounds * (triggers + 5));
+    std::printf(
+        "Outages: broker and database killed (SIGKILL) for one block, then started again; the "
+        "same station's sinks deliver the backlog\n\n");
+    std::printf(
+        "| outage | parts | buffered MQTT | buffered PG | delivered MQTT | delivered PG | "
+        "rows gained | dropped | drain s |\n");
+    std::printf(
+        "|--------|-------|---------------|-------------|----------------|--------------|"
+        "-------------|---------|---------|\n");
+    for (std::size_t i = 0; i < outages.size(); ++i) {
+      const auto& o = outages[i];
+      std::printf("| %6zu | %5llu | %13llu | %11llu | %14llu | %12llu | %11llu | %7llu | %7.2f |\n",
+                  i + 1, static_cast<unsigned long long>(o.parts),
+                  static_cast<unsigned long long>(o.bufferedMqtt),
+                  static_cast<unsigned long long>(o.bufferedPostgres),
+                  static_cast<unsigned long long>(o.deliveredMqtt),
+                  static_cast<unsigned long long>(o.deliveredPostgres),
+                  static_cast<unsigned long long>(o.rowsGained),
+                  static_cast<unsigned long long>(o.dropped), o.drainS);
+    }
+    std::printf("\n");
   } catch (const std::exception& e) {
     std::printf("sinks: FAILED: %s\n", e.what());
     fs::remove_all(dir);
