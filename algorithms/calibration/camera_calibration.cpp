@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 
 #include <opencv2/calib3d.hpp>
@@ -27,6 +28,23 @@ struct Solution {
   CameraModel camera;
   double rms = 0;
   std::vector<cv::Mat> rvecs, tvecs;
+  std::string distortionModel;
+  std::vector<DistortionCandidate> candidates;  // every model tried
+};
+
+// The distortion models tried, simplest first. A narrow lens sees too little of its own field
+// for k3 (or even k2) to be told apart from k1: fitted anyway they follow the noise and bend the
+// model outside the views. The model is chosen by the Bayesian information criterion, so a
+// term stays only when it explains the points better than its cost in freedom.
+struct DistortionModel {
+  const char* name;
+  int flags;
+  int terms;
+};
+constexpr DistortionModel kDistortionModels[] = {
+    {"k1,p1,p2", cv::CALIB_FIX_K2 | cv::CALIB_FIX_K3, 3},
+    {"k1,k2,p1,p2", cv::CALIB_FIX_K3, 4},
+    {"k1,k2,p1,p2,k3", 0, 5},
 };
 
 Solution solve(const BoardSpec& board, cv::Size size,
@@ -34,16 +52,30 @@ Solution solve(const BoardSpec& board, cv::Size size,
   // OpenCV wants float points; float keeps 1e-4 px at 2000 px, two orders below the noise.
   std::vector<std::vector<cv::Point3f>> objects(points.size(), plateFloat(board));
   std::vector<std::vector<cv::Point2f>> images;
-  for (const auto& p : points) images.push_back(imageFloat(p));
-  Solution s;
-  cv::Mat K, D;
-  s.rms = cv::calibrateCamera(
-      objects, images, size, K, D, s.rvecs, s.tvecs, 0,
-      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
-  s.camera.cameraMatrix = cv::Matx33d(K);
-  s.camera.distortion = D.reshape(1, 1).clone();
-  s.camera.imageSize = size;
-  return s;
+  std::size_t count = 0;
+  for (const auto& p : points) images.push_back(imageFloat(p)), count += p.size();
+  const double n = 2.0 * static_cast<double>(count);  // residual components
+  Solution best;
+  std::vector<DistortionCandidate> candidates;
+  double bestBic = std::numeric_limits<double>::infinity();
+  for (const DistortionModel& model : kDistortionModels) {
+    Solution s;
+    cv::Mat K, D;
+    s.rms = cv::calibrateCamera(
+        objects, images, size, K, D, s.rvecs, s.tvecs, model.flags,
+        cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 100, 1e-12));
+    s.camera.cameraMatrix = cv::Matx33d(K);
+    s.camera.distortion = D.reshape(1, 1).clone();
+    s.camera.imageSize = size;
+    s.distortionModel = model.name;
+    // The per-view poses are the same in every model and cancel out.
+    const double rss = s.rms * s.rms * static_cast<double>(count);
+    const double bic = n * std::log(std::max(rss, 1e-300) / n) + (4 + model.terms) * std::log(n);
+    candidates.push_back({model.name, s.rms, bic, s.camera});
+    if (bic < bestBic) bestBic = bic, best = std::move(s);
+  }
+  best.candidates = std::move(candidates);
+  return best;
 }
 
 cv::Matx33d rotationOf(const cv::Mat& rvec) {
@@ -84,6 +116,7 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
     fit.name = views[i].name;
     fit.status = views[i].detection.status;
     fit.points = views[i].detection.points;
+    fit.note = views[i].detection.note;
     if (views[i].detection.status.ok()) used.push_back(i);
     out.views.push_back(std::move(fit));
   }
@@ -130,6 +163,8 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
   }
   out.camera = s.camera;
   out.rmsPx = s.rms;
+  out.distortionModel = s.distortionModel;
+  out.distortionCandidates = s.candidates;
   const auto plate = board.platePoints();
   for (std::size_t k = 0; k < used.size(); ++k) {
     ViewFit& fit = out.views[used[k]];

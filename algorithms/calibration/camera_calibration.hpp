@@ -45,6 +45,7 @@ struct ViewFit {
   std::string name;
   bool used = false;
   Status<CalibrationFailure> status;          // PatternNotFound: why it cannot be used
+  std::string note;                           // used, with a reservation (PatternDetection::note)
   double rmsPx = 0;                           // reprojection RMS of this view's points
   std::vector<cv::Point2d> points;            // detected points
   std::vector<cv::Point2d> residuals;         // detected - reprojected, pixels
@@ -52,11 +53,22 @@ struct ViewFit {
   cv::Vec3d translationMm{0, 0, 0};
 };
 
+// One distortion model tried by the solver, and what it gave.
+struct DistortionCandidate {
+  std::string terms;  // "k1,p1,p2", "k1,k2,p1,p2", "k1,k2,p1,p2,k3"
+  double rmsPx = 0;
+  double bic = 0;  // Bayesian information criterion: the lowest is chosen
+  CameraModel camera;
+};
+
 struct CameraCalibration {
   Status<CalibrationFailure> status;  // refused: the cause and the reason
   std::string warning;                // accepted with a reservation (coverage)
   CameraModel camera;
   double rmsPx = 0;
+  // The distortion terms solved for ("k1,k2,p1,p2" ...): the fewest the points call for.
+  std::string distortionModel;
+  std::vector<DistortionCandidate> distortionCandidates;
   double coverage = 0;  // covered share of the image, 0..1
   std::vector<ViewFit> views;
 };

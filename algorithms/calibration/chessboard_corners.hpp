@@ -25,8 +25,11 @@ namespace facet {
 PatternDetection detectChessboard(const cv::Mat& image, const BoardSpec& board);
 
 // Refines coarse corners (plate order, cols x rows) in place; fails with PatternNotFound when a
-// corner has too few clean edge points on either line (blur too wide for the square size).
+// corner has too few clean edge points on either line (partly hidden). A corner whose squares
+// are too small for clean edge points at the image's blur (under about 25 px at blur 0.6 seen
+// square on) is refined by OpenCV's saddle point instead; `saddleCorners` counts them.
 Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int cols, int rows,
-                                                   std::vector<cv::Point2d>& corners);
+                                                   std::vector<cv::Point2d>& corners,
+                                                   int* saddleCorners = nullptr);
 
 }  // namespace facet

@@ -1,6 +1,7 @@
 #pragma once
 // PatternDetection: where a calibration plate's points lie in one image.
 
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -14,6 +15,7 @@ struct PatternDetection {
   // Not found until a detector has found it; PatternNotFound with the reason for the user.
   Status<CalibrationFailure> status{CalibrationFailure::PatternNotFound, {}};
   std::vector<cv::Point2d> points;  // image pixels, in BoardSpec::platePoints() order
+  std::string note;                 // found, with a reservation for the engineer (empty: none)
 };
 
 }  // namespace facet

@@ -59,11 +59,13 @@ nlohmann::json matrixJson(const cv::Matx33d& m) {
 
 nlohmann::json viewsJson(const CameraCalibration& c) {
   nlohmann::json views = nlohmann::json::array();
-  for (const auto& v : c.views)
+  for (const auto& v : c.views) {
     views.push_back({{"file", v.name},
                      {"rms_px", v.used ? nlohmann::json(v.rmsPx) : nlohmann::json()},
                      {"used", v.used},
                      {"why", v.status.message}});
+    if (!v.note.empty()) views.back()["note"] = v.note;
+  }
   return views;
 }
 
@@ -142,7 +144,8 @@ void run(const CalibrateOptions& o) {
       "facet calibrate --board " + board->text() + " from " +
       std::to_string(
           std::count_if(c.views.begin(), c.views.end(), [](const ViewFit& v) { return v.used; })) +
-      " views in " + o.images + (o.plane.empty() ? "" : "\nmeasuring plane from " + o.plane);
+      " views in " + o.images + ", distortion terms " + c.distortionModel +
+      (o.plane.empty() ? "" : "\nmeasuring plane from " + o.plane);
   {
     std::ofstream out(o.out);
     out << config::calibrationFileText(data, comment);
@@ -155,11 +158,14 @@ void run(const CalibrateOptions& o) {
     nlohmann::json j{{"rms_px", c.rmsPx},
                      {"camera_matrix", matrixJson(c.camera.cameraMatrix)},
                      {"distortion", std::vector<double>(d.begin<double>(), d.end<double>())},
+                     {"distortion_model", c.distortionModel},
                      {"image_size", {size.width, size.height}},
                      {"coverage", c.coverage},
                      {"views", viewsJson(c)},
                      {"out", o.out}};
     if (!c.warning.empty()) j["warning"] = c.warning;
+    for (const auto& m : c.distortionCandidates)
+      j["distortion_models"].push_back({{"terms", m.terms}, {"rms_px", m.rmsPx}, {"bic", m.bic}});
     if (data.plane)
       j["plane"] = {{"rotation", matrixJson(data.plane->rotation)},
                     {"translation_mm",
@@ -172,7 +178,8 @@ void run(const CalibrateOptions& o) {
   }
   for (const auto& v : c.views) {
     if (v.used)
-      std::cout << v.name << ": used, RMS " << v.rmsPx << " px\n";
+      std::cout << v.name << ": used, RMS " << v.rmsPx << " px"
+                << (v.note.empty() ? "" : " (" + v.note + ")") << "\n";
     else
       std::cout << v.name << ": not used: " << v.status.message << "\n";
   }
@@ -181,7 +188,7 @@ void run(const CalibrateOptions& o) {
             << static_cast<int>(100 * c.coverage + 0.5) << "%\n"
             << "fx " << c.camera.cameraMatrix(0, 0) << " fy " << c.camera.cameraMatrix(1, 1)
             << " cx " << c.camera.cameraMatrix(0, 2) << " cy " << c.camera.cameraMatrix(1, 2)
-            << "\n";
+            << ", distortion terms " << c.distortionModel << "\n";
   if (data.plane)
     std::cout << "measuring plane: " << data.mmPerPixel << " mm per pixel at the image centre\n";
   std::cout << "wrote " << o.out << "\n";

@@ -49,7 +49,8 @@ void writeCalibrationReport(const std::string& file, const BoardSpec& board, cv:
     << ", RMS reprojection error <b>" << c.rmsPx << " px</b>, field covered <b>"
     << std::lround(100 * c.coverage) << "%</b>";
   if (!c.warning.empty()) h << " &mdash; warning: " << escape(c.warning);
-  h << "</p><p>Calibration: " << escape(data.kind());
+  h << "</p><p>Calibration: " << escape(data.kind()) << ", distortion terms "
+    << escape(c.distortionModel);
   if (data.plane) h << ", " << data.mmPerPixel << " mm per pixel at the image centre";
   h << "</p>";
   h << "<h2>Residuals over the field</h2><p>Each arrow: detected minus reprojected point, drawn "
@@ -67,12 +68,12 @@ void writeCalibrationReport(const std::string& file, const BoardSpec& board, cv:
       h << "<line x1=\"" << p.x << "\" y1=\"" << p.y << "\" x2=\"" << q.x << "\" y2=\"" << q.y
         << "\" stroke=\"#c00\" stroke-width=\"2\"/>";
     }
-  h << "</svg><h2>Views</h2><table><tr><th>file</th><th>used</th><th>RMS px</th><th>why "
-       "not</th></tr>";
+  h << "</svg><h2>Views</h2><table><tr><th>file</th><th>used</th><th>RMS px</th><th>why not, "
+       "or a reservation</th></tr>";
   for (const auto& v : c.views)
     h << "<tr><td>" << escape(v.name) << "</td><td>" << (v.used ? "yes" : "no") << "</td><td>"
-      << (v.used ? std::to_string(v.rmsPx) : "") << "</td><td>" << escape(v.status.message)
-      << "</td></tr>";
+      << (v.used ? std::to_string(v.rmsPx) : "") << "</td><td>"
+      << escape(v.used ? v.note : v.status.message) << "</td></tr>";
   h << "</table></body></html>\n";
   std::ofstream out(file);
   out << h.str();

@@ -89,6 +89,36 @@ TEST_F(CalibrateCli, CalibratesWritesTheFileAndMeasuresInTheRightPlane) {
   EXPECT_EQ(c["world"]["calibration"], "lens model + plane");
 }
 
+// The example station's calibration file is what `facet calibrate` makes of the plate images
+// shipped beside it (recipes/README.md): nobody edited it by hand, and the command still reads
+// those plates the same way.
+TEST(ExampleStationCalibration, IsWhatFacetCalibrateMakesOfTheShippedPlates) {
+  const fs::path out = fs::temp_directory_path() /
+                       ("facet-example-calibration-" + std::to_string(::getpid()) + ".yaml");
+  const auto run = test::runFacet(
+      "calibrate --images recipes/calibration_plates/views --board chessboard:11x8:2 --plane "
+      "recipes/calibration_plates/plane.png --out " +
+      out.string() + " --json");
+  ASSERT_EQ(run.exitCode, 0) << run.err << run.out;
+  const auto j = nlohmann::json::parse(run.out);
+  for (const auto& v : j["views"]) EXPECT_TRUE(v["used"].get<bool>()) << v.dump();
+  EXPECT_GE(j["coverage"].get<double>(), 0.6);
+  // The file's values, as written (YAML, read as text: the numbers follow their keys).
+  std::ifstream in("recipes/calibration.yaml");
+  const std::string shipped((std::istreambuf_iterator<char>(in)), {});
+  const auto number = [&](const std::string& key) {
+    const auto at = shipped.find(key);
+    if (at == std::string::npos) return std::nan("");
+    return std::stod(shipped.substr(shipped.find_first_of("-0123456789", at + key.size())));
+  };
+  const double mmPerPixel = number("\nmm_per_pixel:");
+  EXPECT_NEAR(j["plane"]["mm_per_px"].get<double>(), mmPerPixel, 1e-9);
+  EXPECT_NEAR(mmPerPixel, 0.05, 1e-4);  // the scale the demo parts were recorded at
+  EXPECT_NEAR(j["rms_px"].get<double>(), number("\nrms_px:"), 1e-9);
+  EXPECT_NEAR(j["distortion"][0].get<double>(), number("\ndistortion: ["), 1e-9);
+  fs::remove(out);
+}
+
 TEST_F(CalibrateCli, RefusesTooFewViewsNamingEveryUnusedImage) {
   fs::create_directories(dir / "few");
   for (int i = 0; i < 5; ++i)

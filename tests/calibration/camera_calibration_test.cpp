@@ -60,6 +60,40 @@ TEST(CameraCalibration, ChessboardViewsGiveTheRenderedCamera) {
   EXPECT_GT(c.coverage, 0.3);
 }
 
+TEST(CameraCalibration, ADistortedWideLensKeepsItsHigherTerms) {
+  // k1 -0.22 and k2 0.08 over a 1280x1024 field at f = 1500: k2 is plainly visible.
+  const auto c = calibrateCamera(test::chessboard(), test::testCamera().size,
+                                 renderViews(test::chessboard(), test::testCamera(), 10, 21));
+  ASSERT_TRUE(c.status.ok()) << c.status.message;
+  EXPECT_NE(c.distortionModel.find("k2"), std::string::npos) << c.distortionModel;
+}
+
+TEST(CameraCalibration, ANarrowLensGetsNoTermsTheViewsCannotTellApart) {
+  // f = 4000 px on 640x480 (a 9 degree field) with k1 alone: k2 and k3 would fit the noise.
+  scene::LensCamera narrow;
+  narrow.size = {640, 480};
+  narrow.fx = narrow.fy = 4000, narrow.cx = 322, narrow.cy = 236;
+  narrow.k1 = -0.05;
+  const BoardSpec board{BoardSpec::Kind::Chessboard, 11, 8, 2.5, 0.0};
+  const auto c = calibrateCamera(board, narrow.size, renderViews(board, narrow, 10, 5));
+  ASSERT_TRUE(c.status.ok()) << c.status.message;
+  EXPECT_EQ(c.distortionModel, "k1,p1,p2");
+  EXPECT_EQ(c.camera.distortion.at<double>(1), 0.0);
+  EXPECT_EQ(c.camera.distortion.at<double>(4), 0.0);
+  // Every model was tried; the full one fits the points as well and the field worse.
+  ASSERT_EQ(c.distortionCandidates.size(), 3u);
+  const auto& full = c.distortionCandidates.back();
+  EXPECT_EQ(full.terms, "k1,k2,p1,p2,k3");
+  EXPECT_LT(c.rmsPx - full.rmsPx, 0.01);
+  const cv::Mat all(narrow.size, CV_8U, cv::Scalar(255));
+  const CameraModel truth{narrow.matrix(), narrow.distortion(), narrow.size};
+  const double chosen = test::modelError(c.camera, truth, all);
+  const double fullError = test::modelError(full.camera, truth, all);
+  std::printf("narrow lens, model error over the whole field: chosen %.4f px, full model %.4f px\n",
+              chosen, fullError);
+  EXPECT_LE(chosen, fullError);
+}
+
 TEST(CameraCalibration, CircleGridViewsGiveTheRenderedCamera) {
   const auto camera = test::testCamera();
   const auto c = calibrateCamera(test::circleGrid(), camera.size,

@@ -33,6 +33,35 @@ TEST(PlateDetection, ChessboardCornersInPlateOrderAndSubpixel) {
   }
 }
 
+TEST(PlateDetection, SquaresTooSmallForEdgeLinesAreLocatedBySaddlePointAndSaySo) {
+  // The example station's camera (f = 2400 px) with 2 mm squares 260 mm away: 18 px squares,
+  // too small for clean edge points between the junctions at blur 0.6.
+  scene::LensCamera camera;
+  camera.size = {640, 480};
+  camera.fx = camera.fy = 2400, camera.cx = 319.5, camera.cy = 239.5;
+  camera.k1 = -0.012;
+  scene::PlaneScene s;
+  s.camera = camera;
+  s.placement = scene::lookAtPlane({10, 7}, 260, 15, 30, 5, camera);
+  scene::addChessboardPlate(s, 11, 8, 2.0);
+  s.lensBlurSigma = 0.6;
+  s.noiseSigma = 1.5;
+  const BoardSpec board{BoardSpec::Kind::Chessboard, 11, 8, 2.0, 0.0};
+  const auto truth = scene::patternImagePoints(s, board.cols, board.rows, board.pitchMm);
+  const PlateView view = detectPlate(s.render(), board, "small");
+  ASSERT_TRUE(view.detection.status.ok()) << view.detection.status.message;
+  EXPECT_NE(view.detection.note.find("88 of 88 corners by saddle point"), std::string::npos)
+      << view.detection.note;
+  const double rms = rmsError(view.detection.points, truth);
+  std::printf("18 px squares: corner RMS %.4f px\n", rms);
+  EXPECT_LT(rms, 0.1);
+  // Squares large enough (the shared scenes): no note.
+  const PlateView large =
+      detectPlate(test::plateScene(test::chessboard(), test::testCamera(), 11, 0).render(),
+                  test::chessboard(), "large");
+  EXPECT_TRUE(large.detection.note.empty()) << large.detection.note;
+}
+
 TEST(PlateDetection, CircleCentresArePerspectiveCorrectWithTheTrueCamera) {
   const BoardSpec board = test::circleGrid();
   const auto camera = test::testCamera();

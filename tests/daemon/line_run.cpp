@@ -145,7 +145,9 @@ std::string writeStationFile(const std::string& dir, const std::string& camera, 
   f << "archive:\n  folder: " << dir << "/archive\n  quota_mb: " << options.archiveQuotaMb
     << "\n  keep: " << options.archiveKeep << "\n";
   f << "http:\n  bind: 127.0.0.1\n  port: 0\n";
-  f << "calibration:\n  file: " << recipes << "/calibration.yaml\n";
+  f << "calibration:\n"
+    << (options.calibration.empty() ? "  file: " + recipes + "/calibration.yaml\n"
+                                    : options.calibration);
   return dir + "/station.yaml";
 }
 

@@ -59,6 +59,9 @@ struct StationFileOptions {
   std::string plcExtra;               // more keys of the plc section, YAML lines indented by two
                                       // spaces (e.g. "  queue_capacity: 16\n")
   std::string resultsExtra;           // more keys of the results section (e.g. "  keep_parts: 5\n")
+  // The calibration section's keys (indented by two spaces); empty: the example station's file,
+  // made for 640x480 frames (facetd refuses other frame sizes with it).
+  std::string calibration;
 };
 
 // The station file for a test: results, archive and HTTP in `dir`; `camera` is the YAML of the

@@ -85,7 +85,9 @@ TEST(SignalFaults, SigtermDuringAPartFinishesAndStoresIt) {
   // A free-run PLC that reports every result as it lands: the finished part must reach it too.
   const int plcPort = plc::test::freeTcpPort();
   const auto station =
-      writeStationFile(dir.path(), replayCamera(images, 2), plcPort, {.plcMode = "free_run"});
+      writeStationFile(dir.path(), replayCamera(images, 2), plcPort,
+                       // Scale only: the example station's lens model is for 640x480 frames.
+                       {.plcMode = "free_run", .calibration = "  mm_per_pixel: 0.05\n"});
   const std::string peerConfig = writePeerConfig(station, /*freeRun=*/true);
   plc::test::PymodbusPlc plc(peerConfig, plcPort);
   plc.start();

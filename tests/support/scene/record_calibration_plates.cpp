@@ -1,8 +1,8 @@
 // Renders the example station's calibration plate images (recipes/calibration_plates): the demo
 // camera (640x480, f = 2400 px, slight barrel distortion) looking at an 11x8-corner chessboard
-// of 2 mm squares in 12 poses tilted up to 40 degrees, and once lying flat where the demo parts
-// lie, 120 mm in front of the camera (0.05 mm per pixel, the scale the demo was recorded at).
-// `facet calibrate` turns them into recipes/calibration.yaml (see recipes/README.md).
+// of 2 mm squares in 12 poses tilted 20-38 degrees over the whole field, and once lying flat where
+// the demo parts lie, 120 mm in front of the camera (0.05 mm per pixel, the scale the demo was
+// recorded at). `facet calibrate` turns them into recipes/calibration.yaml (see recipes/README.md).
 //
 // Usage: record_calibration_plates OUTPUT_FOLDER
 #include <cstdio>
@@ -38,9 +38,24 @@ int main(int argc, char** argv) {
     s.seed = seed;
     return s.render();
   };
-  for (int i = 0; i < 12; ++i) {
-    const auto placement =
-        seriesPlacement(camera, {(cols - 1) * pitch, (rows - 1) * pitch}, 2 * pitch, 7, i);
+  // Twelve views that together cover the field (a lens model is only known where the views
+  // put points): the plate 150 mm away, shifted over a 3x3 grid of the image and tilted 20-35
+  // degrees about a turning axis, plus three steeper views in the middle.
+  const double distance = 150;
+  int i = 0;
+  for (int gy = -1; gy <= 1; ++gy)
+    for (int gx = -1; gx <= 1; ++gx, ++i) {
+      const double tilt = 20 + 15 * ((i * 7) % 9) / 8.0;
+      const auto placement =
+          lookAtPlane({(cols - 1) * pitch / 2, (rows - 1) * pitch / 2}, distance, tilt, 40.0 * i,
+                      6.0 * (i % 3 - 1), camera, {gx * 120.0, gy * 90.0});
+      char name[32];
+      std::snprintf(name, sizeof name, "plate_%02d.png", i);
+      cv::imwrite((out / "views" / name).string(), render(placement, 100 + i));
+    }
+  for (; i < 12; ++i) {
+    const auto placement = lookAtPlane({(cols - 1) * pitch / 2, (rows - 1) * pitch / 2}, distance,
+                                       38, 120.0 * i, 0, camera);
     char name[32];
     std::snprintf(name, sizeof name, "plate_%02d.png", i);
     cv::imwrite((out / "views" / name).string(), render(placement, 100 + i));
