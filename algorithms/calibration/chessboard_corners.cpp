@@ -5,6 +5,7 @@
 
 #include <Eigen/Dense>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/edges/subpixel_edges.hpp"
@@ -144,11 +145,32 @@ Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int col
                                                    std::vector<cv::Point2d>& corners,
                                                    int* saddleCorners) {
   if (saddleCorners) *saddleCorners = 0;
-  cv::Mat grey32;  // made when the first corner needs the saddle refinement
   auto at = [&](int c, int r) { return corners[static_cast<std::size_t>(r * cols + c)]; };
-  std::vector<cv::Point2d> refined(corners.size());
-  for (int r = 0; r < rows; ++r) {
-    for (int c = 0; c < cols; ++c) {
+  const std::size_t count = corners.size();
+  if (count == 0) return {};
+
+  // The image's edge blur and Canny thresholds, once, around the first corner: they decide how
+  // far from a junction edge points are clean; each corner's profile fits estimate their own.
+  EdgeParams probeParams;
+  {
+    const cv::Point2d p = at(0, 0), q = cols > 1 ? at(1, 0) : at(0, std::min(1, rows - 1));
+    const int probe = std::max(8, static_cast<int>(std::ceil(0.5 * cv::norm(q - p))));
+    probeParams.roi =
+        cv::Rect(cvRound(p.x) - probe, cvRound(p.y) - probe, 2 * probe + 1, 2 * probe + 1);
+  }
+  const EdgeContours probe = detectSubpixelEdges(image, probeParams);
+  const double blurSigma = probe.blurSigma;
+  cv::Mat grey32;
+  image.convertTo(grey32, CV_32F);  // for the saddle points
+
+  std::vector<cv::Point2d> refined(count);
+  std::vector<Status<CalibrationFailure>> status(count);
+  std::vector<char> bySaddle(count, 0);
+  // Corners are independent: refined in parallel.
+  cv::parallel_for_(cv::Range(0, static_cast<int>(count)), [&](const cv::Range& range) {
+    for (int index = range.start; index < range.end; ++index) {
+      const int r = index / cols, c = index % cols;
+      const auto i = static_cast<std::size_t>(index);
       const cv::Point2d p = at(c, r);
       const cv::Point2d xa = c > 0 ? at(c - 1, r) : p, xb = c + 1 < cols ? at(c + 1, r) : p;
       const cv::Point2d ya = r > 0 ? at(c, r - 1) : p, yb = r + 1 < rows ? at(c, r + 1) : p;
@@ -161,36 +183,36 @@ Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int col
       // X bends the edges out to about 3 sigma from the junction: edge points of one line are
       // clean where the other line (at the corner, and at the neighbouring corners) is farther
       // than that, measured across the narrower of the X's angles.
-      const int probe = static_cast<int>(std::ceil(0.5 * spacing));
-      EdgeParams params;
-      params.roi =
-          cv::Rect(cvRound(p.x) - probe, cvRound(p.y) - probe, 2 * probe + 1, 2 * probe + 1);
-      EdgeContours edges = detectSubpixelEdges(image, params);
-      const double inner = (6.75 + 3.0 * edges.blurSigma) / sine + 1.0;
+      const double inner = (6.75 + 3.0 * blurSigma) / sine + 1.0;
       const double outer = spacing - inner;
       // Squares a few blur widths across still show the X's saddle; below that nothing in the
       // image locates the corner.
-      const bool saddleVisible = 4.0 * edges.blurSigma < spacing * sine;
-      const auto bySaddle = [&] {
-        if (grey32.empty()) image.convertTo(grey32, CV_32F);
-        refined[static_cast<std::size_t>(r * cols + c)] = saddleCorner(grey32, p, spacing, sine);
-        if (saddleCorners) ++*saddleCorners;
-      };
+      const bool saddleVisible = 4.0 * blurSigma < spacing * sine;
       if (outer < inner + 4.0) {
-        if (!saddleVisible)
-          return Status<CalibrationFailure>::failed(CalibrationFailure::PatternNotFound,
-                                                    "squares too small for the blur (" +
-                                                        std::to_string(spacing) +
-                                                        " px between corners, edge blur sigma " +
-                                                        std::to_string(edges.blurSigma) + " px)");
-        bySaddle();
+        if (saddleVisible) {
+          refined[i] = saddleCorner(grey32, p, spacing, sine);
+          bySaddle[i] = 1;
+        } else {
+          status[i] = Status<CalibrationFailure>::failed(
+              CalibrationFailure::PatternNotFound,
+              "squares too small for the blur (" + std::to_string(spacing) +
+                  " px between corners, edge blur sigma " + std::to_string(blurSigma) + " px)");
+        }
         continue;
       }
+      // Only the two lines' clean stretches are searched: a strip along each, without the
+      // junction (most of the box around the corner is other squares' edges).
       const int half = static_cast<int>(std::ceil(outer)) + 1;
-      if (half > probe) {
-        params.roi = cv::Rect(cvRound(p.x) - half, cvRound(p.y) - half, 2 * half + 1, 2 * half + 1);
-        edges = detectSubpixelEdges(image, params);
-      }
+      EdgeParams params;
+      params.roi = cv::Rect(cvRound(p.x) - half, cvRound(p.y) - half, 2 * half + 1, 2 * half + 1);
+      params.low = probe.lowThreshold;
+      params.high = probe.highThreshold;
+      params.blurOnPixelGrid = probe.blurOnPixelGrid;  // one optics per image: its width is fitted
+      params.mask = cv::Mat::zeros(image.size(), CV_8U);
+      for (const cv::Point2d& d : {dx, dy})
+        cv::line(params.mask, p - (outer + 2) * d, p + (outer + 2) * d, cv::Scalar(255), 9);
+      cv::circle(params.mask, p, std::max(0, static_cast<int>(inner) - 2), cv::Scalar(0), -1);
+      const EdgeContours edges = detectSubpixelEdges(image, params);
       EdgeCurve lx{p, dx, {-dx.y, dx.x}}, ly{p, dy, {-dy.y, dy.x}};
       std::vector<cv::Point2d> onX, onY;
       for (const EdgePoint& e : edges.points) {
@@ -205,20 +227,24 @@ Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int col
       }
       std::optional<cv::Point2d> q;
       if (fitCurve(onX, lx) && fitCurve(onY, ly)) q = intersect(lx, ly, p);
-      if ((!q || cv::norm(*q - p) > 2.0) && saddleVisible && outer < 2.0 * inner) {
+      if (q && cv::norm(*q - p) <= 2.0) {
+        refined[i] = *q;
+      } else if (saddleVisible && outer < 2.0 * inner) {
         // Squares just above the size for edge lines: too few clean points at this angle.
-        bySaddle();
-        continue;
-      }
-      if (!q || cv::norm(*q - p) > 2.0) {
-        return Status<CalibrationFailure>::failed(
+        refined[i] = saddleCorner(grey32, p, spacing, sine);
+        bySaddle[i] = 1;
+      } else {
+        status[i] = Status<CalibrationFailure>::failed(
             CalibrationFailure::PatternNotFound,
             "corner (" + std::to_string(c) + ", " + std::to_string(r) +
                 ") has too few clean edge points on its two lines (blurred or partly hidden?)");
       }
-      refined[static_cast<std::size_t>(r * cols + c)] = *q;
     }
-  }
+  });
+  for (const auto& s : status)
+    if (!s.ok()) return s;
+  if (saddleCorners)
+    *saddleCorners = static_cast<int>(std::count(bySaddle.begin(), bySaddle.end(), 1));
   corners = std::move(refined);
   return {};
 }
