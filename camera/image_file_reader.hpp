@@ -1,7 +1,8 @@
 #pragma once
-// Reading one recorded image with OpenImageIO, safely: the header is checked against a pixel
-// limit before any pixel memory is allocated, and a truncated or corrupt file is an error with
-// its name, never a crash or a half-filled frame.
+// Reading one recorded image, safely: the header is checked against a pixel limit before any
+// pixel memory is allocated, and a truncated or corrupt file is an error with its name, never a
+// crash or a half-filled frame. Decoded by OpenImageIO in the image-codec module
+// (image_codecs.hpp); a module that cannot be loaded is an error of the file's read, too.
 
 #include <cstdint>
 #include <filesystem>

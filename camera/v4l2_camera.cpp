@@ -11,9 +11,9 @@
 #include <thread>
 
 #include <spdlog/spdlog.h>
-#include <opencv2/imgcodecs.hpp>
 
 #include "camera/fourcc.hpp"
+#include "camera/image_codecs.hpp"
 #include "camera/sensor_image.hpp"
 
 namespace facet {
@@ -346,7 +346,7 @@ GrabResult V4l2Camera::grab(std::chrono::milliseconds timeout) {
       // Decoding is the copy: the JPEG bytes are read in place.
       const cv::Mat jpeg(1, static_cast<int>(buffer.bytesused), CV_8UC1, data);
       const bool mono = settings_.colour == ColourConversion::Mono;
-      frame.image = cv::imdecode(jpeg, mono ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
+      frame.image = decodeImage(jpeg, mono ? cv::IMREAD_GRAYSCALE : cv::IMREAD_COLOR);
       frame.format = mono ? PixelFormat::Mono8 : PixelFormat::Bgr8;
       if (frame.image.empty() || frame.image.cols != width_ || frame.image.rows != height_) {
         frame.image.release();

@@ -7,9 +7,8 @@
 #include <iostream>
 #include <set>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "algorithms/calibration/camera_calibration.hpp"
+#include "camera/image_codecs.hpp"
 #include "config/calibration_file.hpp"
 #include "service/cli/calibration_report.hpp"
 #include "service/cli/command_line.hpp"
@@ -48,7 +47,7 @@ std::string sizeText(cv::Size s) {
 }
 
 cv::Mat readGrey(const std::filesystem::path& file) {
-  return cv::imread(file.string(), cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
+  return readImage(file, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
 }
 
 nlohmann::json matrixJson(const cv::Matx33d& m) {

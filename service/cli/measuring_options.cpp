@@ -5,8 +5,6 @@
 #include <sstream>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "service/cli/command_line.hpp"
 
 namespace facet::cli {

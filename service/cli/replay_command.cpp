@@ -9,10 +9,10 @@
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "camera/camera_factory.hpp"
+#include "camera/image_codecs.hpp"
 #include "config/recipe_loader.hpp"
 #include "config/station_config.hpp"
 #include "service/cli/command_line.hpp"
@@ -56,12 +56,12 @@ void pictures(const cv::Mat& image, const service::InspectionOutcome& o, const s
               int width, service::ReplayedPart& part) {
   cv::Mat picture =
       service::drawOverlay(image, o.overlay, banner, o.verdict == service::Verdict::Pass);
-  cv::imencode(".png", picture, part.overlayPng);
+  encodeImage(".png", picture, part.overlayPng);
   if (picture.cols > width) {
     const double scale = static_cast<double>(width) / picture.cols;
     cv::resize(picture, picture, {}, scale, scale, cv::INTER_AREA);
   }
-  cv::imencode(".png", picture, part.thumbnailPng);
+  encodeImage(".png", picture, part.thumbnailPng);
 }
 
 void runReplay(const ReplayOptions& opt, const config::StepKindRegistry& kinds) {

@@ -2,8 +2,7 @@
 
 #include <stdexcept>
 
-#include <opencv2/imgcodecs.hpp>
-
+#include "camera/image_codecs.hpp"
 #include "camera/image_file_list.hpp"
 
 namespace facet::service {
@@ -23,7 +22,7 @@ std::optional<cv::Size> expectedFrameSize(const CameraSettings& camera) {
             camera.replay.folder, camera.replay.glob,
             {".png", ".tif", ".tiff", ".bmp", ".pgm", ".ppm", ".pnm", ".pbm", ".jpg", ".jpeg"});
         for (const auto& f : files) {
-          const cv::Mat image = cv::imread(f.string(), cv::IMREAD_UNCHANGED);
+          const cv::Mat image = readImage(f, cv::IMREAD_UNCHANGED);
           if (!image.empty()) return image.size();
         }
       } catch (const std::exception&) {

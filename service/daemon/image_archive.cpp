@@ -9,7 +9,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include <opencv2/imgcodecs.hpp>
+#include "camera/image_codecs.hpp"
 
 namespace facet::service {
 
@@ -78,8 +78,7 @@ bool ImageArchive::wanted(const PartResult& part) {
 
 void ImageArchive::writeFile(const fs::path& file, const cv::Mat& image) {
   std::vector<unsigned char> png;
-  if (!cv::imencode(".png", image, png))
-    throw std::runtime_error(file.string() + ": cannot encode");
+  if (!encodeImage(".png", image, png)) throw std::runtime_error(file.string() + ": cannot encode");
   // Written to a temporary name and renamed, so a full disk never leaves a truncated PNG behind.
   const fs::path partial = file.string() + std::string(kPartialSuffix);
   try {

@@ -1,6 +1,6 @@
 #include <spdlog/spdlog.h>
-#include <opencv2/imgcodecs.hpp>
 
+#include "camera/image_codecs.hpp"
 #include "service/daemon/part_banner.hpp"
 #include "service/daemon/station.hpp"
 
@@ -113,7 +113,7 @@ std::vector<unsigned char> Station::lastOverlayPng() const {
     last = lastPicture_;
   }
   std::vector<unsigned char> png;
-  if (!last.image.empty()) cv::imencode(".png", last.draw(), png);
+  if (!last.image.empty()) encodeImage(".png", last.draw(), png);
   return png;
 }
 

@@ -1,10 +1,9 @@
 #include "service/engine/steps/align_step.hpp"
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "algorithms/image/grey_image.hpp"
 #include "algorithms/registration/register_images.hpp"
 #include "algorithms/shape/find_shape_model.hpp"
+#include "camera/image_codecs.hpp"
 #include "config/recipe_format.hpp"
 #include "service/engine/frame_maps.hpp"
 #include "service/engine/steps/pose_fields.hpp"
@@ -77,7 +76,7 @@ std::shared_ptr<const config::StepResources> AlignStep::prepare(const config::St
   if (a.method == AlignParams::Method::Shape)
     return prepareShapeModel(trainingOf(a), in, "reference");
   auto reference = std::make_shared<ReferenceImage>();
-  const cv::Mat image = cv::imread(a.reference.string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat image = readImage(a.reference, cv::IMREAD_UNCHANGED);
   if (image.empty()) {
     in.error(in["reference"],
              "'reference' file '" + in["reference"].Scalar() + "' cannot be read as an image");

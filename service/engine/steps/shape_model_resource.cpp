@@ -1,10 +1,9 @@
 #include "service/engine/steps/shape_model_resource.hpp"
 
-#include <opencv2/imgcodecs.hpp>
-
 #include "algorithms/geometry/pose2d.hpp"
 #include "algorithms/image/grey_image.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
+#include "camera/image_codecs.hpp"
 #include "config/recipe_loader.hpp"
 #include "config/recipe_training.hpp"
 #include "config/training_record.hpp"
@@ -33,7 +32,7 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
                                                             const std::string& templateKey) {
   // A missing key was reported by the validator: nothing to load.
   if (!in[templateKey] || !in["model"]) return nullptr;
-  const cv::Mat image = cv::imread(training.templateImage.string(), cv::IMREAD_UNCHANGED);
+  const cv::Mat image = readImage(training.templateImage, cv::IMREAD_UNCHANGED);
   if (image.empty()) {
     in.error(in[templateKey], "'" + templateKey + "' file '" + in[templateKey].Scalar() +
                                   "' cannot be read as an image");
@@ -105,7 +104,7 @@ void drawContour(Overlay& overlay, const std::vector<cv::Point2d>& contour, cv::
 config::TrainedModel trainShapeModel(const config::Step& step, const ShapeTraining& training) {
   const std::string what = "step '" + step.id + "': ";
   const std::string file = training.templateImage.string();
-  const cv::Mat image = cv::imread(file, cv::IMREAD_UNCHANGED);
+  const cv::Mat image = readImage(file, cv::IMREAD_UNCHANGED);
   if (image.empty()) throw config::TrainingError(what + file + ": cannot read the image");
   ShapeModelParams params;
   if (const auto& r = training.region)

@@ -1,7 +1,8 @@
-// libFuzzer target: the replay backend's image decoder path (camera/image_file_reader.hpp,
-// OpenImageIO and, for 16-bit PNM, OpenCV). The first byte picks the file extension the replay
-// folder accepts, the rest is the file. Expected outcome for bad input: an error naming the
-// file. An image that reads must have the size its header announced and a frame format.
+// libFuzzer target: the replay backend's image decoder (camera/image_file_decoder.hpp, what
+// readImageFile runs inside the image-codec module: OpenImageIO and, for 16-bit PNM, OpenCV). The
+// first byte picks the file extension the replay folder accepts, the rest is the file. Expected
+// outcome for bad input: an error naming the file. An image that reads must have the size its
+// header announced and a frame format.
 //
 // The pixel limit is lower than the camera's default (2^28) so that runs stay within the
 // fuzzer's memory limit; the header check in front of any allocation is the same code.
@@ -12,7 +13,7 @@
 #include <cstdlib>
 #include <string>
 
-#include "camera/image_file_reader.hpp"
+#include "camera/image_file_decoder.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -23,7 +24,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const std::string name = std::string("frame") + kExtensions[data[0] % kExtensions.size()];
   const auto file = folder.write(name, data + 1, size - 1);
   constexpr std::uint64_t kMaxPixels = std::uint64_t{1} << 22;
-  const facet::ImageFileContent content = facet::readImageFile(file, kMaxPixels);
+  const facet::ImageFileContent content = facet::decodeImageFile(file, kMaxPixels);
   if (content.ok()) {
     if (content.image.empty() || content.image.total() > kMaxPixels) std::abort();
   } else if (!content.image.empty() || content.error.find(file.string()) != 0) {

@@ -1,4 +1,4 @@
-#include "camera/image_file_reader.hpp"
+#include "camera/image_file_decoder.hpp"
 
 #include <OpenImageIO/imageio.h>
 #include <opencv2/imgcodecs.hpp>
@@ -7,7 +7,7 @@
 namespace facet {
 namespace OIIO = OIIO_NAMESPACE;
 
-ImageFileContent readImageFile(const std::filesystem::path& file, std::uint64_t max_pixels) {
+ImageFileContent decodeImageFile(const std::filesystem::path& file, std::uint64_t max_pixels) {
   ImageFileContent content;
   const std::string name = file.string();
   auto input = OIIO::ImageInput::open(name);

@@ -1,0 +1,109 @@
+#include "camera/image_codecs.hpp"
+
+#include <dlfcn.h>
+
+#include <cstdio>
+#include <cstdlib>
+
+#include "camera/image_codec_table.hpp"
+#include "camera/image_file_reader.hpp"
+
+// Baked in by camera/CMakeLists.txt.
+#ifndef FACET_IMAGE_CODECS_FILE
+#error "FACET_IMAGE_CODECS_FILE (the module's file name) is not defined"
+#endif
+
+namespace facet {
+namespace {
+namespace fs = std::filesystem;
+
+struct LoadedCodecs {
+  const ImageCodecTable* table = nullptr;
+  std::string problem;  // empty when `table` is set
+};
+
+std::vector<fs::path> modulePaths() {
+  if (const char* file = std::getenv("FACET_IMAGE_CODECS"); file && *file) return {file};
+  std::vector<fs::path> paths;
+  std::error_code ec;
+  // The installed layout: <prefix>/bin/facet beside <prefix>/lib/facet/<module>.
+  if (const fs::path exe = fs::read_symlink("/proc/self/exe", ec); !ec)
+    paths.push_back((exe.parent_path() / FACET_IMAGE_CODECS_FROM_BIN / FACET_IMAGE_CODECS_FILE)
+                        .lexically_normal());
+  paths.emplace_back(FACET_IMAGE_CODECS_BUILD_PATH);
+  return paths;
+}
+
+LoadedCodecs load() {
+  std::string tried;
+  for (const fs::path& path : modulePaths()) {
+    void* handle = ::dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);
+    if (!handle) {
+      const char* error = ::dlerror();
+      const std::string why = error ? error : "cannot load";
+      // dlerror() names the path itself for a missing file, a dependency for a broken one.
+      tried += (tried.empty() ? "" : "; ") +
+               (why.starts_with(path.string()) ? why : path.string() + ": " + why);
+      continue;
+    }
+    using Entry = const ImageCodecTable* (*)();
+    const auto entry = reinterpret_cast<Entry>(::dlsym(handle, kImageCodecEntry));
+    const ImageCodecTable* table = entry ? entry() : nullptr;
+    if (table && table->abi == kImageCodecAbi) {
+      // Never closed: decoders keep global state for the life of the process.
+      return {table, {}};
+    }
+    const std::string why = table ? "built for interface " + std::to_string(table->abi) +
+                                        ", this program needs " + std::to_string(kImageCodecAbi)
+                                  : std::string("no ") + kImageCodecEntry;
+    tried += (tried.empty() ? "" : "; ") + path.string() + ": " + why;
+    ::dlclose(handle);
+  }
+  LoadedCodecs failed;
+  failed.problem = "image codecs not loaded (set FACET_IMAGE_CODECS to the module " +
+                   std::string(FACET_IMAGE_CODECS_FILE) + "); tried " + tried;
+  std::fprintf(stderr, "facet: %s\n", failed.problem.c_str());
+  return failed;
+}
+
+const LoadedCodecs& loaded() {
+  static const LoadedCodecs codecs = load();  // once, thread-safe
+  return codecs;
+}
+
+}  // namespace
+
+const std::string& imageCodecsProblem() {
+  return loaded().problem;
+}
+
+cv::Mat readImage(const fs::path& file, int flags) {
+  const ImageCodecTable* table = loaded().table;
+  return table ? table->read(file.string(), flags) : cv::Mat();
+}
+
+bool writeImage(const fs::path& file, const cv::Mat& image, const std::vector<int>& params) {
+  const ImageCodecTable* table = loaded().table;
+  return table && table->write(file.string(), image, params);
+}
+
+bool encodeImage(const std::string& ext, const cv::Mat& image, std::vector<unsigned char>& bytes,
+                 const std::vector<int>& params) {
+  const ImageCodecTable* table = loaded().table;
+  return table && table->encode(ext, image, bytes, params);
+}
+
+cv::Mat decodeImage(const cv::Mat& bytes, int flags) {
+  const ImageCodecTable* table = loaded().table;
+  return table ? table->decode(bytes, flags) : cv::Mat();
+}
+
+ImageFileContent readImageFile(const fs::path& file, std::uint64_t max_pixels) {
+  const LoadedCodecs& codecs = loaded();
+  if (codecs.table) return codecs.table->readFile(file, max_pixels);
+  ImageFileContent content;
+  content.error = file.string() + ": cannot read image: " + codecs.problem;
+  return content;
+}
+
+}  // namespace facet

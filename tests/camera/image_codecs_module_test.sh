@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# The image codecs are a module loaded on first use (camera/image_codecs.hpp): facet and facetd
+# must not link OpenImageIO or OpenCV's imgcodecs (each start would map ~200 more libraries), an
+# image command must find the module in the build tree and in the installed layout, and a missing
+# module must be a clear error, not a crash.
+#   usage: image_codecs_module_test.sh FACET FACETD BUILD_DIR   (from the repository root)
+set -uo pipefail
+facet=$1 facetd=$2 build=$3
+fail() { echo "FAIL: $*" >&2; exit 1; }
+match=(match --model recipes/models/bracket.shape --image recipes/demo/bracket_shape/part_000.png
+       --json)
+
+for program in "$facet" "$facetd"; do
+  needed=$(readelf -d "$program" | grep NEEDED) || fail "readelf -d $program"
+  if grep -Ei 'libOpenImageIO|libopencv_imgcodecs' <<<"$needed"; then
+    fail "$program links an image codec library directly"
+  fi
+done
+
+out=$("$facet" "${match[@]}") || fail "facet match with the module of the build tree: $out"
+grep -q '"score"' <<<"$out" || fail "facet match printed no match: $out"
+
+missing=/nonexistent/libfacet_image_codecs.so
+err=$(FACET_IMAGE_CODECS=$missing "$facet" "${match[@]}" 2>&1 >/dev/null)
+rc=$?
+[[ $rc -eq 1 ]] || fail "a missing module must exit 1 (an unreadable image), got $rc: $err"
+grep -q "part_000.png: cannot read image: image codecs not loaded" <<<"$err" &&
+  grep -q "$missing: cannot open shared object file" <<<"$err" ||
+  fail "the error must name the image, the path tried and dlerror(): $err"
+
+# The installed layout: <prefix>/bin/facet finds <prefix>/lib/facet/ through /proc/self/exe.
+prefix=$(mktemp -d)
+trap 'rm -rf "$prefix"' EXIT
+cmake --install "$build" --prefix "$prefix" >/dev/null || fail "cmake --install"
+err=$(LD_DEBUG=files "$prefix/bin/facet" "${match[@]}" 2>&1 >/dev/null) ||
+  fail "installed facet match failed"
+grep -qF "$prefix/lib/facet/libfacet_image_codecs.so" <<<"$err" ||
+  fail "installed facet did not load the module beside it in $prefix/lib/facet"
+echo "image codecs: a module, found in the build tree and beside the installed binaries"
