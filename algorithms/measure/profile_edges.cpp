@@ -46,12 +46,21 @@ std::vector<double> derivative(const GreyProfile& p, double sigma) {
     norm += w[j] * 2.0 * j * p.step;
   }
   std::vector<double> d(n, 0.0);
-  for (int i = 0; i < n; ++i) {
+  const double* v = p.values.data();
+  // The profile's ends repeat its first and last samples; only the borders need the clamp.
+  auto clamped = [&](int i) {
     double sum = 0;
-    for (int j = 1; j <= r; ++j)
-      sum += w[j] * (p.values[std::min(n - 1, i + j)] - p.values[std::max(0, i - j)]);
+    for (int j = 1; j <= r; ++j) sum += w[j] * (v[std::min(n - 1, i + j)] - v[std::max(0, i - j)]);
+    return sum / norm;
+  };
+  const int innerBegin = std::min(r, n), innerEnd = std::max(innerBegin, n - r);
+  for (int i = 0; i < innerBegin; ++i) d[i] = clamped(i);
+  for (int i = innerBegin; i < innerEnd; ++i) {
+    double sum = 0;
+    for (int j = 1; j <= r; ++j) sum += w[j] * (v[i + j] - v[i - j]);
     d[i] = sum / norm;
   }
+  for (int i = innerEnd; i < n; ++i) d[i] = clamped(i);
   return d;
 }
 
@@ -110,19 +119,17 @@ bool fitStep(const GreyProfile& p, std::vector<Step>& steps, std::size_t i,
   const int i0 = static_cast<int>(std::ceil((lo - p.start) / p.step - 1e-9));
   const int i1 = static_cast<int>(std::floor((hi - p.start) / p.step + 1e-9));
   if (i1 - i0 + 1 < 6) return false;
-  std::vector<double> s, y;
-  for (int j = i0; j <= i1; ++j) {
-    s.push_back(p.positionAt(j));
-    y.push_back(p.values[j] - neighbours(steps, near, i, p.positionAt(j)));
-  }
+  std::vector<double> y(i1 - i0 + 1);
+  for (int j = i0; j <= i1; ++j)
+    y[j - i0] = p.values[j] - neighbours(steps, near, i, p.positionAt(j));
   // Gauss-Newton on (a, b, e, w), started with the linear fit of (a, b) at the current e, w.
   double a = st.a, b = st.b, e = st.e, w = std::clamp(st.w, 0.3, 3.0);
   for (int it = 0; it < 8; ++it) {
     Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
     Eigen::Vector4d jtr = Eigen::Vector4d::Zero();
     const bool levelsOnly = it == 0;
-    for (std::size_t j = 0; j < s.size(); ++j) {
-      const double z = (s[j] - e) / w;
+    for (std::size_t j = 0; j < y.size(); ++j) {
+      const double z = (p.positionAt(i0 + static_cast<int>(j)) - e) / w;
       const auto [g, f] = normal(z);
       Eigen::Vector4d jac(1.0, f, -b * g / w, -b * g * z / w);
       if (levelsOnly) jac[2] = jac[3] = 0;
@@ -131,7 +138,11 @@ bool fitStep(const GreyProfile& p, std::vector<Step>& steps, std::size_t i,
       jtr += jac * r;
     }
     if (levelsOnly) jtj(2, 2) = jtj(3, 3) = 1.0;
-    const Eigen::Vector4d d = jtj.ldlt().solve(jtr);
+    // Cholesky is the cheap solve of the usual positive definite system; a degenerate window
+    // (flat, or too few samples on one side) falls back to the pivoting LDLT.
+    const Eigen::LLT<Eigen::Matrix4d> llt(jtj);
+    const Eigen::Vector4d d =
+        llt.info() == Eigen::Success ? Eigen::Vector4d(llt.solve(jtr)) : jtj.ldlt().solve(jtr);
     if (!d.allFinite()) return false;
     a += d[0], b += d[1];
     if (!levelsOnly) {
@@ -146,13 +157,15 @@ bool fitStep(const GreyProfile& p, std::vector<Step>& steps, std::size_t i,
 
   // Balance the area about the mid level over [e - R, e + R] (see the header).
   const double m = a + 0.5 * b;
-  std::vector<double> yAll(p.values.size());
-  for (int j = std::max(0, i0 - 1); j <= std::min<int>(p.values.size() - 1, i1 + 1); ++j)
-    yAll[j] = p.values[j] - neighbours(steps, near, i, p.positionAt(j)) - m;
+  // The window and one sample either side: [e - R, e + R] stays within [lo, hi].
+  const int j0 = std::max(0, i0 - 1), j1 = std::min<int>(p.values.size() - 1, i1 + 1);
+  std::vector<double> centred(j1 - j0 + 1);
+  for (int j = j0; j <= j1; ++j)
+    centred[j - j0] = p.values[j] - neighbours(steps, near, i, p.positionAt(j)) - m;
   for (int it = 0; it < 4; ++it) {
     const double r = std::min({prm.areaHalfWidth, e - lo, hi - e});
     if (r < 0.5) break;
-    const double area = integrate(yAll, p.start, p.step, e - r, e + r);
+    const double area = integrate(centred, p.positionAt(j0), p.step, e - r, e + r);
     const double gain = b * (2.0 * Phi(r / w) - 1.0);
     const double shift = std::clamp(area / gain, -0.5, 0.5);
     e -= shift;
