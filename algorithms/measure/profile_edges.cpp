@@ -80,22 +80,18 @@ std::vector<double> derivative(const GreyProfile& p, double sigma) {
     w[j] = j * std::exp(-0.5 * j * j / (sigmaSamples * sigmaSamples));
     norm += w[j] * 2.0 * j * p.step;
   }
+  // The profile with its end samples repeated r times either side: no tap needs a clamp.
+  std::vector<double> padded(n + 2 * r);
+  std::fill_n(padded.begin(), r, p.values.front());
+  std::copy(p.values.begin(), p.values.end(), padded.begin() + r);
+  std::fill_n(padded.begin() + r + n, r, p.values.back());
+  const double* v = padded.data() + r;
   std::vector<double> d(n, 0.0);
-  const double* v = p.values.data();
-  // The profile's ends repeat its first and last samples; only the borders need the clamp.
-  auto clamped = [&](int i) {
-    double sum = 0;
-    for (int j = 1; j <= r; ++j) sum += w[j] * (v[std::min(n - 1, i + j)] - v[std::max(0, i - j)]);
-    return sum / norm;
-  };
-  const int innerBegin = std::min(r, n), innerEnd = std::max(innerBegin, n - r);
-  for (int i = 0; i < innerBegin; ++i) d[i] = clamped(i);
-  for (int i = innerBegin; i < innerEnd; ++i) {
+  for (int i = 0; i < n; ++i) {
     double sum = 0;
     for (int j = 1; j <= r; ++j) sum += w[j] * (v[i + j] - v[i - j]);
     d[i] = sum / norm;
   }
-  for (int i = innerEnd; i < n; ++i) d[i] = clamped(i);
   return d;
 }
 
