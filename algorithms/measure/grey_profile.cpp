@@ -7,21 +7,55 @@
 namespace facet {
 namespace {
 
-// Bilinear grey at p; false when p lies outside the pixel centres' hull.
+// The image as the sampling loop reads it: raw rows, and the largest top-left corner a 2x2
+// interpolation cell can have (a point on the last column or row uses the cell before it).
 template <class T>
-bool bilinear(const cv::Mat& image, cv::Point2d p, double& grey) {
-  if (!(p.x >= 0.0 && p.y >= 0.0 && p.x <= image.cols - 1 && p.y <= image.rows - 1)) return false;
-  const int x0 = std::min(static_cast<int>(p.x), image.cols - 2 < 0 ? 0 : image.cols - 2);
-  const int y0 = std::min(static_cast<int>(p.y), image.rows - 2 < 0 ? 0 : image.rows - 2);
-  const int x1 = std::min(x0 + 1, image.cols - 1), y1 = std::min(y0 + 1, image.rows - 1);
-  const double fx = p.x - x0, fy = p.y - y0;
-  const T* r0 = image.ptr<T>(y0);
-  const T* r1 = image.ptr<T>(y1);
-  const double top = r0[x0] + fx * (r0[x1] - r0[x0]);
-  const double bottom = r1[x0] + fx * (r1[x1] - r1[x0]);
-  grey = top + fy * (bottom - top);
-  return true;
-}
+struct Raster {
+  explicit Raster(const cv::Mat& image)
+      : data(image.data),
+        stride(image.step[0]),
+        maxX(image.cols - 1),
+        maxY(image.rows - 1),
+        lastCellX(std::max(0, image.cols - 2)),
+        lastCellY(std::max(0, image.rows - 2)),
+        dx(image.cols > 1 ? 1 : 0),
+        dy(image.rows > 1 ? image.step[0] : 0) {}
+
+  // Strictly inside the last cell: bilinear() needs neither its check nor its clamps.
+  [[nodiscard]] bool interior(double x, double y) const {
+    return x >= 0.0 && y >= 0.0 && x < maxX && y < maxY;
+  }
+  [[nodiscard]] double interiorBilinear(double x, double y) const {
+    const int x0 = static_cast<int>(x), y0 = static_cast<int>(y);
+    const double fx = x - x0, fy = y - y0;
+    const T* r0 = reinterpret_cast<const T*>(data + static_cast<std::size_t>(y0) * stride) + x0;
+    const T* r1 = reinterpret_cast<const T*>(reinterpret_cast<const uchar*>(r0) + stride);
+    const double top = r0[0] + fx * (r0[1] - r0[0]);
+    const double bottom = r1[0] + fx * (r1[1] - r1[0]);
+    return top + fy * (bottom - top);
+  }
+
+  // Bilinear grey at (x, y); false when the point lies outside the pixel centres' hull.
+  bool bilinear(double x, double y, double& grey) const {
+    if (!(x >= 0.0 && y >= 0.0 && x <= maxX && y <= maxY)) return false;
+    const int x0 = std::min(static_cast<int>(x), lastCellX);
+    const int y0 = std::min(static_cast<int>(y), lastCellY);
+    const double fx = x - x0, fy = y - y0;
+    const T* r0 = reinterpret_cast<const T*>(data + static_cast<std::size_t>(y0) * stride) + x0;
+    const T* r1 = reinterpret_cast<const T*>(reinterpret_cast<const uchar*>(r0) + dy);
+    const double top = r0[0] + fx * (r0[dx] - r0[0]);
+    const double bottom = r1[0] + fx * (r1[dx] - r1[0]);
+    grey = top + fy * (bottom - top);
+    return true;
+  }
+
+  const uchar* data;
+  std::size_t stride;
+  double maxX, maxY;
+  int lastCellX, lastCellY;
+  int dx;          // 0 for a one-column image: the cell's right neighbour is itself
+  std::size_t dy;  // bytes to the cell's lower row; 0 for a one-row image
+};
 
 template <class T>
 GreyProfile sample(const cv::Mat& image, const MeasuringPath& path, const GreyProfileParams& prm,
@@ -31,6 +65,11 @@ GreyProfile sample(const cv::Mat& image, const MeasuringPath& path, const GreyPr
   const int n = static_cast<int>(std::floor(path.length() / prm.step + 1e-9)) + 1;
   const int lines = std::max(1, static_cast<int>(std::ceil(path.width() / prm.crossStep - 1e-9)));
   const double start = -(n - 1) * prm.step / 2.0;
+  // The cross offsets of the averaged lines, the same at every position.
+  std::vector<double> offsets(lines);
+  for (int k = 0; k < lines; ++k)
+    offsets[k] = -path.width() / 2.0 + (k + 0.5) * path.width() / lines;
+  const Raster<T> raster(image);
   std::vector<double> values(n, 0.0);
   std::vector<char> inside(n, 0);
   bool anyMissing = false;
@@ -39,10 +78,18 @@ GreyProfile sample(const cv::Mat& image, const MeasuringPath& path, const GreyPr
     const cv::Point2d origin = path.at(s, 0.0), across = path.acrossAt(s);
     double sum = 0;
     int count = 0;
-    for (int k = 0; k < lines; ++k) {
-      const double t = -path.width() / 2.0 + (k + 0.5) * path.width() / lines;
-      double g = 0;
-      if (bilinear<T>(image, origin + t * across, g)) sum += g, ++count;
+    // The cross line is a segment: with both ends inside, every sample on it is.
+    const double tFirst = offsets.front(), tLast = offsets.back();
+    if (raster.interior(origin.x + tFirst * across.x, origin.y + tFirst * across.y) &&
+        raster.interior(origin.x + tLast * across.x, origin.y + tLast * across.y)) {
+      for (const double t : offsets)
+        sum += raster.interiorBilinear(origin.x + t * across.x, origin.y + t * across.y);
+      count = lines;
+    } else {
+      for (const double t : offsets) {
+        double g = 0;
+        if (raster.bilinear(origin.x + t * across.x, origin.y + t * across.y, g)) sum += g, ++count;
+      }
     }
     anyMissing = anyMissing || count < lines;
     if (2 * count >= lines && count > 0) values[i] = sum * scale / count, inside[i] = 1;
@@ -60,7 +107,10 @@ GreyProfile sample(const cv::Mat& image, const MeasuringPath& path, const GreyPr
     i = j;
   }
   if (bestLength < 2) return profile;
-  profile.values.assign(values.begin() + bestBegin, values.begin() + bestBegin + bestLength);
+  if (bestLength == n)
+    profile.values = std::move(values);
+  else
+    profile.values.assign(values.begin() + bestBegin, values.begin() + bestBegin + bestLength);
   profile.start = start + bestBegin * prm.step;
   profile.partial = anyMissing || bestLength < n;
   return profile;

@@ -22,8 +22,7 @@ MeasuringPath::MeasuringPath(const MeasuringArc& arc)
       radius_(arc.radius),
       sign_(arc.extent < 0 ? -1.0 : 1.0) {}
 
-cv::Point2d MeasuringPath::at(double s, double t) const {
-  if (!arc_) return {centre_.x + s * cos_ + t * sin_, centre_.y - s * sin_ + t * cos_};
+cv::Point2d MeasuringPath::arcAt(double s, double t) const {
   const double phi = angle_ + sign_ * s / radius_;
   const double r = radius_ + t;
   return {centre_.x + r * std::cos(phi), centre_.y - r * std::sin(phi)};
@@ -35,8 +34,7 @@ cv::Point2d MeasuringPath::axisAt(double s) const {
   return {-sign_ * std::sin(phi), -sign_ * std::cos(phi)};
 }
 
-cv::Point2d MeasuringPath::acrossAt(double s) const {
-  if (!arc_) return {sin_, cos_};
+cv::Point2d MeasuringPath::arcAcrossAt(double s) const {
   const double phi = angle_ + sign_ * s / radius_;
   return {std::cos(phi), -std::sin(phi)};
 }

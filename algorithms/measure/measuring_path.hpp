@@ -39,16 +39,26 @@ class MeasuringPath {
 
   [[nodiscard]] double length() const { return length_; }
   [[nodiscard]] double width() const { return width_; }
-  // The image point at axis position s and cross offset t.
-  [[nodiscard]] cv::Point2d at(double s, double t) const;
+  // The image point at axis position s and cross offset t. (A rectangle's is inline: profile
+  // sampling asks for it at every position.)
+  [[nodiscard]] cv::Point2d at(double s, double t) const {
+    if (!arc_) return {centre_.x + s * cos_ + t * sin_, centre_.y - s * sin_ + t * cos_};
+    return arcAt(s, t);
+  }
   // The unit measuring direction at s (the tangent for an arc).
   [[nodiscard]] cv::Point2d axisAt(double s) const;
   // The unit direction of growing t at s: at(s, t) = at(s, 0) + t * acrossAt(s).
-  [[nodiscard]] cv::Point2d acrossAt(double s) const;
+  [[nodiscard]] cv::Point2d acrossAt(double s) const {
+    if (!arc_) return {sin_, cos_};
+    return arcAcrossAt(s);
+  }
   // Axis-aligned bounds of the path's area in image pixels (not clipped).
   [[nodiscard]] cv::Rect2d bounds() const;
 
  private:
+  [[nodiscard]] cv::Point2d arcAt(double s, double t) const;
+  [[nodiscard]] cv::Point2d arcAcrossAt(double s) const;
+
   bool arc_ = false;
   cv::Point2d centre_;
   double length_ = 0, width_ = 0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include <Eigen/Dense>
 
@@ -14,8 +15,8 @@ namespace {
 struct Normal {
   double density, cdf;
 };
-Normal normal(double z) {
-  const double e = std::exp(-0.5 * z * z);
+// From z and exp(-z^2 / 2).
+Normal normal(double z, double e) {
   const double x = std::abs(z) * M_SQRT1_2;
   const double t = 1.0 / (1.0 + 0.3275911 * x);
   const double poly =
@@ -24,6 +25,40 @@ Normal normal(double z) {
   const double half = 0.5 * poly * e;  // 0.5 * erfc(x)
   return {0.3989422804014327 * e, z >= 0 ? 1.0 - half : half};
 }
+Normal normal(double z) {
+  return normal(z, std::exp(-0.5 * z * z));
+}
+
+// exp(-z^2 / 2) at evenly spaced z = z0 + j dz, as the step fit needs it at every sample of its
+// window: each value is the last times exp(-z dz - dz^2 / 2), a ratio that shrinks by exp(-dz^2)
+// per sample, so a window costs three exponentials instead of one per sample. The products'
+// rounding (about 1e-14 relative over a window) is far below the erf's 1.5e-7. Where a value or
+// a ratio could leave the range of normal doubles (|z| > 20 or dz > 2) every value is direct.
+class GaussianSweep {
+ public:
+  GaussianSweep(double z0, double dz, int count) : z0_(z0), dz_(dz) {
+    const double zEnd = z0 + (count - 1) * dz;
+    direct_ = std::max(std::abs(z0), std::abs(zEnd)) > 20.0 || std::abs(dz) > 2.0;
+    if (direct_) return;
+    value_ = std::exp(-0.5 * z0 * z0);
+    ratio_ = std::exp(-z0 * dz - 0.5 * dz * dz);
+    shrink_ = std::exp(-dz * dz);
+  }
+  // z and exp(-z^2 / 2) at the next sample, the first at z0.
+  std::pair<double, double> next() {
+    const double z = z0_ + j_++ * dz_;
+    if (direct_) return {z, std::exp(-0.5 * z * z)};
+    const double value = value_;
+    value_ *= ratio_, ratio_ *= shrink_;
+    return {z, value};
+  }
+
+ private:
+  double z0_, dz_;
+  int j_ = 0;
+  bool direct_ = true;
+  double value_ = 0, ratio_ = 0, shrink_ = 0;
+};
 double Phi(double z) {
   return normal(z).cdf;
 }
@@ -45,11 +80,16 @@ std::vector<double> derivative(const GreyProfile& p, double sigma) {
     w[j] = j * std::exp(-0.5 * j * j / (sigmaSamples * sigmaSamples));
     norm += w[j] * 2.0 * j * p.step;
   }
+  // The profile with its end samples repeated r times either side: no tap needs a clamp.
+  std::vector<double> padded(n + 2 * r);
+  std::fill_n(padded.begin(), r, p.values.front());
+  std::copy(p.values.begin(), p.values.end(), padded.begin() + r);
+  std::fill_n(padded.begin() + r + n, r, p.values.back());
+  const double* v = padded.data() + r;
   std::vector<double> d(n, 0.0);
   for (int i = 0; i < n; ++i) {
     double sum = 0;
-    for (int j = 1; j <= r; ++j)
-      sum += w[j] * (p.values[std::min(n - 1, i + j)] - p.values[std::max(0, i - j)]);
+    for (int j = 1; j <= r; ++j) sum += w[j] * (v[i + j] - v[i - j]);
     d[i] = sum / norm;
   }
   return d;
@@ -110,20 +150,19 @@ bool fitStep(const GreyProfile& p, std::vector<Step>& steps, std::size_t i,
   const int i0 = static_cast<int>(std::ceil((lo - p.start) / p.step - 1e-9));
   const int i1 = static_cast<int>(std::floor((hi - p.start) / p.step + 1e-9));
   if (i1 - i0 + 1 < 6) return false;
-  std::vector<double> s, y;
-  for (int j = i0; j <= i1; ++j) {
-    s.push_back(p.positionAt(j));
-    y.push_back(p.values[j] - neighbours(steps, near, i, p.positionAt(j)));
-  }
+  std::vector<double> y(i1 - i0 + 1);
+  for (int j = i0; j <= i1; ++j)
+    y[j - i0] = p.values[j] - neighbours(steps, near, i, p.positionAt(j));
   // Gauss-Newton on (a, b, e, w), started with the linear fit of (a, b) at the current e, w.
   double a = st.a, b = st.b, e = st.e, w = std::clamp(st.w, 0.3, 3.0);
   for (int it = 0; it < 8; ++it) {
     Eigen::Matrix4d jtj = Eigen::Matrix4d::Zero();
     Eigen::Vector4d jtr = Eigen::Vector4d::Zero();
     const bool levelsOnly = it == 0;
-    for (std::size_t j = 0; j < s.size(); ++j) {
-      const double z = (s[j] - e) / w;
-      const auto [g, f] = normal(z);
+    GaussianSweep gauss((p.positionAt(i0) - e) / w, p.step / w, static_cast<int>(y.size()));
+    for (std::size_t j = 0; j < y.size(); ++j) {
+      const auto [z, density] = gauss.next();
+      const auto [g, f] = normal(z, density);
       Eigen::Vector4d jac(1.0, f, -b * g / w, -b * g * z / w);
       if (levelsOnly) jac[2] = jac[3] = 0;
       const double r = y[j] - (a + b * f);
@@ -131,7 +170,11 @@ bool fitStep(const GreyProfile& p, std::vector<Step>& steps, std::size_t i,
       jtr += jac * r;
     }
     if (levelsOnly) jtj(2, 2) = jtj(3, 3) = 1.0;
-    const Eigen::Vector4d d = jtj.ldlt().solve(jtr);
+    // Cholesky is the cheap solve of the usual positive definite system; a degenerate window
+    // (flat, or too few samples on one side) falls back to the pivoting LDLT.
+    const Eigen::LLT<Eigen::Matrix4d> llt(jtj);
+    const Eigen::Vector4d d =
+        llt.info() == Eigen::Success ? Eigen::Vector4d(llt.solve(jtr)) : jtj.ldlt().solve(jtr);
     if (!d.allFinite()) return false;
     a += d[0], b += d[1];
     if (!levelsOnly) {
@@ -146,13 +189,15 @@ bool fitStep(const GreyProfile& p, std::vector<Step>& steps, std::size_t i,
 
   // Balance the area about the mid level over [e - R, e + R] (see the header).
   const double m = a + 0.5 * b;
-  std::vector<double> yAll(p.values.size());
-  for (int j = std::max(0, i0 - 1); j <= std::min<int>(p.values.size() - 1, i1 + 1); ++j)
-    yAll[j] = p.values[j] - neighbours(steps, near, i, p.positionAt(j)) - m;
+  // The window and one sample either side: [e - R, e + R] stays within [lo, hi].
+  const int j0 = std::max(0, i0 - 1), j1 = std::min<int>(p.values.size() - 1, i1 + 1);
+  std::vector<double> centred(j1 - j0 + 1);
+  for (int j = j0; j <= j1; ++j)
+    centred[j - j0] = p.values[j] - neighbours(steps, near, i, p.positionAt(j)) - m;
   for (int it = 0; it < 4; ++it) {
     const double r = std::min({prm.areaHalfWidth, e - lo, hi - e});
     if (r < 0.5) break;
-    const double area = integrate(yAll, p.start, p.step, e - r, e + r);
+    const double area = integrate(centred, p.positionAt(j0), p.step, e - r, e + r);
     const double gain = b * (2.0 * Phi(r / w) - 1.0);
     const double shift = std::clamp(area / gain, -0.5, 0.5);
     e -= shift;
