@@ -286,6 +286,44 @@ TEST(MqttPublisher, FullQuotaDropsTheOldestAndTheRestFollowInOrder) {
   for (std::size_t i = 0; i < ids.size(); ++i) EXPECT_EQ(ids[i], full.outbox.dropped + 1 + i);
 }
 
+// The station's settings for the broker's TLS listener, checking its certificate with `caFile`.
+config::MqttSettings tlsSettingsFor(const MosquittoBroker& broker, const std::string& folder,
+                                    const std::string& caFile) {
+  auto settings = settingsFor(broker, folder);
+  settings.port = broker.tlsPort();
+  settings.caFile = caFile;
+  return settings;
+}
+
+// A station the broker's TLS listener does not let in: the part stays in its outbox, the error
+// names TLS. Returns the error.
+std::string refusedOverTls(config::MqttSettings settings, const std::string& folder) {
+  settings.clientId = "facet-test-refused";
+  settings.outbox.folder = folder + "/outbox-refused";
+  MqttPublisher refused(settings, "cam2");
+  refused.start();
+  refused.submit(samplePart(1));
+  EXPECT_TRUE(
+      waitUntil([&] { return refused.status().lastError.find("tls") != std::string::npos; }, 10s))
+      << refused.status().lastError;
+  const auto s = refused.status();
+  EXPECT_TRUE(s.degraded());
+  EXPECT_EQ(s.outbox.pending, 1u);
+  EXPECT_EQ(s.delivered, 0u);
+  return s.lastError;
+}
+
+// A station that gets in: part `id` reaches the test's subscriber.
+void deliveredOverTls(const config::MqttSettings& settings, MqttSubscriber& results,
+                      std::uint64_t id) {
+  MqttPublisher publisher(settings, "cam1");
+  publisher.start();
+  publisher.submit(samplePart(id));
+  ASSERT_TRUE(results.waitFor([](const auto& m) { return partIds(m).size() == 1; }, 10s))
+      << publisher.status().lastError;
+  EXPECT_EQ(partIds(results.messages()).front(), id);
+}
+
 // TLS: the broker has a TLS listener beside its plain one; the test's subscriber reads on the
 // plain one what the station sent over TLS.
 TEST(MqttPublisherTls, TheStationsCaAndTheBrokersNameCheckedDeliversOverTls) {
@@ -296,9 +334,7 @@ TEST(MqttPublisherTls, TheStationsCaAndTheBrokersNameCheckedDeliversOverTls) {
   broker.start();
   MqttSubscriber results("test-results", broker.port(), "facet/cam1/result");
   ASSERT_TRUE(results.waitSubscribed(5s));
-  auto settings = settingsFor(broker, dir.path());
-  settings.port = broker.tlsPort();
-  settings.caFile = certificates.caFile;
+  auto settings = tlsSettingsFor(broker, dir.path(), certificates.caFile);
   settings.tlsInsecure = false;  // the broker's certificate names 127.0.0.1: checked
   MqttPublisher publisher(settings, "cam1");
   publisher.start();
@@ -315,21 +351,10 @@ TEST(MqttPublisherTls, ABrokerCertificateNotFromTheConfiguredCaIsAClearErrorAndK
   MosquittoBroker broker(dir.path());
   broker.addTlsListener(certificates.brokerCertFile, certificates.brokerKeyFile);
   broker.start();
-  auto settings = settingsFor(broker, dir.path());
-  settings.port = broker.tlsPort();
-  settings.caFile = certificates.foreignCaFile;
-  MqttPublisher publisher(settings, "cam1");
-  publisher.start();
-  publisher.submit(samplePart(1));
-  ASSERT_TRUE(
-      waitUntil([&] { return publisher.status().lastError.find("tls") != std::string::npos; }, 10s))
-      << publisher.status().lastError;
-  const auto s = publisher.status();
-  EXPECT_TRUE(s.degraded());
-  EXPECT_NE(s.lastError.find("certificate verify failed"), std::string::npos) << s.lastError;
-  EXPECT_NE(s.lastError.find("mqtt.tls.ca_file"), std::string::npos) << s.lastError;
-  EXPECT_EQ(s.outbox.pending, 1u);
-  EXPECT_EQ(s.delivered, 0u);
+  const auto error =
+      refusedOverTls(tlsSettingsFor(broker, dir.path(), certificates.foreignCaFile), dir.path());
+  EXPECT_NE(error.find("certificate verify failed"), std::string::npos) << error;
+  EXPECT_NE(error.find("mqtt.tls.ca_file"), std::string::npos) << error;
 }
 
 TEST(MqttPublisherTls, ABrokerCertificateForAnotherHostIsRefusedUnlessTlsInsecure) {
@@ -340,29 +365,11 @@ TEST(MqttPublisherTls, ABrokerCertificateForAnotherHostIsRefusedUnlessTlsInsecur
   broker.start();
   MqttSubscriber results("test-results", broker.port(), "facet/+/result");
   ASSERT_TRUE(results.waitSubscribed(5s));
-  auto settings = settingsFor(broker, dir.path());
-  settings.port = broker.tlsPort();
-  settings.caFile = certificates.caFile;
-
-  auto checked = settings;
-  checked.clientId = "facet-test-checked";
-  checked.outbox.folder = dir.path() + "/outbox-checked";
-  MqttPublisher refused(checked, "cam2");
-  refused.start();
-  refused.submit(samplePart(1));
-  ASSERT_TRUE(
-      waitUntil([&] { return refused.status().lastError.find("tls") != std::string::npos; }, 10s))
-      << refused.status().lastError;
-  EXPECT_EQ(refused.status().outbox.pending, 1u);
-
+  auto settings = tlsSettingsFor(broker, dir.path(), certificates.caFile);
+  const auto error = refusedOverTls(settings, dir.path());
+  EXPECT_NE(error.find("certificate verify failed"), std::string::npos) << error;
   settings.tlsInsecure = true;  // mqtt.tls.insecure: the CA is checked, the name is not
-  MqttPublisher publisher(settings, "cam1");
-  publisher.start();
-  publisher.submit(samplePart(9));
-  ASSERT_TRUE(results.waitFor([](const auto& m) { return partIds(m).size() == 1; }, 10s))
-      << publisher.status().lastError;
-  EXPECT_EQ(partIds(results.messages()).front(), 9u);
-  EXPECT_EQ(refused.status().delivered, 0u);
+  deliveredOverTls(settings, results, 9);
 }
 
 TEST(MqttPublisherTls, ABrokerThatRequiresAClientCertificateGetsTheStationsOne) {
@@ -374,34 +381,14 @@ TEST(MqttPublisherTls, ABrokerThatRequiresAClientCertificateGetsTheStationsOne) 
   broker.start();
   MqttSubscriber results("test-results", broker.port(), "facet/+/result");
   ASSERT_TRUE(results.waitSubscribed(5s));
-  auto settings = settingsFor(broker, dir.path());
-  settings.port = broker.tlsPort();
-  settings.caFile = certificates.caFile;
-
-  // Without one: refused during the handshake, named, kept.
-  auto bare = settings;
-  bare.clientId = "facet-test-no-certificate";
-  bare.outbox.folder = dir.path() + "/outbox-bare";
-  MqttPublisher refused(bare, "cam2");
-  refused.start();
-  refused.submit(samplePart(1));
-  ASSERT_TRUE(
-      waitUntil([&] { return refused.status().lastError.find("tls") != std::string::npos; }, 10s))
-      << refused.status().lastError;
-  EXPECT_NE(refused.status().lastError.find("certificate required"), std::string::npos)
-      << refused.status().lastError;
-  EXPECT_EQ(refused.status().outbox.pending, 1u);
-
+  auto settings = tlsSettingsFor(broker, dir.path(), certificates.caFile);
+  // Without one: refused after the handshake, named, kept.
+  const auto error = refusedOverTls(settings, dir.path());
+  EXPECT_NE(error.find("certificate required"), std::string::npos) << error;
   // With the station's certificate and key: delivered.
   settings.certFile = certificates.clientCertFile;
   settings.keyFile = certificates.clientKeyFile;
-  MqttPublisher publisher(settings, "cam1");
-  publisher.start();
-  publisher.submit(samplePart(5));
-  ASSERT_TRUE(results.waitFor([](const auto& m) { return partIds(m).size() == 1; }, 10s))
-      << publisher.status().lastError;
-  EXPECT_EQ(partIds(results.messages()).front(), 5u);
-  EXPECT_EQ(refused.status().delivered, 0u);
+  deliveredOverTls(settings, results, 5);
 }
 
 }  // namespace
