@@ -23,7 +23,8 @@ const std::string kReplay =
 // runs of the same inspection (wall-clock time, durations) and the station.
 std::map<std::uint64_t, nlohmann::json> comparable(const std::string& exportJson) {
   std::map<std::uint64_t, nlohmann::json> parts;
-  for (auto part : nlohmann::json::parse(exportJson).at("parts")) {
+  const auto exported = nlohmann::json::parse(exportJson);  // outlives the loop over its parts
+  for (auto part : exported.at("parts")) {
     for (const char* key : {"time", "inspection_ms", "timings_ms", "station"}) part.erase(key);
     const auto id = part.at("part_id").get<std::uint64_t>();
     parts[id] = part;
