@@ -38,12 +38,13 @@ void runShardedReplay(const ShardedReplayOptions& opt, const config::StepKindReg
   // was partly written there before).
   std::unique_ptr<service::ResultsStore> store;
   std::unique_ptr<service::PostgresBatchWriter> central;
-  std::string station, destination = opt.resultsFile;
+  std::string destination = opt.resultsFile;
   try {
     if (!opt.postgres.empty()) {
-      station = opt.asStation.empty() ? "replay-" + recipe->recipe().name + "-" +
-                                            recipe->recipe().contentHash.substr(0, 8)
-                                      : opt.asStation;
+      const std::string station =
+          opt.asStation.empty()
+              ? "replay-" + recipe->recipe().name + "-" + recipe->recipe().contentHash.substr(0, 8)
+              : opt.asStation;
       central = std::make_unique<service::PostgresBatchWriter>(opt.postgres, station);
       destination = "postgres " + central->peer() + " station " + station;
     } else {

@@ -102,6 +102,21 @@ std::vector<std::string> splitList(const std::string& text, char sep) {
   return out;
 }
 
+std::string timingsText(const std::vector<StepTiming>& timings) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& t : timings) out.push_back({{"step", t.step}, {"ms", t.ms}});
+  return out.dump();
+}
+
+std::vector<StepTiming> timingsFromText(const std::string& text) {
+  std::vector<StepTiming> out;
+  const auto parsed = nlohmann::json::parse(text, nullptr, false);
+  if (!parsed.is_array()) return out;
+  for (const auto& t : parsed)
+    if (t.is_object()) out.push_back({t.value("step", ""), t.value("ms", 0.0)});
+  return out;
+}
+
 std::string joinedChecks(const std::vector<std::string>& items, char sep) {
   std::string out;
   for (const auto& s : items) {

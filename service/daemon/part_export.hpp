@@ -22,6 +22,11 @@ std::string toCsv(const std::vector<PartResult>& parts, std::span<const std::str
 std::string joinedChecks(const std::vector<std::string>& checks, char sep);
 // The items of a list joinedChecks wrote (empty items dropped).
 std::vector<std::string> splitList(const std::string& text, char sep);
+// A part's step timings as the stores keep them in one text field: [{"step", "ms"}, ...].
+std::string timingsText(const std::vector<StepTiming>& timings);
+// The timings timingsText wrote; entries that are not objects are skipped, unreadable text gives
+// none (a row from an older or damaged store still reads).
+std::vector<StepTiming> timingsFromText(const std::string& text);
 // ISO 8601 in UTC with milliseconds, e.g. 2026-11-25T20:15:03.123Z.
 std::string isoTime(std::chrono::system_clock::time_point t);
 

@@ -155,8 +155,6 @@ void ResultsStore::store(const PartResult& part) {
                          ") VALUES (?1, ?2, ?3, ?4, ?5, ?6, ?7, ?8, ?9, ?10, ?11, ?12, ?13, ?14, "
                          "?15, ?16, ?17)",
                      file_);
-    nlohmann::json timings = nlohmann::json::array();
-    for (const auto& t : part.timings) timings.push_back({{"step", t.step}, {"ms", t.ms}});
     insert.bind(1, static_cast<std::int64_t>(part.partId));
     insert.bind(2, toMicros(part.time));
     insert.bind(3, isoTime(part.time));
@@ -171,7 +169,7 @@ void ResultsStore::store(const PartResult& part) {
     insert.bind(12, joinedChecks(part.failedChecks, ','));
     insert.bind(13, part.error);
     insert.bind(14, part.inspectionMs);
-    insert.bind(15, timings.dump());
+    insert.bind(15, timingsText(part.timings));
     insert.bind(16, part.recordedDefect);
     insert.bind(17, joinedChecks(part.notes, '\n'));
     insert.step();
@@ -277,8 +275,7 @@ std::vector<PartResult> ResultsStore::select(const std::string& where, const std
     p.failedChecks = splitList(q.text(10), ',');
     p.error = q.text(11);
     p.inspectionMs = sqlite3_column_double(q.get(), 12);
-    for (const auto& t : nlohmann::json::parse(q.text(13), nullptr, false))
-      if (t.is_object()) p.timings.push_back({t.value("step", ""), t.value("ms", 0.0)});
+    p.timings = timingsFromText(q.text(13));
     p.recordedDefect = q.text(14);
     p.notes = splitList(q.text(15), '\n');
     index[static_cast<std::int64_t>(p.partId)] = parts.size();

@@ -32,10 +32,7 @@ std::filesystem::path temporaryOutbox() {
 PostgresBatchWriter::PostgresBatchWriter(std::string connection, std::string station) {
   const std::string peer = postgresPeer(connection);
   {
-    std::unique_ptr<PGconn, decltype(&PQfinish)> conn(PQconnectdb(connection.c_str()), &PQfinish);
-    if (PQstatus(conn.get()) != CONNECTION_OK)
-      throw std::runtime_error("postgres " + peer +
-                               ": cannot connect: " + postgresError(conn.get()));
+    const PgConnection conn = connectOrThrow(connection);
     if (!createPostgresSchema(conn.get()))
       throw std::runtime_error("postgres " + peer +
                                ": cannot create the tables: " + postgresError(conn.get()));

@@ -39,7 +39,6 @@ class PostgresBatchWriter {
   void write(const PartResult& part);
   // Waits until every part is written (or throws as write() does), then disconnects.
   void finish();
-  [[nodiscard]] std::uint64_t written() const { return sink_->status().delivered; }
   [[nodiscard]] std::string peer() const { return sink_->status().peer; }
 
  private:

@@ -1,5 +1,7 @@
 #include "service/sinks/postgres_connection.hpp"
 
+#include <stdexcept>
+
 namespace facet::service {
 
 PgResult executeWithText(PGconn* conn, const char* sql,
@@ -35,6 +37,14 @@ std::string postgresError(const PGconn* conn) {
   std::string s = PQerrorMessage(conn);
   while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
   return s;
+}
+
+PgConnection connectOrThrow(const std::string& connection) {
+  PgConnection conn(PQconnectdb(connection.c_str()));
+  if (PQstatus(conn.get()) != CONNECTION_OK)
+    throw std::runtime_error("postgres " + postgresPeer(connection) +
+                             ": cannot connect: " + postgresError(conn.get()));
+  return conn;
 }
 
 }  // namespace facet::service

@@ -17,6 +17,15 @@ struct PgResultDeleter {
 };
 using PgResult = std::unique_ptr<PGresult, PgResultDeleter>;
 
+struct PgConnDeleter {
+  void operator()(PGconn* c) const { PQfinish(c); }
+};
+using PgConnection = std::unique_ptr<PGconn, PgConnDeleter>;
+
+// Connects with a libpq connection string; throws std::runtime_error naming the server (never
+// the password) and libpq's reason when the server cannot be reached or refuses.
+PgConnection connectOrThrow(const std::string& connection);
+
 // PQexecParams with every parameter as text; nullopt is SQL NULL.
 PgResult executeWithText(PGconn* conn, const char* sql,
                          const std::vector<std::optional<std::string>>& params);

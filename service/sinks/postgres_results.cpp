@@ -5,8 +5,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <nlohmann/json.hpp>
-
 #include "service/daemon/part_export.hpp"
 #include "service/sinks/postgres_connection.hpp"
 
@@ -26,9 +24,7 @@ std::vector<StationPart> readPostgresResults(const std::string& connection,
                                              std::chrono::system_clock::time_point since,
                                              std::size_t limit) {
   const std::string peer = postgresPeer(connection);
-  std::unique_ptr<PGconn, decltype(&PQfinish)> conn(PQconnectdb(connection.c_str()), &PQfinish);
-  if (PQstatus(conn.get()) != CONNECTION_OK)
-    throw std::runtime_error("postgres " + peer + ": cannot connect: " + postgresError(conn.get()));
+  const PgConnection conn = connectOrThrow(connection);
   auto fail = [&](const std::string& what) {
     return std::runtime_error("postgres " + peer + ": " + what + ": " + postgresError(conn.get()));
   };
@@ -69,8 +65,7 @@ std::vector<StationPart> readPostgresResults(const std::string& connection,
     p.failedChecks = splitList(text(11), ',');
     p.error = text(12);
     p.inspectionMs = std::stod(text(13));
-    for (const auto& t : nlohmann::json::parse(text(14), nullptr, false))
-      if (t.is_object()) p.timings.push_back({t.value("step", ""), t.value("ms", 0.0)});
+    p.timings = timingsFromText(text(14));
     p.recordedDefect = text(15);
     p.notes = splitList(text(16), '\n');
     index[{s.station, text(1), text(2)}] = out.size();

@@ -195,10 +195,6 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
       done.push_back(record.seq);
       continue;
     }
-    nlohmann::json timings = nlohmann::json::array();
-    for (const auto& t : p.timings) timings.push_back({{"step", t.step}, {"ms", t.ms}});
-    std::string failed;
-    for (const auto& c : p.failedChecks) failed += (failed.empty() ? "" : ",") + c;
     const std::string partId = std::to_string(p.partId);
     const std::string timeUs = std::to_string(
         std::chrono::duration_cast<std::chrono::microseconds>(p.time.time_since_epoch()).count());
@@ -206,8 +202,9 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
         conn_, kInsertPart,
         {station, partId, timeUs, std::to_string(p.recipeId), p.recipeName, p.recipeVersion,
          std::to_string(p.frameId), p.source, p.serial, p.expectedVerdict,
-         std::string(verdictName(p.verdict)), failed, p.error, fmt::format("{}", p.inspectionMs),
-         timings.dump(), p.recordedDefect, joinedChecks(p.notes, '\n')});
+         std::string(verdictName(p.verdict)), joinedChecks(p.failedChecks, ','), p.error,
+         fmt::format("{}", p.inspectionMs), timingsText(p.timings), p.recordedDefect,
+         joinedChecks(p.notes, '\n')});
     if (!succeeded(part)) {
       spdlog::error("postgres: part {}: {}", p.partId, postgresError(conn_));
       rollback();
