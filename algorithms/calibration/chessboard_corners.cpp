@@ -208,10 +208,12 @@ Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int col
       params.low = probe.lowThreshold;
       params.high = probe.highThreshold;
       params.blurOnPixelGrid = probe.blurOnPixelGrid;  // one optics per image: its width is fitted
-      params.mask = cv::Mat::zeros(image.size(), CV_8U);
+      // The mask covers only the ROI (drawn in its coordinates).
+      params.mask = cv::Mat::zeros(params.roi.size(), CV_8U);
+      const cv::Point2d local = p - cv::Point2d(params.roi.tl());
       for (const cv::Point2d& d : {dx, dy})
-        cv::line(params.mask, p - (outer + 2) * d, p + (outer + 2) * d, cv::Scalar(255), 9);
-      cv::circle(params.mask, p, std::max(0, static_cast<int>(inner) - 2), cv::Scalar(0), -1);
+        cv::line(params.mask, local - (outer + 2) * d, local + (outer + 2) * d, cv::Scalar(255), 9);
+      cv::circle(params.mask, local, std::max(0, static_cast<int>(inner) - 2), cv::Scalar(0), -1);
       const EdgeContours edges = detectSubpixelEdges(image, params);
       EdgeCurve lx{p, dx, {-dx.y, dx.x}}, ly{p, dy, {-dy.y, dy.x}};
       std::vector<cv::Point2d> onX, onY;

@@ -53,9 +53,13 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
     throw std::invalid_argument(
         "detectSubpixelEdges: expected an 8-bit or 16-bit single-channel image, got " +
         cv::typeToString(image.type()));
-  if (!params.mask.empty() && (params.mask.size() != image.size() || params.mask.type() != CV_8UC1))
+  const bool maskOfRoi = !params.mask.empty() && !params.roi.empty() &&
+                         params.mask.size() == params.roi.size() &&
+                         params.mask.size() != image.size();
+  if (!params.mask.empty() &&
+      ((!maskOfRoi && params.mask.size() != image.size()) || params.mask.type() != CV_8UC1))
     throw std::invalid_argument(
-        "detectSubpixelEdges: the mask must be CV_8UC1 of the image's size");
+        "detectSubpixelEdges: the mask must be CV_8UC1 of the image's or the ROI's size");
 
   const cv::Rect full(0, 0, image.cols, image.rows);
   const cv::Rect roi = params.roi.empty() ? full : (params.roi & full);
@@ -67,7 +71,15 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   const cv::Rect usable = cv::Rect(2, 2, image.cols - 4, image.rows - 4) & roi;
   if (usable.empty()) return result;
   const cv::Rect candidates = usable - area.tl();
-  const cv::Mat mask = params.mask.empty() ? cv::Mat() : params.mask(area);
+  cv::Mat mask;
+  if (maskOfRoi) {
+    // Pixels of the ring around the ROI are never edge pixels: zero there.
+    mask = cv::Mat::zeros(area.size(), CV_8U);
+    const cv::Rect covered = params.roi & area;
+    params.mask(covered - params.roi.tl()).copyTo(mask(covered - area.tl()));
+  } else if (!params.mask.empty()) {
+    mask = params.mask(area);
+  }
 
   cv::Mat edges;
   if (params.low && params.high) {

@@ -30,7 +30,9 @@ struct EdgeParams {
   std::optional<double> high;
   // Region of interest in image pixels; empty = the whole image.
   cv::Rect roi;
-  // Optional 8-bit mask of the same size as the image: only non-zero pixels may be edge pixels.
+  // Optional 8-bit mask: only non-zero pixels may be edge pixels. Either of the image's size, or
+  // of `roi`'s size and covering `roi` (cheap when many small regions of a large image are
+  // searched).
   cv::Mat mask;
   // Link points into contours (EdgeContours::contours); off saves time when only points are needed.
   bool linkContours = false;

@@ -165,8 +165,26 @@ TEST(SubpixelEdges, RoiAndMaskRestrictThePoints) {
     EXPECT_NEAR(cv::norm(p.position - cv::Point2d(115.6, 58.9)), 25.0, 0.3);
   }
 
+  // A mask of the ROI's size covers the ROI: the same points as the image-sized mask, also
+  // where the ROI reaches past the image's border.
+  for (const cv::Rect box : {cv::Rect(70, 20, 80, 80), cv::Rect(100, -10, 80, 90)}) {
+    EdgeParams imageMask, roiMask;
+    imageMask.roi = roiMask.roi = box;
+    imageMask.mask = masked.mask;
+    roiMask.mask = cv::Mat::zeros(box.size(), CV_8U);
+    cv::circle(roiMask.mask, cv::Point(115, 59) - box.tl(), 35, 255, cv::FILLED);
+    const EdgeContours a = detectSubpixelEdges(image, imageMask);
+    const EdgeContours b = detectSubpixelEdges(image, roiMask);
+    EXPECT_GT(a.points.size(), 50u);
+    ASSERT_EQ(a.points.size(), b.points.size());
+    for (std::size_t i = 0; i < a.points.size(); ++i)
+      EXPECT_EQ(a.points[i].position, b.points[i].position);
+  }
+
   EdgeParams badMask;
   badMask.mask = cv::Mat::zeros(10, 10, CV_8U);
+  EXPECT_THROW(detectSubpixelEdges(image, badMask), std::invalid_argument);
+  badMask.roi = {0, 0, 20, 20};  // neither the image's nor the ROI's size
   EXPECT_THROW(detectSubpixelEdges(image, badMask), std::invalid_argument);
 }
 
