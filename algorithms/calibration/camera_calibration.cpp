@@ -47,8 +47,11 @@ constexpr DistortionModel kDistortionModels[] = {
     {"k1,k2,p1,p2,k3", 0, 5},
 };
 
+// Solves with every distortion model and keeps the one the criterion prefers; with `only`, with
+// that model alone (the re-centring rounds of circle marks, which move points by hundredths of a
+// pixel and would not change the choice).
 Solution solve(const BoardSpec& board, cv::Size size,
-               const std::vector<std::vector<cv::Point2d>>& points) {
+               const std::vector<std::vector<cv::Point2d>>& points, const std::string& only = {}) {
   // OpenCV wants float points; float keeps 1e-4 px at 2000 px, two orders below the noise.
   std::vector<std::vector<cv::Point3f>> objects(points.size(), plateFloat(board));
   std::vector<std::vector<cv::Point2f>> images;
@@ -59,6 +62,7 @@ Solution solve(const BoardSpec& board, cv::Size size,
   std::vector<DistortionCandidate> candidates;
   double bestBic = std::numeric_limits<double>::infinity();
   for (const DistortionModel& model : kDistortionModels) {
+    if (!only.empty() && only != model.name) continue;
     Solution s;
     cv::Mat K, D;
     s.rms = cv::calibrateCamera(
@@ -147,8 +151,11 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
 
   Solution s = solve(board, imageSize, points);
   if (board.kind == BoardSpec::Kind::Circles) {
-    // Re-centre every mark with the perspective-correct centre of the current solution.
-    for (int round = 0; round < 4; ++round) {
+    // Re-centre every mark with the perspective-correct centre of the current solution; the
+    // model is chosen again only on the final centres.
+    const std::string chosen = s.distortionModel;
+    constexpr int kRounds = 4;
+    for (int round = 0; round < kRounds; ++round) {
       double moved = 0;
       for (std::size_t k = 0; k < used.size(); ++k) {
         CircleMarks marks{views[used[k]].detection, views[used[k]].rims};
@@ -157,9 +164,10 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
           moved = std::max(moved, cv::norm(centres[j] - points[k][j]));
         points[k] = std::move(centres);
       }
-      s = solve(board, imageSize, points);
-      if (moved < 1e-4) break;
+      if (moved < 1e-4 || round + 1 == kRounds) break;
+      s = solve(board, imageSize, points, chosen);
     }
+    s = solve(board, imageSize, points);
   }
   out.camera = s.camera;
   out.rmsPx = s.rms;
