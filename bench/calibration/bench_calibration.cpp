@@ -16,7 +16,9 @@
 // and with mm_per_pixel alone (the true scale at the image centre; its centres are given the
 // best rigid placement on the truth, which favours it).
 //
-// Usage: bench_calibration [--smoke] [--views N] [--seed N]
+// Usage: bench_calibration [--smoke] [--views N] [--seed N] [--save-views DIR]
+// --save-views: writes each board's rendered views to DIR/chessboard and DIR/circles as PNG, so
+// that `facet calibrate` (or a profiler) can be run on exactly the views measured here.
 // --smoke: 8 chessboard views without lens blur, one hole scene (a few seconds' check).
 // --seed 1 (default) is the set the code was developed on; --seed 2 and up are held out.
 #include <algorithm>
@@ -24,11 +26,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/calibration/camera_calibration.hpp"
@@ -59,6 +63,7 @@ struct View {
 };
 
 double lensBlur = 0.7;  // --smoke: 0 (renders about 5x faster)
+std::string saveViews;  // --save-views DIR: each board's views as PNG, for `facet calibrate`
 
 std::vector<View> renderViews(const BoardSpec& board, int count, std::uint64_t seed) {
   std::vector<View> views;
@@ -79,6 +84,13 @@ std::vector<View> renderViews(const BoardSpec& board, int count, std::uint64_t s
     s.seed = seed * 7717 + static_cast<std::uint64_t>(i);
     views.push_back(
         {s.render(), scene::patternImagePoints(s, board.cols, board.rows, board.pitchMm)});
+    if (!saveViews.empty()) {
+      const auto folder = std::filesystem::path(saveViews) / (chess ? "chessboard" : "circles");
+      std::filesystem::create_directories(folder);
+      char name[32];
+      std::snprintf(name, sizeof name, "view_%02d.png", i);
+      cv::imwrite((folder / name).string(), views.back().image);
+    }
   }
   return views;
 }
@@ -356,8 +368,11 @@ int main(int argc, char** argv) {
       count = std::atoi(argv[++i]);
     else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc)
       seed = std::strtoull(argv[++i], nullptr, 10);
+    else if (!std::strcmp(argv[i], "--save-views") && i + 1 < argc)
+      saveViews = argv[++i];
     else {
-      std::fprintf(stderr, "usage: bench_calibration [--smoke] [--views N] [--seed N]\n");
+      std::fprintf(
+          stderr, "usage: bench_calibration [--smoke] [--views N] [--seed N] [--save-views DIR]\n");
       return 1;
     }
   }
