@@ -4,9 +4,13 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
+
+#include <opencv2/imgproc.hpp>
 
 #include "camera/image_codec_table.hpp"
 #include "camera/image_file_reader.hpp"
+#include "camera/png_file.hpp"
 
 // Baked in by camera/CMakeLists.txt.
 #ifndef FACET_IMAGE_CODECS_FILE
@@ -71,6 +75,45 @@ const LoadedCodecs& loaded() {
   return codecs;
 }
 
+// OpenCV's own limit on the pixels cv::imread decodes (CV_IO_MAX_IMAGE_PIXELS' default).
+constexpr std::uint64_t kImreadMaxPixels = std::uint64_t{1} << 30;
+
+// cv::imread's result for a plain PNG, where it is the file's pixels as stored: the flags
+// facet reads with, and no conversion or EXIF orientation to apply.
+std::optional<cv::Mat> imreadOfPlainPng(const fs::path& file, int flags) {
+  const bool unchanged = flags == cv::IMREAD_UNCHANGED;
+  const bool grey =
+      flags == cv::IMREAD_GRAYSCALE || flags == (cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
+  if (!unchanged && !grey) return std::nullopt;
+  auto png = readPlainPng(file, kImreadMaxPixels);
+  if (!png) return std::nullopt;
+  const cv::Mat& p = png->pixels;
+  if (unchanged && p.channels() != 2) return p;
+  if (grey && p.channels() == 1 && !png->hasExif &&
+      (p.depth() == CV_8U || (flags & cv::IMREAD_ANYDEPTH)))
+    return p;
+  return std::nullopt;
+}
+
+// readImageFile's result for a plain PNG: what the module's decoder makes of it.
+std::optional<ImageFileContent> frameOfPlainPng(const fs::path& file, std::uint64_t max_pixels) {
+  auto png = readPlainPng(file, max_pixels);
+  if (!png) return std::nullopt;
+  ImageFileContent content;
+  cv::Mat& image = png->pixels;
+  const bool deep = image.depth() == CV_16U;
+  if (image.channels() <= 2) {
+    if (image.channels() == 2) cv::extractChannel(image, image, 0);  // alpha dropped
+    content.format = deep ? PixelFormat::Mono16 : PixelFormat::Mono8;
+  } else {
+    if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
+    if (deep) image.convertTo(image, CV_8U, 1.0 / 256.0);  // Bgr8 is a Frame's only colour format
+    content.format = PixelFormat::Bgr8;
+  }
+  content.image = std::move(image);
+  return content;
+}
+
 }  // namespace
 
 const std::string& imageCodecsProblem() {
@@ -78,6 +121,7 @@ const std::string& imageCodecsProblem() {
 }
 
 cv::Mat readImage(const fs::path& file, int flags) {
+  if (auto png = imreadOfPlainPng(file, flags)) return *png;
   const ImageCodecTable* table = loaded().table;
   return table ? table->read(file.string(), flags) : cv::Mat();
 }
@@ -99,6 +143,7 @@ cv::Mat decodeImage(const cv::Mat& bytes, int flags) {
 }
 
 ImageFileContent readImageFile(const fs::path& file, std::uint64_t max_pixels) {
+  if (auto png = frameOfPlainPng(file, max_pixels)) return std::move(*png);
   const LoadedCodecs& codecs = loaded();
   if (codecs.table) return codecs.table->readFile(file, max_pixels);
   ImageFileContent content;

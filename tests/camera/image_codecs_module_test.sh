@@ -2,13 +2,21 @@
 # The image codecs are a module loaded on first use (camera/image_codecs.hpp): facet and facetd
 # must not link OpenImageIO or OpenCV's imgcodecs (each start would map ~200 more libraries), an
 # image command must find the module in the build tree and in the installed layout, and a missing
-# module must be a clear error, not a crash.
+# module must be a clear error, not a crash. Plain PNG files are read without the module
+# (camera/png_file.hpp); a TIFF copy of the same image (made with OpenImageIO's oiiotool) needs it.
 #   usage: image_codecs_module_test.sh FACET FACETD BUILD_DIR   (from the repository root)
 set -uo pipefail
 facet=$1 facetd=$2 build=$3
 fail() { echo "FAIL: $*" >&2; exit 1; }
-match=(match --model recipes/models/bracket.shape --image recipes/demo/bracket_shape/part_000.png
-       --json)
+command -v oiiotool >/dev/null || fail "oiiotool is missing (deploy/install-deps.sh installs openimageio-tools)"
+work=$(mktemp -d)
+prefix=$work/prefix
+trap 'rm -rf "$work"' EXIT
+png=recipes/demo/bracket_shape/part_000.png
+tiff=$work/part_000.tif
+oiiotool "$png" -o "$tiff" || fail "oiiotool could not write $tiff"
+png_match=(match --model recipes/models/bracket.shape --image "$png" --json)
+match=(match --model recipes/models/bracket.shape --image "$tiff" --json)
 
 for program in "$facet" "$facetd"; do
   needed=$(readelf -d "$program" | grep NEEDED) || fail "readelf -d $program"
@@ -21,16 +29,20 @@ out=$("$facet" "${match[@]}") || fail "facet match with the module of the build 
 grep -q '"score"' <<<"$out" || fail "facet match printed no match: $out"
 
 missing=/nonexistent/libfacet_image_codecs.so
+png_out=$(FACET_IMAGE_CODECS=$missing "$facet" "${png_match[@]}" 2>&1) ||
+  fail "a plain PNG must be read without the module: $png_out"
+[[ $(grep -o '"score":[0-9.]*' <<<"$png_out") == $(grep -o '"score":[0-9.]*' <<<"$out") ]] ||
+  fail "the PNG read without the module must match as the TIFF read by it: $png_out / $out"
+grep -q "image codecs not loaded" <<<"$png_out" && fail "a plain PNG loaded the module: $png_out"
+
 err=$(FACET_IMAGE_CODECS=$missing "$facet" "${match[@]}" 2>&1 >/dev/null)
 rc=$?
 [[ $rc -eq 1 ]] || fail "a missing module must exit 1 (an unreadable image), got $rc: $err"
-grep -q "part_000.png: cannot read image: image codecs not loaded" <<<"$err" &&
+grep -q "part_000.tif: cannot read image: image codecs not loaded" <<<"$err" &&
   grep -q "$missing: cannot open shared object file" <<<"$err" ||
   fail "the error must name the image, the path tried and dlerror(): $err"
 
 # The installed layout: <prefix>/bin/facet finds <prefix>/lib/facet/ through /proc/self/exe.
-prefix=$(mktemp -d)
-trap 'rm -rf "$prefix"' EXIT
 cmake --install "$build" --prefix "$prefix" >/dev/null || fail "cmake --install"
 err=$(LD_DEBUG=files "$prefix/bin/facet" "${match[@]}" 2>&1 >/dev/null) ||
   fail "installed facet match failed"
