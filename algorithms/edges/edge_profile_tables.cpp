@@ -7,6 +7,7 @@
 #include <cmath>
 #include <mutex>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 namespace facet::edge_profile {
@@ -73,10 +74,11 @@ class ApertureProfiles {
     {
       const double angle = k * std::numbers::pi / 180.0;
       const double c = std::cos(angle), sn = std::sin(angle);
+      const GridTaps taps = gridBlur ? gridTaps(c, sn) : GridTaps();
       for (int i = 0; i < kApertureSize; ++i) {
         const double u = -kApertureRange + static_cast<double>(i) / kAperturePerPixel;
         if (gridBlur)
-          gridProfile(u, c, sn, value[i], slope[i]);
+          gridProfile(taps, u, c, sn, value[i], slope[i]);
         else
           profile(u, c, sn, value[i], slope[i]);
       }
@@ -114,8 +116,15 @@ class ApertureProfiles {
  private:
   static double cdf(double x) { return 0.5 * std::erfc(-x / std::numbers::sqrt2); }
   static double pdf(double x) { return std::exp(-0.5 * x * x) / std::sqrt(2 * std::numbers::pi); }
-  static double g(double x) { return x * cdf(x) + pdf(x); }
-  static double h(double x) { return 0.5 * ((x * x + 1) * cdf(x) + x * pdf(x)); }
+  // G and H at one point share its CDF and density (half the erfc and exp calls of a row).
+  struct Antiderivatives {
+    double g, h;
+    explicit Antiderivatives(double x) {
+      const double phi = cdf(x), density = pdf(x);
+      g = x * phi + density;
+      h = 0.5 * ((x * x + 1) * phi + x * density);
+    }
+  };
 
   // The sharp step integrated over the pixel square: the CDF and density of the aperture
   // box(c) * box(s) at x.
@@ -142,43 +151,70 @@ class ApertureProfiles {
   // Blur on the pixel grid: the pixel-integrated sharp step convolved with the sampled Gaussian
   // kernel (truncated at 4 sigma, normalised), as a blur applied to the sampled image does:
   //   P(u) = sum_k g(kx) g(ky) sharpStep(u - kx c - ky s).
-  void gridProfile(double u, double c, double s, double& value, double& slope) const {
+  // The kernel's taps projected on the normal, sorted by offset t = kx c + ky s, with their
+  // weights and the running sum of the weights before each: a tap farther than the aperture's
+  // half width p = (c + s) / 2 from u adds 0 or its whole weight, so only the few taps within p
+  // of u need the sharp step (a row of the table took 81 of them per sample at sigma 1).
+  struct GridTaps {
+    std::vector<double> offset, weight, before;
+  };
+
+  GridTaps gridTaps(double c, double s) const {
     const int r = static_cast<int>(std::ceil(4 * sigma));
-    thread_local std::vector<double> kernel;
-    kernel.assign(2 * r + 1, 0.0);
+    std::vector<double> kernel(2 * r + 1);
     double sum = 0;
     for (int k = -r; k <= r; ++k) sum += kernel[k + r] = std::exp(-0.5 * k * k / (sigma * sigma));
-    value = slope = 0;
+    std::vector<std::pair<double, double>> taps;
     if (s < 1e-9) {  // axis-aligned: the kernel's rows all project to the same offsets
-      for (int kx = -r; kx <= r; ++kx) {
-        double v, d;
-        sharpStep(u - kx * c, c, s, v, d);
-        value += kernel[kx + r] / sum * v;
-        slope += kernel[kx + r] / sum * d;
-      }
-      return;
+      for (int kx = -r; kx <= r; ++kx) taps.push_back({kx * c, kernel[kx + r] / sum});
+    } else {
+      for (int ky = -r; ky <= r; ++ky)
+        for (int kx = -r; kx <= r; ++kx)
+          taps.push_back({kx * c + ky * s, kernel[kx + r] * kernel[ky + r] / (sum * sum)});
     }
-    for (int ky = -r; ky <= r; ++ky)
-      for (int kx = -r; kx <= r; ++kx) {
-        double v, d;
-        sharpStep(u - kx * c - ky * s, c, s, v, d);
-        const double weight = kernel[kx + r] * kernel[ky + r] / (sum * sum);
-        value += weight * v;
-        slope += weight * d;
-      }
+    std::sort(taps.begin(), taps.end());
+    GridTaps out;
+    double running = 0;
+    for (const auto& [t, w] : taps) {
+      out.offset.push_back(t);
+      out.weight.push_back(w);
+      out.before.push_back(running);
+      running += w;
+    }
+    out.before.push_back(running);
+    return out;
+  }
+
+  static void gridProfile(const GridTaps& taps, double u, double c, double s, double& value,
+                          double& slope) {
+    const double p = (c + s) / 2;
+    // Taps with u - t >= p see the whole step (1); those with u - t <= -p see none of it.
+    const auto first = std::upper_bound(taps.offset.begin(), taps.offset.end(), u - p);
+    const auto last = std::lower_bound(first, taps.offset.end(), u + p);
+    auto i = static_cast<std::size_t>(first - taps.offset.begin());
+    const auto end = static_cast<std::size_t>(last - taps.offset.begin());
+    value = taps.before[i];
+    slope = 0;
+    for (; i < end; ++i) {
+      double v, d;
+      sharpStep(u - taps.offset[i], c, s, v, d);
+      value += taps.weight[i] * v;
+      slope += taps.weight[i] * d;
+    }
   }
 
   void profile(double u, double c, double s, double& value, double& slope) const {
     const double sg = sigma;
     if (s < 1e-3) {
-      value = sg / c * (g((u + c / 2) / sg) - g((u - c / 2) / sg));
-      slope = (cdf((u + c / 2) / sg) - cdf((u - c / 2) / sg)) / c;
+      const double a = (u + c / 2) / sg, b = (u - c / 2) / sg;
+      value = sg / c * (Antiderivatives(a).g - Antiderivatives(b).g);
+      slope = (cdf(a) - cdf(b)) / c;
       return;
     }
     const double p = (c + s) / 2, m = (c - s) / 2;
-    value =
-        sg * sg / (c * s) * (h((u + p) / sg) - h((u + m) / sg) - h((u - m) / sg) + h((u - p) / sg));
-    slope = sg / (c * s) * (g((u + p) / sg) - g((u + m) / sg) - g((u - m) / sg) + g((u - p) / sg));
+    const Antiderivatives pp((u + p) / sg), pm((u + m) / sg), mm((u - m) / sg), mp((u - p) / sg);
+    value = sg * sg / (c * s) * (pp.h - pm.h - mm.h + mp.h);
+    slope = sg / (c * s) * (pp.g - pm.g - mm.g + mp.g);
   }
 };
 
