@@ -5,6 +5,7 @@
 // part.
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -133,6 +134,25 @@ scene::PartDrawing nearSymmetricCross() {
   part.primitives.push_back(cross);
   part.templateSize = {140, 134};
   return part;
+}
+
+// The near-symmetries the search tries: the cross's three quarter turns, the bracket none.
+TEST(FindShapeModelSafety, ModelSymmetriesAreTheCrossQuarterTurnsAndNoneOfTheBracket) {
+  const cv::Mat templ =
+      scene::templateScene(nearSymmetricCross(), bracketSpec({}, 31), testing::kPartGrey).render();
+  const ShapeModel cross = createShapeModel(templ);
+  ASSERT_EQ(cross.symmetries.size(), 3u);
+  std::vector<double> turns;
+  for (const ModelSymmetry& s : cross.symmetries) {
+    turns.push_back(degrees(s.angle));
+    EXPECT_GT(s.score, 0.6);
+    EXPECT_LT(s.score, 0.99);  // the arms differ: no exact symmetry
+  }
+  std::sort(turns.begin(), turns.end());
+  EXPECT_NEAR(turns[0], -90, 1.0);
+  EXPECT_NEAR(turns[1], 90, 1.0);
+  EXPECT_NEAR(std::abs(turns[2]), 180, 1.0);
+  EXPECT_TRUE(createShapeModel(bracketTemplate()).symmetries.empty());
 }
 
 TEST(FindShapeModelSafety, FullSearchReturnsTheBestOfNearSymmetricPoses) {
