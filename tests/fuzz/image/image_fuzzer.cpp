@@ -1,8 +1,10 @@
-// libFuzzer target: the replay backend's image decoder (camera/image_file_decoder.hpp, what
-// readImageFile runs inside the image-codec module: OpenImageIO and, for 16-bit PNM, OpenCV). The
-// first byte picks the file extension the replay folder accepts, the rest is the file. Expected
-// outcome for bad input: an error naming the file. An image that reads must have the size its
-// header announced and a frame format.
+// libFuzzer target: the replay backend's image decoders: the one inside the image-codec module
+// (camera/image_file_decoder.hpp: OpenImageIO and, for 16-bit PNM, OpenCV) and the plain-PNG
+// reader that runs in the process before it (camera/png_file.hpp). The first byte picks the file
+// extension the replay folder accepts, the rest is the file. Expected outcome for bad input: an
+// error naming the file (module) or no image (plain PNG: the module then decides). An image that
+// reads must have the size its header announced and a frame format; where both read a file,
+// they agree on its size.
 //
 // The pixel limit is lower than the camera's default (2^28) so that runs stay within the
 // fuzzer's memory limit; the header check in front of any allocation is the same code.
@@ -14,6 +16,7 @@
 #include <string>
 
 #include "camera/image_file_decoder.hpp"
+#include "camera/png_file.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -29,6 +32,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (content.image.empty() || content.image.total() > kMaxPixels) std::abort();
   } else if (!content.image.empty() || content.error.find(file.string()) != 0) {
     std::abort();  // a refused file leaves no pixels and its message names it
+  }
+  if (const auto plain = facet::readPlainPng(file, kMaxPixels)) {
+    const cv::Mat& p = plain->pixels;
+    if (p.empty() || p.total() > kMaxPixels || p.channels() < 1 || p.channels() > 4 ||
+        (p.depth() != CV_8U && p.depth() != CV_16U))
+      std::abort();
+    if (content.ok() && content.image.size() != p.size()) std::abort();
   }
   return 0;
 }
