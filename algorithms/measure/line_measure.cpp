@@ -25,6 +25,8 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
   ProfileEdgeParams ep = params.edges;
   ep.minAmplitude = params.minAmplitude;
 
+  ProfileEdgeFinder finder(ep);  // one kernel and one set of buffers for every station
+
   LineMeasurement m;
   const int count = std::max(1, static_cast<int>(std::floor(rect.length / params.spacing)));
   const double first = -(count - 1) * params.spacing / 2.0;
@@ -43,8 +45,7 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
     const auto [lo, hi] = std::minmax_element(profile.values.begin(), profile.values.end());
     if (*hi - *lo >= params.minAmplitude) ++contrasted;
     const ProfileEdge* best = nullptr;
-    const std::vector<ProfileEdge> edges = findProfileEdges(profile, ep);
-    for (const ProfileEdge& e : edges) {
+    for (const ProfileEdge& e : finder.find(profile)) {
       const bool wanted = params.polarity == EdgePolarity::Any ||
                           (params.polarity == EdgePolarity::Rising) == (e.amplitude > 0);
       if (wanted && (!best || std::abs(e.amplitude) > std::abs(best->amplitude))) best = &e;
