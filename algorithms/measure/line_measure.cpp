@@ -25,7 +25,9 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
   ProfileEdgeParams ep = params.edges;
   ep.minAmplitude = params.minAmplitude;
 
-  ProfileEdgeFinder finder(ep);  // one kernel and one set of buffers for every station
+  // One set of buffers (and one derivative kernel) for every station.
+  GreyProfileSampler sampler(params.sampling);
+  ProfileEdgeFinder finder(ep);
 
   LineMeasurement m;
   const int count = std::max(1, static_cast<int>(std::floor(rect.length / params.spacing)));
@@ -35,7 +37,7 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
     const cv::Point2d c = along.at(first + k * params.spacing, 0.0);
     const MeasuringPath across(
         MeasuringRect{c.x, c.y, rect.width, params.stationWidth, rect.angle - 90.0});
-    const GreyProfile profile = sampleGreyProfile(image, across, params.sampling);
+    const GreyProfile& profile = sampler.sample(image, across);
     if (profile.values.size() < 6) {
       m.partial = true;
       continue;

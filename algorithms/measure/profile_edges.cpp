@@ -219,10 +219,11 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
       }
       jtj[7] = jtj[9] = 1.0;
     } else {
+      const double slope = -b / w;  // the model's derivative in e is slope * phi(z)
       for (int j = 0; j < count; ++j) {
         const auto [z, density] = gauss.next();
         const auto [g, f] = normal(z, density);
-        const double je = -b * g / w, jw = -b * g * z / w;
+        const double je = slope * g, jw = je * z;
         const double r = y[j] - (a + b * f);
         jtj[0] += 1.0, jtj[1] += f, jtj[2] += je, jtj[3] += jw;
         jtj[4] += f * f, jtj[5] += f * je, jtj[6] += f * jw;
