@@ -76,7 +76,7 @@ void GreyProfileSampler::sampleAs(const cv::Mat& image, const MeasuringPath& pat
   for (int k = 0; k < lines; ++k)
     offsets_[k] = -path.width() / 2.0 + (k + 0.5) * path.width() / lines;
   const Raster<T> raster(image);
-  origin_.resize(n), across_.resize(n), sums_.assign(n, 0.0), counts_.assign(n, 0);
+  origin_.resize(n), across_.resize(n), sums_.assign(n, 0.0);
   // The cross line is a segment: with both ends inside, every sample on it is.
   const double tFirst = offsets_.front(), tLast = offsets_.back();
   bool interior = true;
@@ -94,15 +94,21 @@ void GreyProfileSampler::sampleAs(const cv::Mat& image, const MeasuringPath& pat
       for (int i = 0; i < n; ++i)
         sums_[i] += raster.interiorBilinear(origin_[i].x + t * across_[i].x,
                                             origin_[i].y + t * across_[i].y);
-    std::fill(counts_.begin(), counts_.end(), lines);
-  } else {
-    for (int i = 0; i < n; ++i)
-      for (const double t : offsets_) {
-        double g = 0;
-        if (raster.bilinear(origin_[i].x + t * across_[i].x, origin_[i].y + t * across_[i].y, g))
-          sums_[i] += g, ++counts_[i];
-      }
+    // Every position is whole: the profile is all of them.
+    profile.step = prm.step;
+    if (n < 2) return;
+    profile.values.resize(n);
+    for (int i = 0; i < n; ++i) profile.values[i] = sums_[i] * scale / lines;
+    profile.start = start;
+    return;
   }
+  counts_.assign(n, 0);
+  for (int i = 0; i < n; ++i)
+    for (const double t : offsets_) {
+      double g = 0;
+      if (raster.bilinear(origin_[i].x + t * across_[i].x, origin_[i].y + t * across_[i].y, g))
+        sums_[i] += g, ++counts_[i];
+    }
   // A position is inside when at least half its samples are; the longest run of them is kept.
   const auto inside = [&](int i) { return 2 * counts_[i] >= lines && counts_[i] > 0; };
   bool anyMissing = false;

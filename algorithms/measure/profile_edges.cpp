@@ -149,12 +149,15 @@ void ProfileEdgeFinder::derivative(const GreyProfile& p) {
   std::fill_n(padded_.begin() + r + n, r, p.values.back());
   const double* v = padded_.data() + r;
   const double* w = kernel_.data();
-  slope_.resize(n);
-  for (int i = 0; i < n; ++i) {
-    double sum = 0;
-    for (int j = 1; j <= r; ++j) sum += w[j] * (v[i + j] - v[i - j]);
-    slope_[i] = sum / kernelNorm_;
+  // Tap by tap over the whole profile (each position still sums its taps in order): the inner
+  // loop has no carried sum and runs on vector lanes.
+  slope_.assign(n, 0.0);
+  double* d = slope_.data();
+  for (int j = 1; j <= r; ++j) {
+    const double wj = w[j];
+    for (int i = 0; i < n; ++i) d[i] += wj * (v[i + j] - v[i - j]);
   }
+  for (int i = 0; i < n; ++i) d[i] /= kernelNorm_;
 }
 
 // The live steps whose blur reaches into the window of step `self`.
