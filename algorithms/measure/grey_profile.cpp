@@ -57,76 +57,102 @@ struct Raster {
   std::size_t dy;  // bytes to the cell's lower row; 0 for a one-row image
 };
 
+}  // namespace
+
+GreyProfileSampler::GreyProfileSampler(const GreyProfileParams& params) : params_(params) {
+  if (!(params.step > 0) || !(params.crossStep > 0))
+    throw std::invalid_argument("grey profile: sampling steps must be positive");
+}
+
 template <class T>
-GreyProfile sample(const cv::Mat& image, const MeasuringPath& path, const GreyProfileParams& prm,
-                   double scale) {
-  GreyProfile profile;
-  profile.step = prm.step;
+void GreyProfileSampler::sampleAs(const cv::Mat& image, const MeasuringPath& path, double scale) {
+  const GreyProfileParams& prm = params_;
+  GreyProfile& profile = profile_;
   const int n = static_cast<int>(std::floor(path.length() / prm.step + 1e-9)) + 1;
   const int lines = std::max(1, static_cast<int>(std::ceil(path.width() / prm.crossStep - 1e-9)));
   const double start = -(n - 1) * prm.step / 2.0;
   // The cross offsets of the averaged lines, the same at every position.
-  std::vector<double> offsets(lines);
+  offsets_.resize(lines);
   for (int k = 0; k < lines; ++k)
-    offsets[k] = -path.width() / 2.0 + (k + 0.5) * path.width() / lines;
+    offsets_[k] = -path.width() / 2.0 + (k + 0.5) * path.width() / lines;
   const Raster<T> raster(image);
-  std::vector<double> values(n, 0.0);
-  std::vector<char> inside(n, 0);
-  bool anyMissing = false;
+  origin_.resize(n), across_.resize(n), sums_.assign(n, 0.0);
+  // The cross line is a segment: with both ends inside, every sample on it is.
+  const double tFirst = offsets_.front(), tLast = offsets_.back();
+  bool interior = true;
   for (int i = 0; i < n; ++i) {
     const double s = start + i * prm.step;
-    const cv::Point2d origin = path.at(s, 0.0), across = path.acrossAt(s);
-    double sum = 0;
-    int count = 0;
-    // The cross line is a segment: with both ends inside, every sample on it is.
-    const double tFirst = offsets.front(), tLast = offsets.back();
-    if (raster.interior(origin.x + tFirst * across.x, origin.y + tFirst * across.y) &&
-        raster.interior(origin.x + tLast * across.x, origin.y + tLast * across.y)) {
-      for (const double t : offsets)
-        sum += raster.interiorBilinear(origin.x + t * across.x, origin.y + t * across.y);
-      count = lines;
-    } else {
-      for (const double t : offsets) {
-        double g = 0;
-        if (raster.bilinear(origin.x + t * across.x, origin.y + t * across.y, g)) sum += g, ++count;
-      }
-    }
-    anyMissing = anyMissing || count < lines;
-    if (2 * count >= lines && count > 0) values[i] = sum * scale / count, inside[i] = 1;
+    const cv::Point2d o = path.at(s, 0.0), a = path.acrossAt(s);
+    origin_[i] = o, across_[i] = a;
+    interior = interior && raster.interior(o.x + tFirst * a.x, o.y + tFirst * a.y) &&
+               raster.interior(o.x + tLast * a.x, o.y + tLast * a.y);
   }
-  // The longest run of inside positions.
+  if (interior) {
+    // Line by line: the positions' samples are independent of each other, which keeps the
+    // processor's pipeline full; each position still sums its lines in the same order.
+    for (const double t : offsets_)
+      for (int i = 0; i < n; ++i)
+        sums_[i] += raster.interiorBilinear(origin_[i].x + t * across_[i].x,
+                                            origin_[i].y + t * across_[i].y);
+    // Every position is whole: the profile is all of them.
+    profile.step = prm.step;
+    if (n < 2) return;
+    profile.values.resize(n);
+    for (int i = 0; i < n; ++i) profile.values[i] = sums_[i] * scale / lines;
+    profile.start = start;
+    return;
+  }
+  counts_.assign(n, 0);
+  for (int i = 0; i < n; ++i)
+    for (const double t : offsets_) {
+      double g = 0;
+      if (raster.bilinear(origin_[i].x + t * across_[i].x, origin_[i].y + t * across_[i].y, g))
+        sums_[i] += g, ++counts_[i];
+    }
+  // A position is inside when at least half its samples are; the longest run of them is kept.
+  const auto inside = [&](int i) { return 2 * counts_[i] >= lines && counts_[i] > 0; };
+  bool anyMissing = false;
+  for (int i = 0; i < n; ++i) {
+    anyMissing = anyMissing || counts_[i] < lines;
+    if (inside(i)) sums_[i] = sums_[i] * scale / counts_[i];
+  }
   int bestBegin = 0, bestLength = 0;
   for (int i = 0; i < n;) {
-    if (!inside[i]) {
+    if (!inside(i)) {
       ++i;
       continue;
     }
     int j = i;
-    while (j < n && inside[j]) ++j;
+    while (j < n && inside(j)) ++j;
     if (j - i > bestLength) bestBegin = i, bestLength = j - i;
     i = j;
   }
-  if (bestLength < 2) return profile;
-  if (bestLength == n)
-    profile.values = std::move(values);
-  else
-    profile.values.assign(values.begin() + bestBegin, values.begin() + bestBegin + bestLength);
+  profile.step = prm.step;
+  if (bestLength < 2) return;
+  profile.values.assign(sums_.begin() + bestBegin, sums_.begin() + bestBegin + bestLength);
   profile.start = start + bestBegin * prm.step;
   profile.partial = anyMissing || bestLength < n;
-  return profile;
 }
 
-}  // namespace
+const GreyProfile& GreyProfileSampler::sample(const cv::Mat& image, const MeasuringPath& path) {
+  if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
+    throw std::invalid_argument("grey profile: the image must be 8-bit or 16-bit grey");
+  // Cleared, not replaced: the values keep their capacity for the next path.
+  profile_.values.clear();
+  profile_.start = profile_.step = 0;
+  profile_.partial = false;
+  if (image.empty() || !(path.length() > 0) || !(path.width() > 0)) return profile_;
+  if (image.depth() == CV_8U)
+    sampleAs<std::uint8_t>(image, path, 1.0);
+  else
+    sampleAs<std::uint16_t>(image, path, 1.0 / 256.0);
+  return profile_;
+}
 
 GreyProfile sampleGreyProfile(const cv::Mat& image, const MeasuringPath& path,
                               const GreyProfileParams& params) {
-  if (image.type() != CV_8UC1 && image.type() != CV_16UC1)
-    throw std::invalid_argument("grey profile: the image must be 8-bit or 16-bit grey");
-  if (!(params.step > 0) || !(params.crossStep > 0))
-    throw std::invalid_argument("grey profile: sampling steps must be positive");
-  if (image.empty() || !(path.length() > 0) || !(path.width() > 0)) return {};
-  return image.depth() == CV_8U ? sample<std::uint8_t>(image, path, params, 1.0)
-                                : sample<std::uint16_t>(image, path, params, 1.0 / 256.0);
+  GreyProfileSampler sampler(params);
+  return sampler.sample(image, path);
 }
 
 }  // namespace facet

@@ -42,4 +42,24 @@ struct GreyProfile {
 GreyProfile sampleGreyProfile(const cv::Mat& image, const MeasuringPath& path,
                               const GreyProfileParams& params = {});
 
+// The same sampling for many paths (a line's cross calipers), its buffers kept between them.
+class GreyProfileSampler {
+ public:
+  explicit GreyProfileSampler(const GreyProfileParams& params = {});
+
+  // As sampleGreyProfile(image, path, params); the profile lives until the next call.
+  const GreyProfile& sample(const cv::Mat& image, const MeasuringPath& path);
+
+ private:
+  template <class T>
+  void sampleAs(const cv::Mat& image, const MeasuringPath& path, double scale);
+
+  GreyProfileParams params_;
+  GreyProfile profile_;
+  std::vector<double> offsets_;               // cross offsets of the averaged lines
+  std::vector<cv::Point2d> origin_, across_;  // per position: the axis point, the cross direction
+  std::vector<double> sums_;                  // per position: the sum over its cross samples
+  std::vector<int> counts_;                   // per position: how many of them lay inside
+};
+
 }  // namespace facet

@@ -25,6 +25,10 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
   ProfileEdgeParams ep = params.edges;
   ep.minAmplitude = params.minAmplitude;
 
+  // One set of buffers (and one derivative kernel) for every station.
+  GreyProfileSampler sampler(params.sampling);
+  ProfileEdgeFinder finder(ep);
+
   LineMeasurement m;
   const int count = std::max(1, static_cast<int>(std::floor(rect.length / params.spacing)));
   const double first = -(count - 1) * params.spacing / 2.0;
@@ -33,7 +37,7 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
     const cv::Point2d c = along.at(first + k * params.spacing, 0.0);
     const MeasuringPath across(
         MeasuringRect{c.x, c.y, rect.width, params.stationWidth, rect.angle - 90.0});
-    const GreyProfile profile = sampleGreyProfile(image, across, params.sampling);
+    const GreyProfile& profile = sampler.sample(image, across);
     if (profile.values.size() < 6) {
       m.partial = true;
       continue;
@@ -43,8 +47,7 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
     const auto [lo, hi] = std::minmax_element(profile.values.begin(), profile.values.end());
     if (*hi - *lo >= params.minAmplitude) ++contrasted;
     const ProfileEdge* best = nullptr;
-    const std::vector<ProfileEdge> edges = findProfileEdges(profile, ep);
-    for (const ProfileEdge& e : edges) {
+    for (const ProfileEdge& e : finder.find(profile)) {
       const bool wanted = params.polarity == EdgePolarity::Any ||
                           (params.polarity == EdgePolarity::Rising) == (e.amplitude > 0);
       if (wanted && (!best || std::abs(e.amplitude) > std::abs(best->amplitude))) best = &e;

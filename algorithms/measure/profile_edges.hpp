@@ -42,4 +42,36 @@ struct ProfileEdge {
 std::vector<ProfileEdge> findProfileEdges(const GreyProfile& profile,
                                           const ProfileEdgeParams& params = {});
 
+// The same search over many profiles with one set of parameters (a line's cross calipers): the
+// derivative's kernel is made once and the working buffers are kept, so that a profile costs no
+// allocation once the buffers have grown.
+class ProfileEdgeFinder {
+ public:
+  explicit ProfileEdgeFinder(const ProfileEdgeParams& params = {});
+  ~ProfileEdgeFinder();
+  ProfileEdgeFinder(const ProfileEdgeFinder&) = delete;
+  ProfileEdgeFinder& operator=(const ProfileEdgeFinder&) = delete;
+
+  // As findProfileEdges(profile, params); the result lives until the next call.
+  const std::vector<ProfileEdge>& find(const GreyProfile& profile);
+
+ private:
+  struct Step;
+  void derivative(const GreyProfile& profile);
+  void findNear(std::size_t self);
+  [[nodiscard]] double neighbours(std::size_t self, double s) const;
+  bool fitStep(const GreyProfile& profile, std::size_t self);
+
+  ProfileEdgeParams params_;
+  double kernelStep_ = 0;          // the profile step the kernel was made for
+  std::vector<double> kernel_;     // derivative taps 1..r (index 0 unused)
+  double kernelNorm_ = 0;          // their response to a unit slope
+  std::vector<double> padded_;     // the profile with its ends repeated r times
+  std::vector<double> slope_;      // the derivative
+  std::vector<Step> steps_;        // candidates, then fitted steps
+  std::vector<std::size_t> near_;  // steps reaching into the current step's window
+  std::vector<double> window_;     // the current step's samples, neighbours removed
+  std::vector<ProfileEdge> found_, edges_;
+};
+
 }  // namespace facet
