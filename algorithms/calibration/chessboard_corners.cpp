@@ -14,6 +14,11 @@
 namespace facet {
 namespace {
 
+// Edge points per corner that estimate its local blur width. The width barely moves a symmetric
+// step's position, and a corner's strips hold a hundred or more points; fitting 64 of them with a
+// free width first took a third of the detection time.
+constexpr int kCornerBlurSamples = 16;
+
 double meanGrey(const cv::Mat& image8, cv::Point2d centre, double radius) {
   const int r = std::max(1, static_cast<int>(radius));
   const cv::Rect box =
@@ -208,6 +213,7 @@ Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int col
       params.low = probe.lowThreshold;
       params.high = probe.highThreshold;
       params.blurOnPixelGrid = probe.blurOnPixelGrid;  // one optics per image: its width is fitted
+      params.blurSamples = kCornerBlurSamples;
       // The mask covers only the ROI (drawn in its coordinates).
       params.mask = cv::Mat::zeros(params.roi.size(), CV_8U);
       const cv::Point2d local = p - cv::Point2d(params.roi.tl());

@@ -122,10 +122,11 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
     if (params.blurOnPixelGrid) {
       // The model is known: only the width is estimated, with that model's profiles.
       profile.blurOnPixelGrid = *params.blurOnPixelGrid;
-      blur = {estimateEdgeBlur(image, seeds, profile, 64, profile.blurOnPixelGrid).width,
+      blur = {estimateEdgeBlur(image, seeds, profile, params.blurSamples, profile.blurOnPixelGrid)
+                  .width,
               profile.blurOnPixelGrid};
     } else {
-      blur = estimateEdgeBlur(image, seeds, profile);
+      blur = estimateEdgeBlur(image, seeds, profile, params.blurSamples);
     }
     profile.width = blur.width;
     profile.blurOnPixelGrid = blur.onPixelGrid;

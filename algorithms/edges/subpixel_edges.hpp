@@ -49,6 +49,9 @@ struct EdgeParams {
   // after sampling), false = before pixel integration (a lens). Unset (default): chosen per image
   // from the edges' profiles (estimateEdgeBlur), so neither has to be known.
   std::optional<bool> blurOnPixelGrid;
+  // Edge points fitted with a free width to estimate the blur (estimateEdgeBlur). Fewer suffice
+  // where many small regions of one image are searched and each only needs its local width.
+  int blurSamples = 64;
 };
 
 struct EdgeContours {
