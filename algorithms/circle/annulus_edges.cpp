@@ -20,6 +20,77 @@ double median(std::vector<float>& v) {
   return v[v.size() / 2];
 }
 
+// The annulus' pixels within [xLo, xHi] x [yLo, yHi] as runs: per row the pixels x with
+// |x - cx| <= outer and not |x - cx| < inner, one run or two around the inner disc. The bounds
+// come from square roots; each is then moved to where the per-pixel test itself changes, so the
+// runs hold exactly the pixels that test accepts.
+RowRuns annulusRuns(cv::Point2d centre, double rIn, double rOut, int xLo, int xHi, int yLo,
+                    int yHi) {
+  RowRuns runs;
+  for (int y = yLo; y <= yHi; ++y) {
+    const double dy = y - centre.y;
+    if (std::abs(dy) > rOut) continue;
+    const double outer = std::sqrt(rOut * rOut - dy * dy);
+    const double inner = std::abs(dy) < rIn ? std::sqrt(rIn * rIn - dy * dy) : -1.0;
+    const int xa = std::max(xLo, static_cast<int>(std::ceil(centre.x - outer)));
+    const int xb = std::min(xHi, static_cast<int>(std::floor(centre.x + outer)));
+    if (xa > xb) continue;
+    auto hole = [&](int x) { return std::abs(x - centre.x) < inner; };
+    // The inner disc's pixels on this row: [h0, h1) (empty when the row misses it).
+    int h0 = static_cast<int>(std::ceil(centre.x - inner)), h1 = h0;
+    if (inner > 0.0) {
+      while (h0 > xa && hole(h0 - 1)) --h0;
+      while (h0 <= xb && !hole(h0) && h0 < centre.x) ++h0;
+      h1 = h0;
+      while (h1 <= xb && hole(h1)) ++h1;
+    }
+    if (h1 == h0) {
+      runs.push_back({y, xa, xb + 1});
+      continue;
+    }
+    if (xa < h0) runs.push_back({y, xa, std::min(h0, xb + 1)});
+    if (h1 <= xb) runs.push_back({y, std::max(h1, xa), xb + 1});
+  }
+  return runs;
+}
+
+// Pixel (x, y) on the 8-bit scale.
+template <typename T>
+double grey(const cv::Mat& image, int x, int y, double scale) {
+  return image.ptr<T>(y)[x] * scale;
+}
+
+// The largest gradient magnitude in each angular sector and Immerkaer's noise response on every
+// third pixel of the annulus.
+template <typename T>
+void annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const RowRuns& runs,
+                       cv::Point2d centre, double scale, std::vector<float>& peak,
+                       std::vector<float>& noise) {
+  const int sectors = static_cast<int>(peak.size());
+  const cv::Rect crop = gradient.area;
+  for (const RowRun& run : runs) {
+    const int y = run.y;
+    const double dy = y - centre.y;
+    const float* magnitude = gradient.magnitude.ptr<float>(y - crop.y) - crop.x;
+    for (int x = run.x0; x < run.x1; ++x) {
+      const double dx = x - centre.x;
+      // Sector from the "diamond angle" in [0, 4), a monotonic stand-in for atan2.
+      const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);
+      const double turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
+      float& sectorPeak = peak[std::min(sectors - 1, static_cast<int>(turn * sectors))];
+      sectorPeak = std::max(sectorPeak, magnitude[x]);
+      // Immerkaer's noise mask (its taps' squares sum to 36), on every third pixel: plenty for
+      // a median.
+      if ((x + y) % 3 != 0) continue;
+      auto at = [&](int u, int v) { return grey<T>(image, u, v, scale); };
+      const double n = at(x - 1, y - 1) - 2 * at(x, y - 1) + at(x + 1, y - 1) - 2 * at(x - 1, y) +
+                       4 * at(x, y) - 2 * at(x + 1, y) + at(x - 1, y + 1) - 2 * at(x, y + 1) +
+                       at(x + 1, y + 1);
+      noise.push_back(static_cast<float>(std::abs(n)));
+    }
+  }
+}
+
 }  // namespace
 
 AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double rIn, double rOut,
@@ -34,47 +105,23 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
   const cv::Rect crop = box & cv::Rect(0, 0, image.cols, image.rows);
   if (crop.width < 5 || crop.height < 5) return out;
 
-  // Annulus pixels that carry a full 5x5 window inside the image (and inside the crop).
-  cv::Mat mask = cv::Mat::zeros(crop.size(), CV_8U);
+  // Annulus pixels that carry a full 5x5 window inside the image (and inside the crop). Only
+  // they and their neighbours get a gradient: a thin annulus is a small part of its box.
   const int xLo = std::max(2, crop.x + 2), xHi = std::min(image.cols - 3, crop.br().x - 3);
   const int yLo = std::max(2, crop.y + 2), yHi = std::min(image.rows - 3, crop.br().y - 3);
+  const RowRuns runs = annulusRuns(centre, rIn, rOut, xLo, xHi, yLo, yHi);
+  for (const RowRun& run : runs) out.annulusPixels += run.x1 - run.x0;
+  if (out.annulusPixels == 0) return out;
+
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
   const int sectors = std::clamp(static_cast<int>(2.0 * std::numbers::pi * rOut / 6.0), 8, 120);
-  const EdgeGradient gradient = computeEdgeGradient(image, crop);
+  const EdgeGradient gradient = computeEdgeGradientOnRuns(image, crop, runs);
   std::vector<float> noise, peak(sectors, 0.0f);
-  for (int y = yLo; y <= yHi; ++y) {
-    const double dy = y - centre.y;
-    if (std::abs(dy) > rOut) continue;
-    const double outer = std::sqrt(rOut * rOut - dy * dy);
-    const double inner = std::abs(dy) < rIn ? std::sqrt(rIn * rIn - dy * dy) : -1.0;
-    auto* row = mask.ptr<std::uint8_t>(y - crop.y);
-    const float* magnitude = gradient.magnitude.ptr<float>(y - crop.y) - crop.x;
-    const int xa = std::max(xLo, static_cast<int>(std::ceil(centre.x - outer)));
-    const int xb = std::min(xHi, static_cast<int>(std::floor(centre.x + outer)));
-    for (int x = xa; x <= xb; ++x) {
-      const double dx = x - centre.x;
-      if (std::abs(dx) < inner) continue;
-      row[x - crop.x] = 255;
-      ++out.annulusPixels;
-      // Sector from the "diamond angle" in [0, 4), a monotonic stand-in for atan2.
-      const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);
-      const double turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
-      float& sectorPeak = peak[std::min(sectors - 1, static_cast<int>(turn * sectors))];
-      sectorPeak = std::max(sectorPeak, magnitude[x]);
-      // Immerkaer's noise mask (its taps' squares sum to 36), on every third pixel: plenty for
-      // a median.
-      if ((x + y) % 3 != 0) continue;
-      auto at = [&](int u, int v) {
-        return image.depth() == CV_16U ? image.at<std::uint16_t>(v, u) * scale
-                                       : static_cast<double>(image.at<std::uint8_t>(v, u));
-      };
-      const double n = at(x - 1, y - 1) - 2 * at(x, y - 1) + at(x + 1, y - 1) - 2 * at(x - 1, y) +
-                       4 * at(x, y) - 2 * at(x + 1, y) + at(x - 1, y + 1) - 2 * at(x, y + 1) +
-                       at(x + 1, y + 1);
-      noise.push_back(static_cast<float>(std::abs(n)));
-    }
-  }
-  if (out.annulusPixels == 0) return out;
+  noise.reserve(out.annulusPixels / 3 + runs.size());
+  if (image.depth() == CV_16U)
+    annulusStatistics<std::uint16_t>(image, gradient, runs, centre, scale, peak, noise);
+  else
+    annulusStatistics<std::uint8_t>(image, gradient, runs, centre, scale, peak, noise);
 
   out.noiseSigma = median(noise) / (0.6745 * 6.0);
   if (low && high) {
@@ -90,13 +137,14 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
     out.lowThreshold = std::max(0.4 * out.highThreshold, 2.5 * sigmaG);
   }
 
-  const cv::Mat edges = cannyFromGradient(gradient, out.lowThreshold, out.highThreshold, mask);
-  for (int y = 0; y < edges.rows; ++y) {
-    const auto* e = edges.ptr<std::uint8_t>(y);
-    for (int x = 0; x < edges.cols; ++x)
+  // Edge pixels can only lie on the runs: visiting them row by row keeps the points in the
+  // image's row-major order.
+  const cv::Mat edges = cannyOnRuns(gradient, out.lowThreshold, out.highThreshold, runs);
+  for (const RowRun& run : runs) {
+    const auto* e = edges.ptr<std::uint8_t>(run.y - crop.y) - crop.x;
+    for (int x = run.x0; x < run.x1; ++x)
       if (e[x])
-        if (auto point = facetEdgePoint(image, cv::Point(x + crop.x, y + crop.y)))
-          out.points.push_back(*point);
+        if (auto point = facetEdgePoint(image, cv::Point(x, run.y))) out.points.push_back(*point);
   }
   return out;
 }
