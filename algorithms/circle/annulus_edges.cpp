@@ -20,46 +20,6 @@ double median(std::vector<float>& v) {
   return v[v.size() / 2];
 }
 
-// The annulus' pixels within [xLo, xHi] x [yLo, yHi] as runs: per row the pixels x with
-// |x - cx| <= outer and not |x - cx| < inner, one run or two around the inner disc. The bounds
-// come from square roots; each is then moved to where the per-pixel test itself changes, so the
-// runs hold exactly the pixels that test accepts.
-RowRuns annulusRuns(cv::Point2d centre, double rIn, double rOut, int xLo, int xHi, int yLo,
-                    int yHi) {
-  RowRuns runs;
-  for (int y = yLo; y <= yHi; ++y) {
-    const double dy = y - centre.y;
-    if (std::abs(dy) > rOut) continue;
-    const double outer = std::sqrt(rOut * rOut - dy * dy);
-    const double inner = std::abs(dy) < rIn ? std::sqrt(rIn * rIn - dy * dy) : -1.0;
-    const int xa = std::max(xLo, static_cast<int>(std::ceil(centre.x - outer)));
-    const int xb = std::min(xHi, static_cast<int>(std::floor(centre.x + outer)));
-    if (xa > xb) continue;
-    auto hole = [&](int x) { return std::abs(x - centre.x) < inner; };
-    // The inner disc's pixels on this row: [h0, h1) (empty when the row misses it).
-    int h0 = static_cast<int>(std::ceil(centre.x - inner)), h1 = h0;
-    if (inner > 0.0) {
-      while (h0 > xa && hole(h0 - 1)) --h0;
-      while (h0 <= xb && !hole(h0) && h0 < centre.x) ++h0;
-      h1 = h0;
-      while (h1 <= xb && hole(h1)) ++h1;
-    }
-    if (h1 == h0) {
-      runs.push_back({y, xa, xb + 1});
-      continue;
-    }
-    if (xa < h0) runs.push_back({y, xa, std::min(h0, xb + 1)});
-    if (h1 <= xb) runs.push_back({y, std::max(h1, xa), xb + 1});
-  }
-  return runs;
-}
-
-// Pixel (x, y) on the 8-bit scale.
-template <typename T>
-double grey(const cv::Mat& image, int x, int y, double scale) {
-  return image.ptr<T>(y)[x] * scale;
-}
-
 // The largest gradient magnitude in each angular sector and Immerkaer's noise response on every
 // third pixel of the annulus.
 template <typename T>
@@ -68,24 +28,34 @@ void annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const
                        std::vector<float>& noise) {
   const int sectors = static_cast<int>(peak.size());
   const cv::Rect crop = gradient.area;
+  std::vector<int> sector;  // of each pixel of a run
   for (const RowRun& run : runs) {
     const int y = run.y;
     const double dy = y - centre.y;
     const float* magnitude = gradient.magnitude.ptr<float>(y - crop.y) - crop.x;
+    // Sector from the "diamond angle" in [0, 4), a monotonic stand-in for atan2; a loop of its
+    // own so that it vectorises.
+    sector.resize(run.x1 - run.x0);
     for (int x = run.x0; x < run.x1; ++x) {
       const double dx = x - centre.x;
-      // Sector from the "diamond angle" in [0, 4), a monotonic stand-in for atan2.
       const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);
       const double turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
-      float& sectorPeak = peak[std::min(sectors - 1, static_cast<int>(turn * sectors))];
+      sector[x - run.x0] = std::min(sectors - 1, static_cast<int>(turn * sectors));
+    }
+    for (int x = run.x0; x < run.x1; ++x) {
+      float& sectorPeak = peak[sector[x - run.x0]];
       sectorPeak = std::max(sectorPeak, magnitude[x]);
-      // Immerkaer's noise mask (its taps' squares sum to 36), on every third pixel: plenty for
-      // a median.
-      if ((x + y) % 3 != 0) continue;
-      auto at = [&](int u, int v) { return grey<T>(image, u, v, scale); };
-      const double n = at(x - 1, y - 1) - 2 * at(x, y - 1) + at(x + 1, y - 1) - 2 * at(x - 1, y) +
-                       4 * at(x, y) - 2 * at(x + 1, y) + at(x - 1, y + 1) - 2 * at(x, y + 1) +
-                       at(x + 1, y + 1);
+    }
+    // Immerkaer's noise mask (its taps' squares sum to 36), on every third pixel: plenty for a
+    // median.
+    const T* above = image.ptr<T>(y - 1);
+    const T* here = image.ptr<T>(y);
+    const T* below = image.ptr<T>(y + 1);
+    for (int x = run.x0 + ((3 - (run.x0 + y) % 3) % 3); x < run.x1; x += 3) {
+      auto at = [&](const T* row, int u) { return row[u] * scale; };
+      const double n = at(above, x - 1) - 2 * at(above, x) + at(above, x + 1) -
+                       2 * at(here, x - 1) + 4 * at(here, x) - 2 * at(here, x + 1) +
+                       at(below, x - 1) - 2 * at(below, x) + at(below, x + 1);
       noise.push_back(static_cast<float>(std::abs(n)));
     }
   }
@@ -109,7 +79,8 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
   // they and their neighbours get a gradient: a thin annulus is a small part of its box.
   const int xLo = std::max(2, crop.x + 2), xHi = std::min(image.cols - 3, crop.br().x - 3);
   const int yLo = std::max(2, crop.y + 2), yHi = std::min(image.rows - 3, crop.br().y - 3);
-  const RowRuns runs = annulusRuns(centre, rIn, rOut, xLo, xHi, yLo, yHi);
+  const RowRuns runs =
+      annulusRowRuns(centre, rIn, rOut, cv::Rect(xLo, yLo, xHi - xLo + 1, yHi - yLo + 1));
   for (const RowRun& run : runs) out.annulusPixels += run.x1 - run.x0;
   if (out.annulusPixels == 0) return out;
 

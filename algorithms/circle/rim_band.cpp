@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <utility>
 
 namespace facet::rim_band {
@@ -16,7 +17,7 @@ double medianOf(std::vector<double> v) {
 // subset of at most kScaleSamples: it only scales the Tukey weight and the sector test, where a
 // few percent do not matter, and the median of all of a big rim's residuals cost a tenth of the
 // measurement.
-double robustSigma(const std::vector<double>& residuals) {
+double robustSigma(std::span<const double> residuals) {
   constexpr std::size_t kScaleSamples = 512;
   const std::size_t stride = std::max<std::size_t>(1, residuals.size() / kScaleSamples);
   std::vector<double> a;
@@ -30,7 +31,7 @@ double robustSigma(const std::vector<double>& residuals) {
 // with the median over all bins, the noise level of a clean rim including the model's own misfit;
 // a bin above it by more than kSectorZ standard errors of a chi-square mean is contaminated.
 std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
-                                           const std::vector<double>& residuals, int bins) {
+                                           std::span<const double> residuals, int bins) {
   constexpr double kSectorZ = 4.0;
   std::vector<double> sum(bins, 0.0), count(bins, 0.0);
   const double cap = 6.0 * robustSigma(residuals);

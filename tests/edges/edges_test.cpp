@@ -318,6 +318,28 @@ TEST(RowRuns, DilationGrowsByOnePixelAndMerges) {
   EXPECT_TRUE(dilateRowRuns({}, cv::Rect(0, 0, 9, 9)).empty());
 }
 
+TEST(RowRuns, AnnulusHoldsExactlyThePixelsOfThePerPixelTest) {
+  cv::RNG rng(5);
+  for (int trial = 0; trial < 200; ++trial) {
+    const cv::Point2d c(rng.uniform(-5.0, 45.0), rng.uniform(-5.0, 45.0));
+    const double rIn = trial % 5 == 0 ? 0.0 : rng.uniform(0.0, 15.0);
+    const double rOut = rIn + rng.uniform(0.5, 12.0);
+    const cv::Rect clip(2, 3, 36, 33);
+    cv::Mat expected = cv::Mat::zeros(40, 40, CV_8U), got = expected.clone();
+    for (int y = clip.y; y < clip.br().y; ++y)
+      for (int x = clip.x; x < clip.br().x; ++x) {
+        const double d = std::hypot(x - c.x, y - c.y);
+        expected.at<uchar>(y, x) = d >= rIn && d <= rOut ? 1 : 0;
+      }
+    for (const RowRun& r : annulusRowRuns(c, rIn, rOut, clip)) {
+      ASSERT_LT(r.x0, r.x1);
+      got.row(r.y).colRange(r.x0, r.x1) += 1;
+    }
+    // Pixels exactly on a circle may fall either way by rounding; none lies there in this draw.
+    ASSERT_EQ(cv::countNonZero(expected != got), 0) << "trial " << trial;
+  }
+}
+
 TEST(SubpixelEdges, DiscIsOneClosedContourAndTheCurvatureCorrectionHelps) {
   SceneSpec spec;
   spec.size = {100, 100};
