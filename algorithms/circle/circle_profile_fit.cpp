@@ -106,6 +106,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // their coordinates and grey values.
   struct BandPixel {
     int column, row, bin;
+    bool narrow;  // within kNarrowBand of the rim
   };
   std::vector<BandPixel> band;
   const double rOut = radius + halfBand, rIn = std::max(0.0, radius - halfBand);
@@ -142,16 +143,29 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     }
   }
   band.reserve(static_cast<std::size_t>(kPi * (rOut * rOut - rIn * rIn) + 4.0 * (rOut + rIn)) + 16);
+  // Bins and the narrow band's test in loops of their own, which vectorise.
+  const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
   std::vector<int> runBins;
+  std::vector<std::uint8_t> runNarrow;
+  std::size_t narrowPixels = 0;
   for (const RowRun& run :
        annulusRowRuns(centre, rIn, rOut, cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1))) {
     const double dy = run.y - centre.y;
     runBins.resize(run.x1 - run.x0);
-    for (int x = run.x0; x < run.x1; ++x) runBins[x - run.x0] = binOf(x - centre.x, dy);
+    runNarrow.resize(run.x1 - run.x0);
+    for (int x = run.x0; x < run.x1; ++x) {
+      const double dx = x - centre.x;
+      runBins[x - run.x0] = binOf(dx, dy);
+      const double rho2 = dx * dx + dy * dy;
+      runNarrow[x - run.x0] = !(rho2 < lo * lo || rho2 > hi * hi);
+    }
     const auto* taint = tainted.empty() ? nullptr : tainted.ptr<std::uint8_t>(run.y - y0) - x0;
     for (int x = run.x0; x < run.x1; ++x) {
       const int bin = runBins[x - run.x0];
-      if (covered[bin] && !(taint && taint[x])) band.push_back({x, run.y, bin});
+      if (!covered[bin] || (taint && taint[x])) continue;
+      const bool narrow = runNarrow[x - run.x0] != 0;
+      band.push_back({x, run.y, bin, narrow});
+      narrowPixels += narrow;
     }
   }
   if (band.size() < 30) return std::nullopt;
@@ -180,12 +194,6 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   constexpr double kTargetSigma = 0.0035;
   bool narrow = false;  // keep the pixels within kNarrowBand of the rim only
   double share = 1.0;   // ... and of their bins this share
-  const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
-  auto inNarrowBand = [&](const BandPixel& e) {
-    const double dx = e.column - centre.x, dy = e.row - centre.y;
-    const double rho2 = dx * dx + dy * dy;
-    return !(rho2 < lo * lo || rho2 > hi * hi);
-  };
   if (noiseSigma > 0.0) {
     const double snr = p(7) / noiseSigma;
     auto needed = [&](double halfWidth) {
@@ -194,15 +202,14 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     };
     if (static_cast<double>(band.size()) > needed(halfBand)) {
       narrow = true;
-      const auto kept = std::count_if(band.begin(), band.end(), inNarrowBand);
-      share = needed(kNarrowBand) / static_cast<double>(kept);
+      share = needed(kNarrowBand) / static_cast<double>(narrowPixels);
     }
   }
   std::vector<Sample> samples;
   samples.reserve(narrow ? static_cast<std::size_t>(std::min(1.0, share) * band.size()) + 64
                          : band.size());
   for (const BandPixel& e : band) {
-    if (narrow && (!inNarrowBand(e) ||
+    if (narrow && (!e.narrow ||
                    (share < 1.0 && std::floor((e.bin + 1) * share) == std::floor(e.bin * share))))
       continue;
     samples.push_back({e.column - centre.x, e.row - centre.y, greyAt(image, e.column, e.row), e.bin,
