@@ -20,6 +20,47 @@ double median(std::vector<float>& v) {
   return v[v.size() / 2];
 }
 
+// The largest gradient magnitude in each angular sector and Immerkaer's noise response on every
+// third pixel of the annulus.
+template <typename T>
+void annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const RowRuns& runs,
+                       cv::Point2d centre, double scale, std::vector<float>& peak,
+                       std::vector<float>& noise) {
+  const int sectors = static_cast<int>(peak.size());
+  const cv::Rect crop = gradient.area;
+  std::vector<int> sector;  // of each pixel of a run
+  for (const RowRun& run : runs) {
+    const int y = run.y;
+    const double dy = y - centre.y;
+    const float* magnitude = gradient.magnitude.ptr<float>(y - crop.y) - crop.x;
+    // Sector from the "diamond angle" in [0, 4), a monotonic stand-in for atan2; a loop of its
+    // own so that it vectorises.
+    sector.resize(run.x1 - run.x0);
+    for (int x = run.x0; x < run.x1; ++x) {
+      const double dx = x - centre.x;
+      const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);
+      const double turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
+      sector[x - run.x0] = std::min(sectors - 1, static_cast<int>(turn * sectors));
+    }
+    for (int x = run.x0; x < run.x1; ++x) {
+      float& sectorPeak = peak[sector[x - run.x0]];
+      sectorPeak = std::max(sectorPeak, magnitude[x]);
+    }
+    // Immerkaer's noise mask (its taps' squares sum to 36), on every third pixel: plenty for a
+    // median.
+    const T* above = image.ptr<T>(y - 1);
+    const T* here = image.ptr<T>(y);
+    const T* below = image.ptr<T>(y + 1);
+    for (int x = run.x0 + ((3 - (run.x0 + y) % 3) % 3); x < run.x1; x += 3) {
+      auto at = [&](const T* row, int u) { return row[u] * scale; };
+      const double n = at(above, x - 1) - 2 * at(above, x) + at(above, x + 1) -
+                       2 * at(here, x - 1) + 4 * at(here, x) - 2 * at(here, x + 1) +
+                       at(below, x - 1) - 2 * at(below, x) + at(below, x + 1);
+      noise.push_back(static_cast<float>(std::abs(n)));
+    }
+  }
+}
+
 }  // namespace
 
 AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double rIn, double rOut,
@@ -34,47 +75,24 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
   const cv::Rect crop = box & cv::Rect(0, 0, image.cols, image.rows);
   if (crop.width < 5 || crop.height < 5) return out;
 
-  // Annulus pixels that carry a full 5x5 window inside the image (and inside the crop).
-  cv::Mat mask = cv::Mat::zeros(crop.size(), CV_8U);
+  // Annulus pixels that carry a full 5x5 window inside the image (and inside the crop). Only
+  // they and their neighbours get a gradient: a thin annulus is a small part of its box.
   const int xLo = std::max(2, crop.x + 2), xHi = std::min(image.cols - 3, crop.br().x - 3);
   const int yLo = std::max(2, crop.y + 2), yHi = std::min(image.rows - 3, crop.br().y - 3);
+  const RowRuns runs =
+      annulusRowRuns(centre, rIn, rOut, cv::Rect(xLo, yLo, xHi - xLo + 1, yHi - yLo + 1));
+  for (const RowRun& run : runs) out.annulusPixels += run.x1 - run.x0;
+  if (out.annulusPixels == 0) return out;
+
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
   const int sectors = std::clamp(static_cast<int>(2.0 * std::numbers::pi * rOut / 6.0), 8, 120);
-  const EdgeGradient gradient = computeEdgeGradient(image, crop);
+  const EdgeGradient gradient = computeEdgeGradientOnRuns(image, crop, runs);
   std::vector<float> noise, peak(sectors, 0.0f);
-  for (int y = yLo; y <= yHi; ++y) {
-    const double dy = y - centre.y;
-    if (std::abs(dy) > rOut) continue;
-    const double outer = std::sqrt(rOut * rOut - dy * dy);
-    const double inner = std::abs(dy) < rIn ? std::sqrt(rIn * rIn - dy * dy) : -1.0;
-    auto* row = mask.ptr<std::uint8_t>(y - crop.y);
-    const float* magnitude = gradient.magnitude.ptr<float>(y - crop.y) - crop.x;
-    const int xa = std::max(xLo, static_cast<int>(std::ceil(centre.x - outer)));
-    const int xb = std::min(xHi, static_cast<int>(std::floor(centre.x + outer)));
-    for (int x = xa; x <= xb; ++x) {
-      const double dx = x - centre.x;
-      if (std::abs(dx) < inner) continue;
-      row[x - crop.x] = 255;
-      ++out.annulusPixels;
-      // Sector from the "diamond angle" in [0, 4), a monotonic stand-in for atan2.
-      const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);
-      const double turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
-      float& sectorPeak = peak[std::min(sectors - 1, static_cast<int>(turn * sectors))];
-      sectorPeak = std::max(sectorPeak, magnitude[x]);
-      // Immerkaer's noise mask (its taps' squares sum to 36), on every third pixel: plenty for
-      // a median.
-      if ((x + y) % 3 != 0) continue;
-      auto at = [&](int u, int v) {
-        return image.depth() == CV_16U ? image.at<std::uint16_t>(v, u) * scale
-                                       : static_cast<double>(image.at<std::uint8_t>(v, u));
-      };
-      const double n = at(x - 1, y - 1) - 2 * at(x, y - 1) + at(x + 1, y - 1) - 2 * at(x - 1, y) +
-                       4 * at(x, y) - 2 * at(x + 1, y) + at(x - 1, y + 1) - 2 * at(x, y + 1) +
-                       at(x + 1, y + 1);
-      noise.push_back(static_cast<float>(std::abs(n)));
-    }
-  }
-  if (out.annulusPixels == 0) return out;
+  noise.reserve(out.annulusPixels / 3 + runs.size());
+  if (image.depth() == CV_16U)
+    annulusStatistics<std::uint16_t>(image, gradient, runs, centre, scale, peak, noise);
+  else
+    annulusStatistics<std::uint8_t>(image, gradient, runs, centre, scale, peak, noise);
 
   out.noiseSigma = median(noise) / (0.6745 * 6.0);
   if (low && high) {
@@ -90,13 +108,14 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
     out.lowThreshold = std::max(0.4 * out.highThreshold, 2.5 * sigmaG);
   }
 
-  const cv::Mat edges = cannyFromGradient(gradient, out.lowThreshold, out.highThreshold, mask);
-  for (int y = 0; y < edges.rows; ++y) {
-    const auto* e = edges.ptr<std::uint8_t>(y);
-    for (int x = 0; x < edges.cols; ++x)
+  // Edge pixels can only lie on the runs: visiting them row by row keeps the points in the
+  // image's row-major order.
+  const cv::Mat edges = cannyOnRuns(gradient, out.lowThreshold, out.highThreshold, runs);
+  for (const RowRun& run : runs) {
+    const auto* e = edges.ptr<std::uint8_t>(run.y - crop.y) - crop.x;
+    for (int x = run.x0; x < run.x1; ++x)
       if (e[x])
-        if (auto point = facetEdgePoint(image, cv::Point(x + crop.x, y + crop.y)))
-          out.points.push_back(*point);
+        if (auto point = facetEdgePoint(image, cv::Point(x, run.y))) out.points.push_back(*point);
   }
   return out;
 }

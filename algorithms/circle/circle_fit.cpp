@@ -14,27 +14,21 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 // Weighted geometric (orthogonal distance) fit by Levenberg-Marquardt: minimises
-// sum w_i (|p_i - c| - R)^2 over (cx, cy, R).
+// sum w_i (|p_i - c| - R)^2 over (cx, cy, R). The offsets and distances of a trial are kept for
+// the normal equations at it once it is accepted: one pass of square roots per iteration.
 class GeometricCircleFit {
  public:
   GeometricCircleFit(const std::vector<Eigen::Vector2d>& pts, const std::vector<double>& w)
-      : pts_(pts), w_(w) {}
+      : pts_(pts), w_(w), current_(pts.size()), trial_(pts.size()) {}
 
-  double cost(const Eigen::Vector3d& x) const {
-    double s = 0;
-    for (std::size_t i = 0; i < pts_.size(); ++i) {
-      const double r = (pts_[i] - x.head<2>()).norm() - x.z();
-      s += w_[i] * r * r;
-    }
-    return s;
-  }
+  double cost(const Eigen::Vector3d& x) { return evaluate(x, current_); }
   void normalEquations(int, const Eigen::Vector3d& x, Eigen::Matrix3d& jtj, Eigen::Vector3d& jtr,
                        double&) const {
     jtj.setZero();
     jtr.setZero();
     for (std::size_t i = 0; i < pts_.size(); ++i) {
-      const Eigen::Vector2d d = pts_[i] - x.head<2>();
-      const double n = d.norm();
+      const Eigen::Vector2d& d = current_[i].offset;
+      const double n = current_[i].distance;
       if (n < 1e-12 || w_[i] == 0.0) continue;
       const Eigen::Vector3d j{-d.x() / n, -d.y() / n, -1.0};
       const double r = n - x.z();
@@ -42,15 +36,31 @@ class GeometricCircleFit {
       jtr.noalias() += w_[i] * j * r;
     }
   }
-  std::optional<double> trialCost(const Eigen::Vector3d& x) const { return cost(x); }
-  void accept() {}
+  std::optional<double> trialCost(const Eigen::Vector3d& x) { return evaluate(x, trial_); }
+  void accept() { std::swap(current_, trial_); }
   bool converged(int, const Eigen::Vector3d& step) const {
     return step.norm() < 1e-5;  // pixels: far below the accuracy sought
   }
 
  private:
+  struct Offset {
+    Eigen::Vector2d offset;  // p_i - c
+    double distance = 0;     // |p_i - c|
+  };
+  double evaluate(const Eigen::Vector3d& x, std::vector<Offset>& out) const {
+    double s = 0;
+    for (std::size_t i = 0; i < pts_.size(); ++i) {
+      out[i].offset = pts_[i] - x.head<2>();
+      out[i].distance = out[i].offset.norm();
+      const double r = out[i].distance - x.z();
+      s += w_[i] * r * r;
+    }
+    return s;
+  }
+
   const std::vector<Eigen::Vector2d>& pts_;
   const std::vector<double>& w_;
+  std::vector<Offset> current_, trial_;
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "algorithms/circle/rim_band.hpp"
+#include "algorithms/edges/row_runs.hpp"
 #include "algorithms/geometry/levenberg_marquardt.hpp"
 
 namespace facet {
@@ -30,6 +31,7 @@ using rim_band::Sample;
 
 using Vector8 = Eigen::Matrix<double, 8, 1>;
 using Matrix8 = Eigen::Matrix<double, 8, 8>;
+using Columns = Eigen::Matrix<double, Eigen::Dynamic, 8>;
 
 // A monotonic stand-in for the polar angle, in [0, 4) (no atan2 in the pixel loops); bins of
 // equal width in it are within a factor 1.5 of equal angles.
@@ -99,8 +101,14 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const double halfBand = smallRim ? 8.0 : 6.0;
   constexpr double kNarrowBand = 4.0;
 
-  // The band |rho - R| <= halfBand inside the image.
-  std::vector<Sample> samples;
+  // The band |rho - R| <= halfBand inside the image, first as pixels and bins only: a big rim's
+  // band holds several times the pixels the fit keeps (the thinning below), and only those need
+  // their coordinates and grey values.
+  struct BandPixel {
+    int column, row, bin;
+    bool narrow;  // within kNarrowBand of the rim
+  };
+  std::vector<BandPixel> band;
   const double rOut = radius + halfBand, rIn = std::max(0.0, radius - halfBand);
   const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - rOut)));
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
@@ -134,36 +142,44 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
             tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
     }
   }
-  for (int y = y0; y <= y1; ++y) {
-    const double dy = y - centre.y;
-    if (dy * dy > rOut * rOut) continue;
-    // The row meets the band in up to two runs: |dx| in [inner, outer].
-    const double outer = std::sqrt(rOut * rOut - dy * dy);
-    const double inner = dy * dy < rIn * rIn ? std::sqrt(rIn * rIn - dy * dy) : 0.0;
-    const int xa = std::max(x0, static_cast<int>(std::ceil(centre.x - outer)));
-    const int xb = std::min(x1, static_cast<int>(std::floor(centre.x + outer)));
-    for (int x = xa; x <= xb; ++x) {
+  band.reserve(static_cast<std::size_t>(kPi * (rOut * rOut - rIn * rIn) + 4.0 * (rOut + rIn)) + 16);
+  // Bins and the narrow band's test in loops of their own, which vectorise.
+  const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
+  std::vector<int> runBins;
+  std::vector<std::uint8_t> runNarrow;
+  std::size_t narrowPixels = 0;
+  for (const RowRun& run :
+       annulusRowRuns(centre, rIn, rOut, cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1))) {
+    const double dy = run.y - centre.y;
+    runBins.resize(run.x1 - run.x0);
+    runNarrow.resize(run.x1 - run.x0);
+    for (int x = run.x0; x < run.x1; ++x) {
       const double dx = x - centre.x;
-      if (std::abs(dx) < inner) {
-        x = static_cast<int>(std::ceil(centre.x + inner)) - 1;  // jump over the inner disc
-        continue;
-      }
-      const int bin = binOf(dx, dy);
-      if (!covered[bin] || (!tainted.empty() && tainted.at<std::uint8_t>(y - y0, x - x0))) continue;
-      samples.push_back({dx, dy, greyAt(image, x, y), bin, x, y});
+      runBins[x - run.x0] = binOf(dx, dy);
+      const double rho2 = dx * dx + dy * dy;
+      runNarrow[x - run.x0] = !(rho2 < lo * lo || rho2 > hi * hi);
+    }
+    const auto* taint = tainted.empty() ? nullptr : tainted.ptr<std::uint8_t>(run.y - y0) - x0;
+    for (int x = run.x0; x < run.x1; ++x) {
+      const int bin = runBins[x - run.x0];
+      if (!covered[bin] || (taint && taint[x])) continue;
+      const bool narrow = runNarrow[x - run.x0] != 0;
+      band.push_back({x, run.y, bin, narrow});
+      narrowPixels += narrow;
     }
   }
-  if (samples.size() < 30) return std::nullopt;
+  if (band.size() < 30) return std::nullopt;
 
   // Start: outside and inside levels from the band's two halves, blur 1.2 px, no ramp.
   // Every few pixels suffice for a starting level (a big rim's band has thousands).
   std::vector<double> inside, outside;
-  const std::size_t levelStride = std::max<std::size_t>(1, samples.size() / 1024);
-  for (std::size_t i = 0; i < samples.size(); i += levelStride) {
-    const Sample& e = samples[i];
-    const double d = std::sqrt(e.x * e.x + e.y * e.y) - radius;
-    if (d < -2.0) inside.push_back(e.grey);
-    if (d > 2.0) outside.push_back(e.grey);
+  const std::size_t levelStride = std::max<std::size_t>(1, band.size() / 1024);
+  for (std::size_t i = 0; i < band.size(); i += levelStride) {
+    const BandPixel& e = band[i];
+    const double dx = e.column - centre.x, dy = e.row - centre.y;
+    const double d = std::sqrt(dx * dx + dy * dy) - radius;
+    if (d < -2.0) inside.push_back(greyAt(image, e.column, e.row));
+    if (d > 2.0) outside.push_back(greyAt(image, e.column, e.row));
   }
   if (inside.empty() || outside.empty()) return std::nullopt;
   Vector8 p;
@@ -176,24 +192,30 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // bounds the time of big, high-contrast circles and keeps every pixel of faint ones. When
   // pixels are to spare, the narrower band goes first: its pixels carry more about the rim.
   constexpr double kTargetSigma = 0.0035;
+  bool narrow = false;  // keep the pixels within kNarrowBand of the rim only
+  double share = 1.0;   // ... and of their bins this share
   if (noiseSigma > 0.0) {
     const double snr = p(7) / noiseSigma;
-    auto needed = [&](double band) {
-      const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * band);
+    auto needed = [&](double halfWidth) {
+      const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * halfWidth);
       return std::max(1000.0, 1.0 / (kTargetSigma * kTargetSigma * infoPerPixel));
     };
-    if (static_cast<double>(samples.size()) > needed(halfBand)) {
-      const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
-      std::erase_if(samples, [&](const Sample& e) {
-        const double rho2 = e.x * e.x + e.y * e.y;
-        return rho2 < lo * lo || rho2 > hi * hi;
-      });
-      const double share = needed(kNarrowBand) / static_cast<double>(samples.size());
-      if (share < 1.0)
-        std::erase_if(samples, [&](const Sample& e) {
-          return std::floor((e.bin + 1) * share) == std::floor(e.bin * share);
-        });
+    if (static_cast<double>(band.size()) > needed(halfBand)) {
+      narrow = true;
+      share = needed(kNarrowBand) / static_cast<double>(narrowPixels);
     }
+  }
+  std::vector<Sample> samples;
+  samples.reserve(narrow ? static_cast<std::size_t>(std::min(1.0, share) * band.size()) + 64
+                         : band.size());
+  for (const BandPixel& e : band) {
+    if (narrow && (!e.narrow ||
+                   (share < 1.0 && std::floor((e.bin + 1) * share) == std::floor(e.bin * share))))
+      continue;
+    samples.push_back({e.column - centre.x, e.row - centre.y, greyAt(image, e.column, e.row), e.bin,
+                       e.column, e.row});
+  }
+  if (noiseSigma > 0.0) {
     // After the thinning, so that a big rim pays only for the pixels it keeps.
     dropForeignGradients(samples, image, centre, radius, noiseSigma,
                          cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
@@ -206,53 +228,78 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // that was 2-5% of the precision). Without a noise level there is no screen: the usual value.
   const double tukeyC = noiseSigma > 0.0 ? 8.0 : 4.685;
 
-  // One pass over the band at parameters q: residuals (grey - model) and Jacobian rows.
+  // One pass over the band at parameters q: residuals (grey - model) and the Jacobian. The band
+  // and the Jacobian are kept in columns, one per coordinate or parameter, so that the passes
+  // vectorise; the Jacobian's columns of the levels and the ramp (1, x, y) never change.
   std::size_t m = samples.size();
-  std::vector<double> r(m), rTry(m), weight(m, 1.0);
-  std::vector<Vector8> jac(m), jacTry(m);
-  auto evaluate = [&](const Vector8& q, std::vector<double>& res, std::vector<Vector8>& j) {
-    const double s = q(3), inv = 1.0 / s, norm = 1.0 / (std::sqrt(2.0 * kPi) * s);
-    for (std::size_t i = 0; i < m; ++i) {
-      const Sample& e = samples[i];
-      const double ex = e.x - q(0), ey = e.y - q(1);
-      const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
-      const double z = (rho - q(2)) * inv;
-      const double gauss = std::exp(-0.5 * z * z);
-      const double phi = upperTail(z, gauss);  // Phi(-d / s)
-      const double bg = q(7) * norm * gauss;   // b * pdf(d; s)
-      res[i] = e.grey - (q(4) + q(5) * e.x + q(6) * e.y + q(7) * phi);
-      // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
-      j[i] << bg * ex / rho, bg * ey / rho, bg, bg * z, 1.0, e.x, e.y, phi;
+  Eigen::VectorXd px, py, grey, r, rTry, weight;
+  Columns jac, jacTry, weighted;
+  auto loadBand = [&] {
+    const auto n = static_cast<Eigen::Index>(m);
+    px.resize(n);
+    py.resize(n);
+    grey.resize(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      px(i) = samples[i].x;
+      py(i) = samples[i].y;
+      grey(i) = samples[i].grey;
+    }
+    r.resize(n);
+    rTry.resize(n);
+    weight.setOnes(n);
+    for (Columns* j : {&jac, &jacTry}) {
+      j->resize(n, 8);
+      j->col(4).setOnes();
+      j->col(5) = px;
+      j->col(6) = py;
     }
   };
-  auto cost = [&](const std::vector<double>& res) {
-    double c = 0;
-    for (std::size_t i = 0; i < m; ++i) c += weight[i] * res[i] * res[i];
-    return c;
+  loadBand();
+  auto evaluate = [&](const Vector8& q, Eigen::VectorXd& res, Columns& j) {
+    const double s = q(3), inv = 1.0 / s, norm = 1.0 / (std::sqrt(2.0 * kPi) * s);
+    const auto n = static_cast<Eigen::Index>(m);
+    const double* x = px.data();
+    const double* y = py.data();
+    const double* g = grey.data();
+    double* out = res.data();
+    double* cx = j.col(0).data();  // dI/dcx, after the first pass ex / rho
+    double* cy = j.col(1).data();  // dI/dcy, after the first pass ey / rho
+    double* cr = j.col(2).data();  // dI/dR, after the second pass the Gaussian
+    double* cs = j.col(3).data();  // dI/ds, after the first pass z
+    double* cb = j.col(7).data();  // dI/db
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double ex = x[i] - q(0), ey = y[i] - q(1);
+      const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
+      cx[i] = ex / rho;
+      cy[i] = ey / rho;
+      cs[i] = (rho - q(2)) * inv;
+    }
+    for (Eigen::Index i = 0; i < n; ++i) cr[i] = std::exp(-0.5 * cs[i] * cs[i]);
+    for (Eigen::Index i = 0; i < n; ++i) {
+      const double z = cs[i], gauss = cr[i];
+      const double phi = upperTail(z, gauss);  // Phi(-d / s)
+      const double bg = q(7) * norm * gauss;   // b * pdf(d; s)
+      out[i] = g[i] - (q(4) + q(5) * x[i] + q(6) * y[i] + q(7) * phi);
+      // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
+      cx[i] *= bg;
+      cy[i] *= bg;
+      cr[i] = bg;
+      cs[i] = bg * z;
+      cb[i] = phi;
+    }
+  };
+  auto cost = [&](const Eigen::VectorXd& res) {
+    return (weight.array() * res.array().square()).sum();
   };
   Matrix8 jtj;
   Vector8 jtr;
   auto normalEquations = [&] {
-    jtj.setZero();
-    jtr.setZero();
-    double h[8][8] = {}, g[8] = {};
-    for (std::size_t i = 0; i < m; ++i) {
-      const double w = weight[i];
-      if (w == 0.0) continue;
-      const double* j = jac[i].data();
-      for (int u = 0; u < 8; ++u) {
-        const double wu = w * j[u];
-        g[u] += wu * r[i];
-        for (int v = 0; v <= u; ++v) h[u][v] += wu * j[v];
-      }
-    }
-    for (int u = 0; u < 8; ++u) {
-      jtr(u) = g[u];
-      for (int v = 0; v <= u; ++v) jtj(u, v) = jtj(v, u) = h[u][v];
-    }
+    weighted = jac.array().colwise() * weight.array();
+    jtj.noalias() = weighted.transpose() * jac;
+    jtr.noalias() = weighted.transpose() * r;
   };
   auto tukeyWeights = [&] {
-    const double sigma = std::max(robustSigma(r), 0.25);
+    const double sigma = std::max(robustSigma({r.data(), m}), 0.25);
     const double c = tukeyC * sigma;
     for (std::size_t i = 0; i < m; ++i) {
       const double u = std::abs(r[i]) / c;
@@ -341,7 +388,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // each of its pixels stays within the Tukey weight's reach. The refit only pays when the
   // flagged sectors hold a noticeable share of the pixels: a stray bin of a long rim (chance, or a
   // blob on a big circle) moves the centre by far less than the bound and would cost a solve.
-  const std::vector<std::uint8_t> bad = contaminatedBins(samples, r, bins);
+  const std::vector<std::uint8_t> bad = contaminatedBins(samples, {r.data(), m}, bins);
   std::size_t kept = 0;
   for (std::size_t i = 0; i < m; ++i)
     if (!bad[samples[i].bin]) ++kept;
@@ -352,11 +399,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       if (!bad[samples[i].bin]) samples[kept++] = samples[i];
     samples.resize(kept);
     m = kept;
-    r.resize(m);
-    rTry.resize(m);
-    jac.resize(m);
-    jacTry.resize(m);
-    weight.assign(m, 1.0);
+    loadBand();
     if (!solve({true, true, true, true, true, withRamp, withRamp, true}, 10, true))
       return std::nullopt;
   }

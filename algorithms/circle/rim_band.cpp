@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <utility>
 
 namespace facet::rim_band {
@@ -16,7 +17,7 @@ double medianOf(std::vector<double> v) {
 // subset of at most kScaleSamples: it only scales the Tukey weight and the sector test, where a
 // few percent do not matter, and the median of all of a big rim's residuals cost a tenth of the
 // measurement.
-double robustSigma(const std::vector<double>& residuals) {
+double robustSigma(std::span<const double> residuals) {
   constexpr std::size_t kScaleSamples = 512;
   const std::size_t stride = std::max<std::size_t>(1, residuals.size() / kScaleSamples);
   std::vector<double> a;
@@ -30,7 +31,7 @@ double robustSigma(const std::vector<double>& residuals) {
 // with the median over all bins, the noise level of a clean rim including the model's own misfit;
 // a bin above it by more than kSectorZ standard errors of a chi-square mean is contaminated.
 std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
-                                           const std::vector<double>& residuals, int bins) {
+                                           std::span<const double> residuals, int bins) {
   constexpr double kSectorZ = 4.0;
   std::vector<double> sum(bins, 0.0), count(bins, 0.0);
   const double cap = 6.0 * robustSigma(residuals);
@@ -52,6 +53,55 @@ std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
   return bad;
 }
 
+namespace {
+
+// The 3x3 Sobel gradient (divided by 8: unit gain) at pixel (x, y), on the 8-bit scale.
+template <typename T>
+cv::Point2d sobel3(const cv::Mat& image, int x, int y, double scale) {
+  const T* a = image.ptr<T>(y - 1) + x;
+  const T* b = image.ptr<T>(y) + x;
+  const T* c = image.ptr<T>(y + 1) + x;
+  auto at = [&](const T* row, int dx) { return row[dx] * scale; };
+  const double gx =
+      (at(a, 1) + 2.0 * at(b, 1) + at(c, 1) - at(a, -1) - 2.0 * at(b, -1) - at(c, -1)) / 8.0;
+  const double gy =
+      (at(c, -1) + 2.0 * at(c, 0) + at(c, 1) - at(a, -1) - 2.0 * at(a, 0) - at(a, 1)) / 8.0;
+  return {gx, gy};
+}
+
+template <typename T>
+void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d centre,
+                 double radius, double noiseSigma, cv::Rect box, double scale) {
+  constexpr double kGradientZ = 4.0;
+  constexpr double kFlatZone = 3.0;  // pixels from the rim: the blurred edge's slope is < 1% there
+  // The 3x3 Sobel divided by 8 is a unit-gain derivative; its noise is sqrt(12) / 8 of the pixels'.
+  const double limit = kGradientZ * noiseSigma * std::sqrt(12.0) / 8.0;
+  // The flag map only when some pixel is foreign: a clean rim needs none.
+  cv::Mat flagged;
+  for (const Sample& e : samples) {
+    const int x = e.column, y = e.row;
+    if (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1) continue;
+    const cv::Point2d g = sobel3<T>(image, x, y, scale);
+    const double dx = x - centre.x, dy = y - centre.y;
+    const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
+    const double tangential = (g.y * dx - g.x * dy) / rho;
+    const bool foreign = std::abs(rho - radius) > kFlatZone ? g.x * g.x + g.y * g.y > limit * limit
+                                                            : std::abs(tangential) > limit;
+    if (!foreign) continue;
+    if (flagged.empty())
+      flagged = cv::Mat::zeros(box.height + 2, box.width + 2, CV_8U);  // 1 px margin
+    for (int v = -1; v <= 1; ++v)
+      for (int u = -1; u <= 1; ++u)
+        flagged.at<std::uint8_t>(y - box.y + 1 + v, x - box.x + 1 + u) = 1;
+  }
+  if (flagged.empty()) return;
+  std::erase_if(samples, [&](const Sample& e) {
+    return flagged.at<std::uint8_t>(e.row - box.y + 1, e.column - box.x + 1) != 0;
+  });
+}
+
+}  // namespace
+
 // Removes the samples whose pixel, or a neighbour among the samples, has a grey-value gradient
 // the blurred rim cannot explain. The rim's gradient is radial, and more than kFlatZone px from
 // the rim the model is flat but for the illumination ramp (below 1 grey level per pixel); so a
@@ -64,37 +114,10 @@ std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
 // tail is still a few grey levels high where its gradient has sunk into the noise.
 void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d centre,
                           double radius, double noiseSigma, cv::Rect box) {
-  constexpr double kGradientZ = 4.0;
-  constexpr double kFlatZone = 3.0;  // pixels from the rim: the blurred edge's slope is < 1% there
-  // The 3x3 Sobel divided by 8 is a unit-gain derivative; its noise is sqrt(12) / 8 of the pixels'.
-  const double limit = kGradientZ * noiseSigma * std::sqrt(12.0) / 8.0;
-  auto at = [&](int x, int y) { return greyAt(image, x, y); };
-  cv::Mat flagged = cv::Mat::zeros(box.height + 2, box.width + 2, CV_8U);  // 1 px margin
-  bool any = false;
-  for (const Sample& e : samples) {
-    const int x = e.column, y = e.row;
-    if (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1) continue;
-    const double gx = (at(x + 1, y - 1) + 2.0 * at(x + 1, y) + at(x + 1, y + 1) - at(x - 1, y - 1) -
-                       2.0 * at(x - 1, y) - at(x - 1, y + 1)) /
-                      8.0;
-    const double gy = (at(x - 1, y + 1) + 2.0 * at(x, y + 1) + at(x + 1, y + 1) - at(x - 1, y - 1) -
-                       2.0 * at(x, y - 1) - at(x + 1, y - 1)) /
-                      8.0;
-    const double dx = x - centre.x, dy = y - centre.y;
-    const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
-    const double tangential = (gy * dx - gx * dy) / rho;
-    const bool foreign = std::abs(rho - radius) > kFlatZone ? gx * gx + gy * gy > limit * limit
-                                                            : std::abs(tangential) > limit;
-    if (!foreign) continue;
-    any = true;
-    for (int v = -1; v <= 1; ++v)
-      for (int u = -1; u <= 1; ++u)
-        flagged.at<std::uint8_t>(y - box.y + 1 + v, x - box.x + 1 + u) = 1;
-  }
-  if (!any) return;
-  std::erase_if(samples, [&](const Sample& e) {
-    return flagged.at<std::uint8_t>(e.row - box.y + 1, e.column - box.x + 1) != 0;
-  });
+  if (image.depth() == CV_16U)
+    dropForeign<std::uint16_t>(samples, image, centre, radius, noiseSigma, box, 1.0 / 256.0);
+  else
+    dropForeign<std::uint8_t>(samples, image, centre, radius, noiseSigma, box, 1.0);
 }
 
 }  // namespace facet::rim_band

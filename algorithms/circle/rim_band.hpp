@@ -3,6 +3,7 @@
 // the screens that keep pixels of foreign objects (clutter, occluders) out of that fit.
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -27,11 +28,11 @@ inline double greyAt(const cv::Mat& image, int x, int y) {
 double medianOf(std::vector<double> v);
 
 // Robust sigma (1.4826 x median absolute value) of residuals around zero.
-double robustSigma(const std::vector<double>& residuals);
+double robustSigma(std::span<const double> residuals);
 
 // Angular bins whose grey residuals are too large for the noise (1 = contaminated).
 std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
-                                           const std::vector<double>& residuals, int bins);
+                                           std::span<const double> residuals, int bins);
 
 // Removes the samples whose pixel, or a neighbour among the samples, has a grey-value gradient
 // the blurred rim around `centre` with `radius` cannot explain. `box` holds every sample's pixel.

@@ -36,34 +36,77 @@ void magnitudeOf(const cv::Mat& gx, const cv::Mat& gy, float scale, cv::Mat& mag
   }
 }
 
-// Non-maximum suppression along the image axis nearest to the gradient, then hysteresis.
-// Ties are broken towards the left/upper pixel so that a plateau of two equal magnitudes yields
-// one pixel. state: 0 = no, 1 = candidate, 2 = edge.
+// Non-maximum suppression along the image axis nearest to the gradient, on the pixels
+// xBegin <= x < xEnd of row y (coordinates of the gradient's area, whose maps start at row
+// gradientRow0 of it). Ties are broken towards the left/upper pixel so that a plateau of two equal
+// magnitudes yields one pixel. state: 0 = no, 1 = candidate, 2 = edge.
 template <typename T>
-void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask, cv::Rect area,
-              int gradientRow0, cv::Mat& state, std::vector<cv::Point>& strong) {
+void suppressRow(const EdgeGradient& g, float low, float high, const uchar* mask, int y, int xBegin,
+                 int xEnd, int gradientRow0, cv::Mat& state, std::vector<cv::Point>& strong) {
   // Signed: m[x - step] with an unsigned step wraps around before the pointer addition, which is
   // undefined behaviour (UBSan's pointer-overflow check) even though it lands on the row above.
   const auto step = static_cast<std::ptrdiff_t>(g.magnitude.step1());
-  for (int y = area.y; y < area.y + area.height; ++y) {
-    const int gy0 = y - gradientRow0;  // the gradient maps may cover a strip only
-    const float* m = g.magnitude.ptr<float>(gy0);
-    const T* gx = g.gx.ptr<T>(gy0);
-    const T* gy = g.gy.ptr<T>(gy0);
-    const uchar* k = mask.empty() ? nullptr : mask.ptr<uchar>(y);
-    uchar* s = state.ptr<uchar>(y);
-    for (int x = area.x; x < area.x + area.width; ++x) {
-      const float v = m[x];
-      if (v < low || (k && !k[x])) continue;
-      const bool horizontal = std::abs(gx[x]) >= std::abs(gy[x]);
-      const float before = horizontal ? m[x - 1] : m[x - step];
-      const float after = horizontal ? m[x + 1] : m[x + step];
-      if (!(v > before && v >= after)) continue;
-      s[x] = 1;
-      if (v >= high) {
-        s[x] = 2;
-        strong.emplace_back(x, y);
-      }
+  const int gy0 = y - gradientRow0;  // the gradient maps may cover a strip only
+  const float* m = g.magnitude.ptr<float>(gy0);
+  const T* gx = g.gx.ptr<T>(gy0);
+  const T* gy = g.gy.ptr<T>(gy0);
+  uchar* s = state.ptr<uchar>(y);
+  for (int x = xBegin; x < xEnd; ++x) {
+    const float v = m[x];
+    if (v < low || (mask && !mask[x])) continue;
+    const bool horizontal = std::abs(gx[x]) >= std::abs(gy[x]);
+    const float before = horizontal ? m[x - 1] : m[x - step];
+    const float after = horizontal ? m[x + 1] : m[x + step];
+    if (!(v > before && v >= after)) continue;
+    s[x] = 1;
+    if (v >= high) {
+      s[x] = 2;
+      strong.emplace_back(x, y);
+    }
+  }
+}
+
+template <typename T>
+void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask, cv::Rect area,
+              int gradientRow0, cv::Mat& state, std::vector<cv::Point>& strong) {
+  for (int y = area.y; y < area.y + area.height; ++y)
+    suppressRow<T>(g, low, high, mask.empty() ? nullptr : mask.ptr<uchar>(y), y, area.x,
+                   area.x + area.width, gradientRow0, state, strong);
+}
+
+// The 5x5 Sobel derivatives and the magnitude at the pixels of `runs` (image coordinates, inside
+// g.area), separably: the vertical passes of the run's columns (two more either side), then the
+// horizontal ones. Integer sums, so equal to cv::Sobel's (CV_16S for 8-bit input; CV_32F for
+// 16-bit input, exact there too: every partial sum stays below 2^24). The image border is
+// replicated, as computeEdgeGradient does.
+template <typename T, typename D>
+void gradientOnRuns(const cv::Mat& image, const RowRuns& runs, EdgeGradient& g) {
+  const float scale = static_cast<float>(g.scale);
+  std::vector<int> smooth, deriv;
+  for (const RowRun& run : runs) {
+    if (run.x0 >= run.x1) continue;
+    const T* r[5];
+    for (int j = 0; j < 5; ++j) r[j] = image.ptr<T>(std::clamp(run.y - 2 + j, 0, image.rows - 1));
+    const int n = run.x1 - run.x0 + 4;
+    smooth.resize(n);
+    deriv.resize(n);
+    for (int i = 0; i < n; ++i) {
+      const int x = std::clamp(run.x0 - 2 + i, 0, image.cols - 1);
+      const int a = r[0][x], b = r[1][x], c = r[2][x], d = r[3][x], e = r[4][x];
+      smooth[i] = a + 4 * b + 6 * c + 4 * d + e;
+      deriv[i] = e - a + 2 * (d - b);
+    }
+    const int row = run.y - g.area.y;
+    D* gx = g.gx.ptr<D>(row) - g.area.x;
+    D* gy = g.gy.ptr<D>(row) - g.area.x;
+    float* mag = g.magnitude.ptr<float>(row) - g.area.x;
+    const int* s = smooth.data() + 2 - run.x0;  // s[x]: the vertical pass of column x
+    const int* d = deriv.data() + 2 - run.x0;
+    for (int x = run.x0; x < run.x1; ++x) {
+      gx[x] = static_cast<D>(s[x + 2] - s[x - 2] + 2 * (s[x + 1] - s[x - 1]));
+      gy[x] = static_cast<D>(d[x - 2] + 4 * d[x - 1] + 6 * d[x] + 4 * d[x + 1] + d[x + 2]);
+      const float fa = static_cast<float>(gx[x]), fb = static_cast<float>(gy[x]);
+      mag[x] = scale * std::sqrt(fa * fa + fb * fb);
     }
   }
 }
@@ -119,6 +162,47 @@ EdgeGradient computeEdgeGradient(const cv::Mat& image, cv::Rect area) {
   else
     magnitudeOf<float>(g.gx, g.gy, static_cast<float>(g.scale), g.magnitude);
   return g;
+}
+
+EdgeGradient computeEdgeGradientOnRuns(const cv::Mat& image, cv::Rect area, const RowRuns& runs) {
+  requireGreyImage(image);
+  EdgeGradient g;
+  g.area = area & cv::Rect(0, 0, image.cols, image.rows);
+  if (g.area.empty()) return g;
+  const bool eightBit = image.depth() == CV_8U;
+  g.scale = (eightBit ? 1.0 : 1.0 / 256.0) / kSobelGain;
+  const int type = eightBit ? CV_16S : CV_32F;
+  g.gx.create(g.area.size(), type);
+  g.gy.create(g.area.size(), type);
+  g.magnitude.create(g.area.size(), CV_32F);
+  const RowRuns grown = dilateRowRuns(runs, g.area);
+  if (eightBit)
+    gradientOnRuns<uchar, short>(image, grown, g);
+  else
+    gradientOnRuns<ushort, float>(image, grown, g);
+  return g;
+}
+
+cv::Mat cannyOnRuns(const EdgeGradient& gradient, double low, double high, const RowRuns& runs) {
+  const cv::Rect area = gradient.area;
+  cv::Mat state = cv::Mat::zeros(area.size(), CV_8U);
+  if (area.empty()) return state;
+  // One pixel inside the area: suppression and hysteresis read the neighbours.
+  const cv::Rect inside(area.x + 1, area.y + 1, area.width - 2, area.height - 2);
+  const auto lowF = static_cast<float>(low);
+  const auto highF = static_cast<float>(std::max(low, high));
+  std::vector<cv::Point> stack;
+  for (const RowRun& run : runs) {
+    if (run.y < inside.y || run.y >= inside.br().y) continue;
+    const int x0 = std::max(run.x0, inside.x) - area.x;
+    const int x1 = std::min(run.x1, inside.br().x) - area.x;
+    if (gradient.gx.depth() == CV_16S)
+      suppressRow<short>(gradient, lowF, highF, nullptr, run.y - area.y, x0, x1, 0, state, stack);
+    else
+      suppressRow<float>(gradient, lowF, highF, nullptr, run.y - area.y, x0, x1, 0, state, stack);
+  }
+  hysteresis(state, stack);
+  return state;
 }
 
 cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,

@@ -11,6 +11,8 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/edges/row_runs.hpp"
+
 namespace facet {
 
 struct EdgeGradient {
@@ -25,6 +27,12 @@ struct EdgeGradient {
 // Throws std::invalid_argument for any other image type.
 EdgeGradient computeEdgeGradient(const cv::Mat& image, cv::Rect area = {});
 
+// The gradient at the pixels of `runs` (image coordinates) and their eight neighbours only, in
+// maps covering `area` (clipped to the image): what cannyOnRuns reads. Equal to
+// computeEdgeGradient(image, area) at those pixels; the maps' other pixels are left unset. A thin
+// region (an annulus) costs its own size instead of its bounding box's.
+EdgeGradient computeEdgeGradientOnRuns(const cv::Mat& image, cv::Rect area, const RowRuns& runs);
+
 // Edge pixels (CV_8U, 255 = edge, same size as gradient.area) after non-maximum suppression and
 // hysteresis: a pixel whose magnitude is >= low is kept when it is 8-connected through such
 // pixels to one whose magnitude is >= high. `mask` (CV_8U, size of gradient.area, may be empty)
@@ -33,6 +41,12 @@ EdgeGradient computeEdgeGradient(const cv::Mat& image, cv::Rect area = {});
 // one pixel away from the area's border, which suppression needs as neighbours.
 cv::Mat cannyFromGradient(const EdgeGradient& gradient, double low, double high,
                           const cv::Mat& mask = {}, cv::Rect candidates = {});
+
+// Canny whose candidates are the pixels of `runs` (image coordinates; those less than one pixel
+// inside gradient.area are dropped): cannyFromGradient with a mask of exactly these pixels, reading
+// only them and their neighbours (a gradient from computeEdgeGradientOnRuns suffices). Result as
+// cannyFromGradient's.
+cv::Mat cannyOnRuns(const EdgeGradient& gradient, double low, double high, const RowRuns& runs);
 
 // The same as cannyFromGradient(computeEdgeGradient(image, area), ...), computed in strips of
 // rows so that no full-size gradient maps are allocated (faster on large images). `mask` and

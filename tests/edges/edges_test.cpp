@@ -10,6 +10,7 @@
 
 #include "algorithms/edges/auto_thresholds.hpp"
 #include "algorithms/edges/canny.hpp"
+#include "algorithms/edges/row_runs.hpp"
 #include "algorithms/edges/subpixel_edges.hpp"
 #include "tests/support/scene/scene.hpp"
 
@@ -259,6 +260,102 @@ TEST(Canny, HysteresisKeepsWeakPartsConnectedToStrongOnes) {
   EXPECT_EQ(count(cannyEdges(image, 15, 25), 18, 50, 77), 0);
   // And with a high threshold below it the isolated edge is kept.
   EXPECT_GE(count(cannyEdges(image, 5, 9), 58, 3, 77), 70);
+}
+
+// A ring of runs (as an annulus is measured) that reaches the image's border, where the
+// gradient replicates the border pixels.
+RowRuns ringRuns(cv::Size size, cv::Point2d centre, double rIn, double rOut) {
+  RowRuns runs;
+  for (int y = 1; y < size.height - 1; ++y) {
+    int start = -1;
+    for (int x = 1; x <= size.width - 1; ++x) {
+      const double d = std::hypot(x - centre.x, y - centre.y);
+      const bool in = x < size.width - 1 && d >= rIn && d <= rOut;
+      if (in && start < 0) start = x;
+      if (!in && start >= 0) {
+        runs.push_back({y, start, x});
+        start = -1;
+      }
+    }
+  }
+  return runs;
+}
+
+TEST(Canny, OnRunsEqualsTheMaskedFullGradient) {
+  cv::RNG rng(11);
+  for (int depth : {CV_8U, CV_16U}) {
+    SceneSpec spec;
+    spec.size = {70, 60};
+    spec.background = 40;
+    spec.blurSigma = 1.0;
+    spec.noiseSigma = 3.0;
+    spec.depth = depth;
+    Scene scene(spec);
+    scene.addDisc({30.3, 27.6}, 24.0, 200);
+    const cv::Mat image = scene.render();
+    const cv::Rect area(0, 0, image.cols, image.rows);
+    const RowRuns runs = ringRuns(image.size(), {30.3, 27.6}, 19.0, 29.0);
+    const EdgeGradient full = computeEdgeGradient(image, area);
+    const EdgeGradient onRuns = computeEdgeGradientOnRuns(image, area, runs);
+    cv::Mat mask = cv::Mat::zeros(image.size(), CV_8U);
+    for (const RowRun& r : runs) mask.row(r.y).colRange(r.x0, r.x1).setTo(255);
+    cv::Mat near;
+    cv::dilate(mask, near, cv::Mat::ones(3, 3, CV_8U));
+    int compared = 0;
+    for (int y = 0; y < image.rows; ++y)
+      for (int x = 0; x < image.cols; ++x) {
+        if (!near.at<uchar>(y, x)) continue;
+        ++compared;
+        ASSERT_EQ(onRuns.magnitude.at<float>(y, x), full.magnitude.at<float>(y, x))
+            << "depth " << depth << " at " << x << "," << y;
+        if (depth == CV_8U)
+          ASSERT_EQ(onRuns.gx.at<short>(y, x), full.gx.at<short>(y, x));
+        else
+          ASSERT_EQ(onRuns.gy.at<float>(y, x), full.gy.at<float>(y, x));
+      }
+    EXPECT_GT(compared, 1500);
+    const cv::Mat expected = cannyFromGradient(full, 3.0, 8.0, mask);
+    const cv::Mat got = cannyOnRuns(onRuns, 3.0, 8.0, runs);
+    EXPECT_EQ(cv::countNonZero(expected != got), 0) << "depth " << depth;
+    EXPECT_GT(cv::countNonZero(got), 100);
+  }
+}
+
+TEST(RowRuns, DilationGrowsByOnePixelAndMerges) {
+  const RowRuns runs{{5, 2, 4}, {5, 6, 9}, {7, 3, 4}};
+  const RowRuns grown = dilateRowRuns(runs, cv::Rect(0, 0, 9, 20));
+  cv::Mat a = cv::Mat::zeros(20, 12, CV_8U), b = a.clone();
+  for (const RowRun& r : runs) a.row(r.y).colRange(r.x0, r.x1).setTo(255);
+  cv::dilate(a, a, cv::Mat::ones(3, 3, CV_8U));
+  a.colRange(9, 12).setTo(0);  // the clip
+  for (const RowRun& r : grown) {
+    ASSERT_LT(r.x0, r.x1);
+    b.row(r.y).colRange(r.x0, r.x1) += 1;
+  }
+  EXPECT_EQ(cv::countNonZero(a != b * 255), 0);  // each pixel once
+  EXPECT_TRUE(dilateRowRuns({}, cv::Rect(0, 0, 9, 9)).empty());
+}
+
+TEST(RowRuns, AnnulusHoldsExactlyThePixelsOfThePerPixelTest) {
+  cv::RNG rng(5);
+  for (int trial = 0; trial < 200; ++trial) {
+    const cv::Point2d c(rng.uniform(-5.0, 45.0), rng.uniform(-5.0, 45.0));
+    const double rIn = trial % 5 == 0 ? 0.0 : rng.uniform(0.0, 15.0);
+    const double rOut = rIn + rng.uniform(0.5, 12.0);
+    const cv::Rect clip(2, 3, 36, 33);
+    cv::Mat expected = cv::Mat::zeros(40, 40, CV_8U), got = expected.clone();
+    for (int y = clip.y; y < clip.br().y; ++y)
+      for (int x = clip.x; x < clip.br().x; ++x) {
+        const double d = std::hypot(x - c.x, y - c.y);
+        expected.at<uchar>(y, x) = d >= rIn && d <= rOut ? 1 : 0;
+      }
+    for (const RowRun& r : annulusRowRuns(c, rIn, rOut, clip)) {
+      ASSERT_LT(r.x0, r.x1);
+      got.row(r.y).colRange(r.x0, r.x1) += 1;
+    }
+    // Pixels exactly on a circle may fall either way by rounding; none lies there in this draw.
+    ASSERT_EQ(cv::countNonZero(expected != got), 0) << "trial " << trial;
+  }
 }
 
 TEST(SubpixelEdges, DiscIsOneClosedContourAndTheCurvatureCorrectionHelps) {
