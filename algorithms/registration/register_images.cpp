@@ -354,8 +354,15 @@ RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& i
     TransformFitParams tight;
     tight.model = params.model;
     tight.inlierThreshold = params.finalThreshold;
-    const std::vector<HarrisCorner> dense =
-        detectHarrisGrid(ref, params.refineCell, params.corners);
+    // The grid's cell is refineCell pixels of the finer view: where the image magnifies the
+    // reference, a cell of the reference holds s^2 times more image pixels, each able to match.
+    const cv::Point2d centre((ref.cols - 1) / 2.0, (ref.rows - 1) / 2.0);
+    const double magnification = std::sqrt(std::abs(cv::determinant(jacobianAt(result.H, centre))));
+    const int cell =
+        magnification > 1.0
+            ? std::max(1, static_cast<int>(std::lround(params.refineCell / magnification)))
+            : params.refineCell;
+    const std::vector<HarrisCorner> dense = detectHarrisGrid(ref, cell, params.corners);
     for (int it = 0; it < params.refineIterations; ++it) {
       // Once H rests on the dense pairs, the prediction is within a pixel or two.
       const int radius =

@@ -51,7 +51,7 @@ struct RegistrationParams {
   // on a grid (the strongest per `refineCell` x `refineCell` block) around their predicted
   // positions (NCC of square patches within `refineSearchRadius` pixels), refit. 0 disables it.
   int refineIterations = 2;
-  int refineCell = 10;          // pixels of the reference
+  int refineCell = 10;          // pixels of the finer view (the reference, or a magnified image)
   int refineSearchRadius = 8;   // pixels, in the image (3 after the first iteration)
   int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
   double finalThreshold = 1.0;  // pixels; RANSAC threshold of the fit to the re-matched pairs

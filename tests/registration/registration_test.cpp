@@ -67,6 +67,25 @@ TEST(RegisterImages, IdenticalImagesGiveTheIdentity) {
   }
 }
 
+// An image that magnifies the reference 2x sees a quarter of it; the re-matching grid is laid
+// at the image's density, so the pairs stay about as many as for an unmagnified view.
+TEST(RegisterImages, AMagnifiedImageIsReMatchedAtItsOwnDensity) {
+  const cv::Mat ref = texturedScene({320, 320}, 7);
+  const RegistrationResult same = registerImages(ref, ref, {});
+  ASSERT_TRUE(same.status.ok()) << same.status.message;
+  const cv::Matx33d truth = similarity(25.0, 2.0, {159.5, 159.5}, {159.5, 159.5});
+  const cv::Mat image = warp(ref, truth, {320, 320});
+  const RegistrationResult r = registerImages(ref, image, {});
+  ASSERT_TRUE(r.status.ok()) << toString(r.status.cause) << ": " << r.status.message;
+  EXPECT_LT(cornerError(r.H, truth, ref.size()), 1.0);
+  EXPECT_GE(r.inliers.size(), same.inliers.size() / 2)
+      << "identical images: " << same.inliers.size() << " pairs";
+  for (const cv::Vec4d& q : r.pairs()) {
+    const cv::Point2d t = mapPoint(truth, {q[0], q[1]});
+    EXPECT_LT(std::hypot(t.x - q[2], t.y - q[3]), 3.0);
+  }
+}
+
 TEST(RegisterImages, BlankImageIsAClearFailure) {
   const cv::Mat ref = texturedScene({200, 200}, 4);
   const cv::Mat blank(200, 200, CV_8U, cv::Scalar(128));
