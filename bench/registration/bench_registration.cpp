@@ -247,13 +247,11 @@ void syntheticTable(const std::string& dir, int count) {
 
 // Real photographs from Debian's opencv-doc package (examples/data), warped by known
 // homographies: SYNTHETIC warps (pre-blurred where the view shrinks, noise sigma 2), not real
-// viewpoint changes. None of these images was used to choose a default (those were set on graf).
-void photoWarpTable(bool smoke) {
+// viewpoint changes. The defaults were set on graf; the first set's zoom rows then led to the
+// re-matching grid's density rule. The held-out set was run once after that change, and
+// nothing has been chosen on it: keep it so.
+void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
   const std::string dir = "/usr/share/doc/opencv-doc/examples/data";
-  const std::vector<std::string> photos =
-      smoke ? std::vector<std::string>{"fruits.jpg"}
-            : std::vector<std::string>{"fruits.jpg",   "baboon.jpg", "aero1.jpg",     "leuvenA.jpg",
-                                       "building.jpg", "home.jpg",   "butterfly.jpg", "messi5.jpg"};
   struct Warp {
     const char* name;
     double deg, scale, tilt, px;  // rotation, zoom, foreshortening along x, perspective term
@@ -262,9 +260,10 @@ void photoWarpTable(bool smoke) {
                                    {"tilt 0.6 rot10 persp", 10, 1.0, 0.6, 4e-4},
                                    {"zoom1.6 rot70", 70, 1.6, 1.0, 0.0}};
   std::printf(
-      "\n== Photographs of Debian's opencv-doc (examples/data) under SYNTHETIC homographies "
-      "(noise sigma 2); defaults ==\n");
-  std::printf("%-14s %-21s | %7s %7s %8s %8s %-15s | %7s %7s %8s %8s | %s\n", "photo", "warp",
+      "\n== %s: photographs of Debian's opencv-doc (examples/data) under SYNTHETIC "
+      "homographies (noise sigma 2); defaults ==\n",
+      title);
+  std::printf("%-20s %-21s | %7s %7s %8s %8s %-15s | %7s %7s %8s %8s | %s\n", "photo", "warp",
               "correct", "inliers", "corner", "ms", "stage", "correct", "inliers", "corner", "ms",
               "targets");
   int pairs = 0, met = 0;
@@ -272,7 +271,7 @@ void photoWarpTable(bool smoke) {
   for (const std::string& name : photos) {
     cv::Mat photo = cv::imread(dir + "/" + name, cv::IMREAD_GRAYSCALE);
     if (photo.empty()) {
-      std::printf("%-14s cannot read %s/%s (apt-get install opencv-doc): skipped\n", name.c_str(),
+      std::printf("%-20s cannot read %s/%s (apt-get install opencv-doc): skipped\n", name.c_str(),
                   dir.c_str(), name.c_str());
       continue;
     }
@@ -312,7 +311,7 @@ void photoWarpTable(bool smoke) {
       met += good;
       oursMs += ours.ms;
       siftMs += sift.ms;
-      std::printf("%-14s %-21s | %7d %7d %8.2f %8.1f %-15s | %7d %7d %8.2f %8.1f | %s\n",
+      std::printf("%-20s %-21s | %7d %7d %8.2f %8.1f %-15s | %7d %7d %8.2f %8.1f | %s\n",
                   name.c_str(), w.name, ours.correct, ours.inliers, ours.ok ? ours.cornerError : -1,
                   ours.ms, ours.stage.c_str(), sift.correct, sift.inliers,
                   sift.ok ? sift.cornerError : -1, sift.ms, good ? "met" : "MISSED");
@@ -410,7 +409,16 @@ int main(int argc, char** argv) {
   cv::setNumThreads(1);  // single-threaded, like facet's algorithms
   grafTable(dir, smoke, smoke ? 1 : 3);
   syntheticTable(dir, synthetic);
-  photoWarpTable(smoke);
+  if (smoke) {
+    photoWarpTable("Smoke", {"fruits.jpg"});
+  } else {
+    photoWarpTable("Tuned set", {"fruits.jpg", "baboon.jpg", "aero1.jpg", "leuvenA.jpg",
+                                 "building.jpg", "home.jpg", "butterfly.jpg", "messi5.jpg"});
+    photoWarpTable("Held-out set",
+                   {"apple.jpg", "orange.jpg", "HappyFish.jpg", "blox.jpg", "box_in_scene.png",
+                    "starry_night.jpg", "stuff.jpg", "smarties.png", "Blender_Suzanne1.jpg",
+                    "squirrel_cls.jpg", "sudoku.png", "graf3.png"});
+  }
   nccTable(dir, smoke);
   return 0;
 }
