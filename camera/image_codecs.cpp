@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "camera/decoded_frame.hpp"
 #include "camera/image_codec_table.hpp"
 #include "camera/image_file_reader.hpp"
 #include "camera/png_file.hpp"
@@ -85,33 +86,21 @@ std::optional<cv::Mat> imreadOfPlainPng(const fs::path& file, int flags) {
   const bool grey =
       flags == cv::IMREAD_GRAYSCALE || flags == (cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
   if (!unchanged && !grey) return std::nullopt;
-  auto png = readPlainPng(file, kImreadMaxPixels);
-  if (!png) return std::nullopt;
-  const cv::Mat& p = png->pixels;
-  if (unchanged && p.channels() != 2) return p;
-  if (grey && p.channels() == 1 && !png->hasExif &&
-      (p.depth() == CV_8U || (flags & cv::IMREAD_ANYDEPTH)))
-    return p;
-  return std::nullopt;
+  // OpenCV gives grey+alpha as BGRA, and a grey read of a deep file as 8 bits unless asked.
+  const auto stored = [&](int type) {
+    if (unchanged) return CV_MAT_CN(type) != 2;
+    return CV_MAT_CN(type) == 1 && (CV_MAT_DEPTH(type) == CV_8U || (flags & cv::IMREAD_ANYDEPTH));
+  };
+  auto png = readPlainPng(file, kImreadMaxPixels, stored);
+  if (!png || (grey && png->hasExif)) return std::nullopt;
+  return std::move(png->pixels);
 }
 
 // readImageFile's result for a plain PNG: what the module's decoder makes of it.
 std::optional<ImageFileContent> frameOfPlainPng(const fs::path& file, std::uint64_t max_pixels) {
   auto png = readPlainPng(file, max_pixels);
   if (!png) return std::nullopt;
-  ImageFileContent content;
-  cv::Mat& image = png->pixels;
-  const bool deep = image.depth() == CV_16U;
-  if (image.channels() <= 2) {
-    if (image.channels() == 2) cv::extractChannel(image, image, 0);  // alpha dropped
-    content.format = deep ? PixelFormat::Mono16 : PixelFormat::Mono8;
-  } else {
-    if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
-    if (deep) image.convertTo(image, CV_8U, 1.0 / 256.0);  // Bgr8 is a Frame's only colour format
-    content.format = PixelFormat::Bgr8;
-  }
-  content.image = std::move(image);
-  return content;
+  return frameOfDecodedPixels(std::move(png->pixels));
 }
 
 }  // namespace

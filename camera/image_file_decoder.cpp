@@ -4,6 +4,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "camera/decoded_frame.hpp"
+
 namespace facet {
 namespace OIIO = OIIO_NAMESPACE;
 
@@ -43,14 +45,7 @@ ImageFileContent decodeImageFile(const std::filesystem::path& file, std::uint64_
       content.error = name + ": corrupt or truncated image";
       return content;
     }
-    const bool deep = content.image.depth() == CV_16U;
-    if (content.image.channels() == 3) {
-      if (deep) content.image.convertTo(content.image, CV_8U, 1.0 / 256.0);  // Bgr8 only
-      content.format = PixelFormat::Bgr8;
-    } else {
-      content.format = deep ? PixelFormat::Mono16 : PixelFormat::Mono8;
-    }
-    return content;
+    return frameOfDecodedPixels(std::move(content.image));
   }
   content.image.create(spec.height, spec.width, CV_MAKETYPE(eight_bit ? CV_8U : CV_16U, channels));
   if (!input->read_image(0, 0, 0, channels, type, content.image.data)) {
@@ -58,17 +53,8 @@ ImageFileContent decodeImageFile(const std::filesystem::path& file, std::uint64_
     content.image.release();
     return content;
   }
-  if (channels == 3) {
-    cv::cvtColor(content.image, content.image, cv::COLOR_RGB2BGR);  // in place
-    if (!eight_bit) {
-      // Bgr8 is the only colour format of a Frame.
-      content.image.convertTo(content.image, CV_8U, 1.0 / 256.0);
-    }
-    content.format = PixelFormat::Bgr8;
-  } else {
-    content.format = eight_bit ? PixelFormat::Mono8 : PixelFormat::Mono16;
-  }
-  return content;
+  if (channels == 3) cv::cvtColor(content.image, content.image, cv::COLOR_RGB2BGR);  // in place
+  return frameOfDecodedPixels(std::move(content.image));
 }
 
 }  // namespace facet

@@ -66,7 +66,8 @@ int channelsOf(int colour) {
 
 }  // namespace
 
-std::optional<PlainPng> readPlainPng(const std::filesystem::path& file, std::uint64_t maxPixels) {
+std::optional<PlainPng> readPlainPng(const std::filesystem::path& file, std::uint64_t maxPixels,
+                                     const PngLayoutFilter& wanted) {
   const std::unique_ptr<FILE, int (*)(FILE*)> in(std::fopen(file.c_str(), "rb"), &std::fclose);
   if (!in) return std::nullopt;
   unsigned char signature[8];
@@ -89,10 +90,11 @@ std::optional<PlainPng> readPlainPng(const std::filesystem::path& file, std::uin
       h.transparency || h.width == 0 || h.height == 0 ||
       static_cast<std::uint64_t>(h.width) * h.height > maxPixels)
     return std::nullopt;
+  const int type = CV_MAKETYPE(h.depth == 8 ? CV_8U : CV_16U, channels);
+  if (wanted && !wanted(type)) return std::nullopt;
 
   PlainPng out;
-  out.pixels.create(static_cast<int>(h.height), static_cast<int>(h.width),
-                    CV_MAKETYPE(h.depth == 8 ? CV_8U : CV_16U, channels));
+  out.pixels.create(static_cast<int>(h.height), static_cast<int>(h.width), type);
   std::vector<png_bytep> rows(h.height);
   for (png_uint_32 y = 0; y < h.height; ++y) rows[y] = out.pixels.ptr(static_cast<int>(y));
   // PNG stores 16-bit samples big-endian.

@@ -101,6 +101,23 @@ TEST(PlainPng, GreyWithAlphaKeepsTheGreyForAFrame) {
   EXPECT_TRUE(same(frame.image, grey));
 }
 
+// A caller that would pass a layout on says so before the pixels are decoded.
+TEST(PlainPng, ALayoutTheCallerRefusesIsNotRead) {
+  const test::TempFolder folder;
+  ASSERT_TRUE(writeImage(folder / "colour.png", noise(CV_16UC3, 4))) << imageCodecsProblem();
+  int asked = -1;
+  const auto refused = readPlainPng(folder / "colour.png", 1u << 20, [&](int type) {
+    asked = type;
+    return CV_MAT_CN(type) == 1;
+  });
+  EXPECT_FALSE(refused.has_value());
+  EXPECT_EQ(asked, CV_16UC3);
+  const auto accepted =
+      readPlainPng(folder / "colour.png", 1u << 20, [](int type) { return type == CV_16UC3; });
+  ASSERT_TRUE(accepted.has_value());
+  EXPECT_EQ(accepted->pixels.type(), CV_16UC3);
+}
+
 TEST(PlainPng, OtherKindsAreLeftToTheModuleWhichReadsThem) {
   const test::TempFolder folder;
   const int w = 16, h = 9;
