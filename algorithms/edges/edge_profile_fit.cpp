@@ -210,28 +210,54 @@ void gatherAny(const cv::Mat& image, const EdgeSeed& seed, const EdgeProfilePara
             std::is_same_v<T, ushort> ? 1.0f / 256 : 1.0f, out);
 }
 
+// Half the stretch along each seed that the blur search reads (pixels).
+constexpr double kBlurHalfAlong = 2.0;
+
 // The blur model and sigma whose exact profiles fit the seeds best (least residual sum of
 // squares), searched around the erf width's sigma in steps of 0.02 px. Why both models: a lens
 // blurs before the pixel integrates (a continuous Gaussian times the pixel square), a blur filter
 // run on a sampled image after it (a discrete kernel); at sigma 0.5-0.8 the two profiles differ by
 // up to 3% of the contrast, and fitting the wrong one moves axis-aligned edges by up to 0.03 px
-// with their subpixel phase. Also why not the erf width alone: an axis-aligned edge shows the
-// profile at one phase only, which biases the erf width by up to +-0.05 px.
+// with their subpixel phase. Also why not the erf width alone: it is the width of the wrong
+// shape, biased by the edges' subpixel phases by up to +-0.05 px (estimateEdgeBlur).
 EdgeBlur fitBlurModel(const cv::Mat& image, const std::vector<const EdgeSeed*>& seeds,
                       const EdgeProfileParams& params, double width,
                       std::optional<bool> onlyModel) {
+  // The profiles are those of a straight edge: a short stretch along each seed keeps an arc's
+  // sagitta out of the profile's width (a disc of radius 15 px read over +-6 px gave sigma 1.10
+  // for 1.00; over +-2 px the sagitta is 0.13 px, and the test of that disc reads 1.00 +- 0.1).
+  EdgeProfileParams stretch = params;
+  stretch.halfAlong = std::min(params.halfAlong, kBlurHalfAlong);
   std::vector<Samples> samples(seeds.size());
   for (size_t i = 0; i < seeds.size(); ++i) {
     if (image.depth() == CV_16U)
-      gatherAny<ushort>(image, *seeds[i], params, samples[i]);
+      gatherAny<ushort>(image, *seeds[i], stretch, samples[i]);
     else
-      gatherAny<uchar>(image, *seeds[i], params, samples[i]);
+      gatherAny<uchar>(image, *seeds[i], stretch, samples[i]);
   }
   const double sigma0 = std::round(std::sqrt(std::max(width * width - 1.0 / 12, 0.04)) * 50) / 50;
+  // The seeds that a straight blurred step fits worst at the erf width's sigma (a corner, a tight
+  // arc, a neighbouring edge in the window) would take their misfit for blur; the worst quarter
+  // is left out of the search.
+  std::vector<size_t> kept(seeds.size());
+  for (size_t i = 0; i < seeds.size(); ++i) kept[i] = i;
+  if (seeds.size() >= 8) {
+    std::vector<double> misfit(seeds.size(), std::numeric_limits<double>::infinity());
+    for (const bool grid : {false, true}) {
+      if (onlyModel && *onlyModel != grid) continue;
+      const auto profiles = apertureProfiles(sigma0, grid);
+      for (size_t i = 0; i < seeds.size(); ++i)
+        misfit[i] = std::min(
+            misfit[i],
+            fitResidual(samples[i], apertureView(*profiles, seeds[i]->normal), seeds[i]->offset));
+    }
+    std::sort(kept.begin(), kept.end(), [&](size_t a, size_t b) { return misfit[a] < misfit[b]; });
+    kept.resize(seeds.size() - seeds.size() / 4);
+  }
   const auto rssAt = [&](double sigma, bool grid) {
     const auto profiles = apertureProfiles(sigma, grid);
     double rss = 0;
-    for (size_t i = 0; i < seeds.size(); ++i)
+    for (const size_t i : kept)
       rss += fitResidual(samples[i], apertureView(*profiles, seeds[i]->normal), seeds[i]->offset);
     return rss;
   };
@@ -360,11 +386,12 @@ EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& see
   if (widths.empty()) return {params.initialWidth, params.blurOnPixelGrid};
   std::nth_element(widths.begin(), widths.begin() + widths.size() / 2, widths.end());
   const double width = widths[widths.size() / 2];
-  // Where edges within 10 degrees of an axis dominate, their erf width is biased by their
-  // subpixel phase (one phase for an axis-aligned edge, a slowly drifting one near it: at sigma
-  // 0.5 on the pixel grid that cost 0.035 px at 2-3 degrees) and the exact profiles' best sigma
-  // replaces it; elsewhere the median erf width stands (on curved edges the exact straight-edge
-  // profiles would take the arc's spread for blur) and the search picks the model only.
+  // The median erf width only starts the search: an erf is not the shape of a profile that holds
+  // the pixel aperture (or a discrete kernel), and its width is biased by the edges' subpixel
+  // phases. At sigma 0.5 on the pixel grid that cost 0.035 px at 2-3 degrees (one phase for an
+  // axis-aligned edge, a slowly drifting one near it) and 0.012 px at 44-46 degrees (where the
+  // pixels sample the profile only every 0.7 px). The blur is the exact profiles' best sigma, from
+  // the axis-near edges where they dominate (their phase bias is the largest).
   const bool axisDominated = axis.size() * 2 >= widths.size();
   std::vector<const EdgeSeed*>& chosen = axisDominated ? axis : fitted;
   constexpr size_t kModelSeeds = 16;
@@ -374,8 +401,7 @@ EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& see
       fewer.push_back(chosen[i * chosen.size() / kModelSeeds]);
     chosen.swap(fewer);
   }
-  const EdgeBlur blur = fitBlurModel(image, chosen, params, width, onlyModel);
-  return axisDominated ? blur : EdgeBlur{width, blur.onPixelGrid};
+  return fitBlurModel(image, chosen, params, width, onlyModel);
 }
 
 double estimateEdgeWidth(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,

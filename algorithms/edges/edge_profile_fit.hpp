@@ -82,11 +82,10 @@ struct EdgeBlur {
   bool onPixelGrid = false;
 };
 // One blur for an image, from up to `maxSamples` of the given seeds (pixel, facet normal, facet
-// offset), spread evenly over the list: the median of their fitted erf widths gives the width;
-// then both blur models' exact profiles, at sigmas around it, are fitted to up to 16 of those
-// seeds and the model with the least residual wins (where axis-aligned edges dominate, whose erf
-// width is biased by their single subpixel phase, that search's sigma replaces the width too).
-// So the default needs no knowledge of how the images were formed. Returns
+// offset), spread evenly over the list: the median of their fitted erf widths gives a first
+// width; then both blur models' exact profiles, at sigmas around it, are fitted to up to 16 of
+// those seeds (the quarter that fits a straight step worst left out) and the model and sigma with
+// the least residual win. So the default needs no knowledge of how the images were formed. Returns
 // `params.initialWidth` and `params.blurOnPixelGrid` when no fit succeeds.
 // `onlyModel` restricts the search to one model (true = pixel grid, false = lens).
 EdgeBlur estimateEdgeBlur(const cv::Mat& image, const std::vector<EdgeSeed>& seeds,
