@@ -155,14 +155,20 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
                                   int R, const RegistrationParams& params) {
   const cv::Point2d centre((refGrey.cols - 1) / 2.0, (refGrey.rows - 1) / 2.0);
   const double s = std::sqrt(std::abs(cv::determinant(jacobianAt(H, centre))));
-  // Match resolutions: blur whichever image is seen at the finer scale.
+  // Match resolutions: blur whichever image is seen at the finer scale, into a buffer of its own
+  // (a blur into `ref` or `img` while they share the caller's pixels would blur those in place,
+  // and the next iteration would blur them again).
   cv::Mat ref = refGrey, img = imgGrey;
   if (s < 0.8) {
     const double sigma = 0.5 * std::sqrt(1.0 / (s * s) - 1.0);
-    cv::GaussianBlur(refGrey, ref, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    cv::Mat blurred;
+    cv::GaussianBlur(refGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    ref = blurred;
   } else if (s > 1.25) {
     const double sigma = 0.5 * std::sqrt(s * s - 1.0);
-    cv::GaussianBlur(imgGrey, img, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    cv::Mat blurred;
+    cv::GaussianBlur(imgGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    img = blurred;
   }
   cv::Mat warped, valid;
   cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
