@@ -7,6 +7,7 @@
 // The result H maps reference pixel coordinates to image pixel coordinates (homogeneous,
 // x right, y down, pixel centres at integers): q ~ H * (x, y, 1).
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -100,5 +101,23 @@ RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
 // One stage only: the detector that params.affineRegions names, no escalation between them.
 RegistrationResult registerSingleStage(const cv::Mat& ref, const cv::Mat& image,
                                        const RegistrationParams& params = {});
+
+// What the stages of one pair share, computed once: the grey images, their sampling pyramids and
+// corners (detected with the larger of the two budgets), each detector's windows described so far
+// and its first global match, and the reference's grid points for the re-matching. Built for
+// `params`; the stages run on it may differ from them in affineRegions only.
+class StageCache {
+ public:
+  StageCache(const cv::Mat& ref, const cv::Mat& image, const RegistrationParams& params);
+  ~StageCache();
+  StageCache(const StageCache&) = delete;
+  StageCache& operator=(const StageCache&) = delete;
+  struct State;  // register_images.cpp
+  std::unique_ptr<State> state;
+};
+
+// One stage on the cache's pair: registerSingleStage, except that with `widen` false the
+// escalation to escalateCorners is left out (registerImages defers the plain stage's one).
+RegistrationResult registerStage(StageCache& cache, const RegistrationParams& params, bool widen);
 
 }  // namespace facet

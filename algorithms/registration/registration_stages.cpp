@@ -44,14 +44,27 @@ void polishHomography(RegistrationResult& r, const RegistrationParams& params) {
 
 RegistrationResult registerStages(const cv::Mat& ref, const cv::Mat& image,
                                   const RegistrationParams& params) {
-  RegistrationResult fast = registerSingleStage(ref, image, params);
-  if (params.affineRegions || !params.escalateToAffine ||
-      (fast.status.ok() && fast.globalInliers >= params.affineBelowInliers))
-    return fast;
+  StageCache cache(ref, image, params);
+  if (params.affineRegions || !params.escalateToAffine) return registerStage(cache, params, true);
+  // The plain stage's own escalation to escalateCorners is deferred. It runs when the first match
+  // has fewer than escalateBelowInliers inliers, and then the affine stage follows unless the
+  // wider match reaches affineBelowInliers, which it seldom does from there; the affine stage
+  // (which escalates in turn) costs about as much and is what such a pair needs.
+  RegistrationResult fast = registerStage(cache, params, false);
+  if (fast.status.ok() && fast.globalInliers >= params.affineBelowInliers) return fast;
   RegistrationParams affine = params;
   affine.affineRegions = true;
-  RegistrationResult adapted = registerSingleStage(ref, image, affine);
+  RegistrationResult adapted = registerStage(cache, affine, true);
   adapted.escalated = fast.escalated = true;
+  // Neither stage found a transform: the deferred plain escalation is the last resort (not when
+  // it would repeat the plain stage: no wider budget, or a first match that needs none).
+  if (!adapted.status.ok() && !fast.status.ok() &&
+      params.escalateCorners > params.corners.maxCorners &&
+      fast.globalInliers < params.escalateBelowInliers) {
+    RegistrationResult wider = registerStage(cache, params, true);
+    wider.escalated = true;
+    return wider.status.ok() ? wider : adapted;
+  }
   if (!adapted.status.ok() && fast.status.ok()) return fast;
   if (adapted.status.ok() && fast.status.ok() && adapted.globalInliers <= fast.globalInliers)
     return fast;
