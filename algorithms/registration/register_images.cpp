@@ -205,11 +205,6 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
   return out;
 }
 
-RegistrationResult failure(RegistrationResult r, RegistrationFailure cause, std::string message) {
-  r.status = Status<RegistrationFailure>::failed(cause, std::move(message));
-  return r;
-}
-
 struct GlobalStage {
   std::vector<FeatureMatch> matches;
   std::vector<int> inliers;  // indices into matches
@@ -358,6 +353,12 @@ RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& i
 }
 
 RegistrationResult registerStage(StageCache& cache, const RegistrationParams& params, bool widen) {
+  RegistrationResult result = matchStage(cache, params, widen);
+  if (result.status.ok()) refineStage(cache, params, result);
+  return result;
+}
+
+RegistrationResult matchStage(StageCache& cache, const RegistrationParams& params, bool widen) {
   RegistrationResult result;
   result.stage = params.affineRegions ? "harris-affine" : "harris";
   StageCache::State& s = *cache.state;
@@ -392,8 +393,13 @@ RegistrationResult registerStage(StageCache& cache, const RegistrationParams& pa
   result.H = stage.H;
   result.inliers = stage.inliers;
 
-  const std::size_t globalInliers = result.inliers.size();
-  result.globalInliers = static_cast<int>(globalInliers);
+  result.globalInliers = static_cast<int>(result.inliers.size());
+  return result;
+}
+
+void refineStage(StageCache& cache, const RegistrationParams& params, RegistrationResult& result) {
+  StageCache::State& s = *cache.state;
+  const auto globalInliers = static_cast<std::size_t>(result.globalInliers);
   if (params.refineIterations > 0) {
     TransformFitParams tight;
     tight.model = params.model;
@@ -426,13 +432,12 @@ RegistrationResult registerStage(StageCache& cache, const RegistrationParams& pa
     // A transform resting on very few global matches must be confirmed by the re-matching.
     if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
         static_cast<int>(result.inliers.size()) < params.confirmInliers)
-      return failure(result, RegistrationFailure::TooFewInliers,
-                     std::to_string(globalInliers) +
-                         " global inliers, not confirmed by re-matching (" +
-                         std::to_string(result.inliers.size()) + " inliers, " +
-                         std::to_string(params.confirmInliers) + " needed)");
+      result.status = Status<RegistrationFailure>::failed(
+          RegistrationFailure::TooFewInliers,
+          std::to_string(globalInliers) + " global inliers, not confirmed by re-matching (" +
+              std::to_string(result.inliers.size()) + " inliers, " +
+              std::to_string(params.confirmInliers) + " needed)");
   }
-  return result;
 }
 
 }  // namespace facet

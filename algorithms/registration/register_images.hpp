@@ -118,6 +118,13 @@ class StageCache {
 
 // One stage on the cache's pair: registerSingleStage, except that with `widen` false the
 // escalation to escalateCorners is left out (registerImages defers the plain stage's one).
+// It is matchStage, then refineStage when the global fit succeeded.
 RegistrationResult registerStage(StageCache& cache, const RegistrationParams& params, bool widen);
+// The global part of a stage: windows, all-pairs matching, robust fit (status, H, the window
+// matches and their inliers, globalInliers).
+RegistrationResult matchStage(StageCache& cache, const RegistrationParams& params, bool widen);
+// The warp-and-re-match of a global result (refineIterations), then the confirmation of a fit on
+// fewer than confirmBelowInliers inliers, which may turn the result into a failure.
+void refineStage(StageCache& cache, const RegistrationParams& params, RegistrationResult& result);
 
 }  // namespace facet
