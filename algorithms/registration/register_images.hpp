@@ -44,7 +44,8 @@ struct RegistrationParams {
   // Escalation for hard pairs (large viewpoint change): when the first global matching gives
   // fewer than `escalateBelowInliers` inliers, it is repeated with `escalateCorners` corners per
   // image and the minimum NCC lowered to `escalateMinScore`. escalateCorners <= maxCorners
-  // disables it.
+  // disables it. registerImages defers it in the plain stage when escalateToAffine is on (the
+  // affine stage comes first, this one only if neither finds a transform).
   int escalateCorners = 650;
   double escalateMinScore = 0.7;
   int escalateBelowInliers = 12;
