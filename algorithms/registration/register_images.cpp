@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <optional>
 
 #include <opencv2/imgproc.hpp>
 
@@ -40,29 +41,23 @@ bool isBlank(const cv::Mat& grey) {
   return stddev[0] < 1e-3;
 }
 
+// One image's regions and windows for one detector, described lazily in the corners' spreading
+// order.
 struct Features {
-  std::vector<HarrisCorner> corners;  // detected, in spreading order
   int described = 0;                  // corners [0, described) have been turned into windows
   std::vector<AffineRegion> regions;  // only those with a valid window
   std::vector<LogPolarWindow> windows;
   std::vector<int> ranks;  // the corner's position in spreading order
 };
 
-Features detect(const cv::Mat& grey, const RegistrationParams& params, int budget) {
-  HarrisParams hp = params.corners;
-  hp.maxCorners = budget;
-  Features f;
-  f.corners = detectHarrisCorners(grey, hp);
-  return f;
-}
-
 // Regions (adapted when asked) and windows of the corners up to rank `count`; lazily, so that
 // the corners kept for escalation cost nothing unless it happens.
-void describeUpTo(Features& f, const std::vector<cv::Mat>& pyramid,
-                  const RegistrationParams& params, int count) {
-  const int end = std::min(count, static_cast<int>(f.corners.size()));
+void describeUpTo(Features& f, const std::vector<HarrisCorner>& corners,
+                  const std::vector<cv::Mat>& pyramid, const RegistrationParams& params,
+                  int count) {
+  const int end = std::min(count, static_cast<int>(corners.size()));
   for (int i = f.described; i < end; ++i) {
-    const HarrisCorner& c = f.corners[i];
+    const HarrisCorner& c = corners[i];
     AffineRegion r{c.pt, cv::Matx22d(c.scale, 0, 0, c.scale), c.response};
     if (params.affineRegions) {
       const std::vector<AffineRegion> adapted = adaptAffineRegions(pyramid, {c});
@@ -155,14 +150,20 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
                                   int R, const RegistrationParams& params) {
   const cv::Point2d centre((refGrey.cols - 1) / 2.0, (refGrey.rows - 1) / 2.0);
   const double s = std::sqrt(std::abs(cv::determinant(jacobianAt(H, centre))));
-  // Match resolutions: blur whichever image is seen at the finer scale.
+  // Match resolutions: blur whichever image is seen at the finer scale, into a buffer of its own
+  // (a blur into `ref` or `img` while they share the caller's pixels would blur those in place,
+  // and the next iteration would blur them again).
   cv::Mat ref = refGrey, img = imgGrey;
   if (s < 0.8) {
     const double sigma = 0.5 * std::sqrt(1.0 / (s * s) - 1.0);
-    cv::GaussianBlur(refGrey, ref, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    cv::Mat blurred;
+    cv::GaussianBlur(refGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    ref = blurred;
   } else if (s > 1.25) {
     const double sigma = 0.5 * std::sqrt(s * s - 1.0);
-    cv::GaussianBlur(imgGrey, img, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    cv::Mat blurred;
+    cv::GaussianBlur(imgGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+    img = blurred;
   }
   cv::Mat warped, valid;
   cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
@@ -202,11 +203,6 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
     out.push_back(m);
   }
   return out;
-}
-
-RegistrationResult failure(RegistrationResult r, RegistrationFailure cause, std::string message) {
-  r.status = Status<RegistrationFailure>::failed(cause, std::move(message));
-  return r;
 }
 
 struct GlobalStage {
@@ -302,39 +298,89 @@ std::vector<cv::Vec4d> RegistrationResult::pairs() const {
   return out;
 }
 
-RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& image,
-                                       const RegistrationParams& params) {
-  RegistrationResult result;
-  result.stage = params.affineRegions ? "harris-affine" : "harris";
-  if (refImage.empty() || image.empty())
-    return failure(result, RegistrationFailure::EmptyImage,
-                   refImage.empty() ? "the reference image is empty" : "the image is empty");
-  const cv::Mat ref = unitGrey(refImage), img = unitGrey(image);
-  if (isBlank(ref))
-    return failure(result, RegistrationFailure::BlankImage,
-                   "the reference image is uniform: no corners to register");
-  if (isBlank(img))
-    return failure(result, RegistrationFailure::BlankImage,
-                   "the image is uniform: no corners to register");
-
-  const std::vector<cv::Mat> refPyramid = buildSamplingPyramid(ref);
-  const std::vector<cv::Mat> imgPyramid = buildSamplingPyramid(img);
+struct StageCache::State {
+  Status<RegistrationFailure> status;  // failed: an empty or uniform image
+  cv::Mat ref, img;                    // grey on [0, 1]
+  std::vector<cv::Mat> refPyramid, imgPyramid;
   // Detected once with the larger budget: the corners come in spreading order, so the first
   // maxCorners of them are what a smaller budget would have kept.
-  const int budget = std::max(params.corners.maxCorners, params.escalateCorners);
-  Features fr = detect(ref, params, budget);
-  Features fi = detect(img, params, budget);
-  describeUpTo(fr, refPyramid, params, params.corners.maxCorners);
-  describeUpTo(fi, imgPyramid, params, params.corners.maxCorners);
+  std::vector<HarrisCorner> refCorners, imgCorners;
+  // Per detector (plain, affine): the windows described so far and the first global match.
+  struct Detector {
+    Features ref, img;
+    std::optional<GlobalStage> first;
+  };
+  Detector plain, affine;
+  std::optional<std::vector<HarrisCorner>> grid;  // reference points for the re-matching
+  int gridCell = 0;                               // the grid's cell, reference pixels
+};
 
-  GlobalStage stage =
-      matchGlobally(fr, fi, params.corners.maxCorners, params.matching.minScore, params);
-  if (params.escalateCorners > params.corners.maxCorners &&
+StageCache::StageCache(const cv::Mat& refImage, const cv::Mat& image,
+                       const RegistrationParams& params)
+    : state(std::make_unique<State>()) {
+  State& s = *state;
+  if (refImage.empty() || image.empty()) {
+    s.status = Status<RegistrationFailure>::failed(
+        RegistrationFailure::EmptyImage,
+        refImage.empty() ? "the reference image is empty" : "the image is empty");
+    return;
+  }
+  s.ref = unitGrey(refImage);
+  s.img = unitGrey(image);
+  if (isBlank(s.ref)) {
+    s.status = Status<RegistrationFailure>::failed(
+        RegistrationFailure::BlankImage, "the reference image is uniform: no corners to register");
+    return;
+  }
+  if (isBlank(s.img)) {
+    s.status = Status<RegistrationFailure>::failed(RegistrationFailure::BlankImage,
+                                                   "the image is uniform: no corners to register");
+    return;
+  }
+  s.refPyramid = buildSamplingPyramid(s.ref);
+  s.imgPyramid = buildSamplingPyramid(s.img);
+  HarrisParams hp = params.corners;
+  hp.maxCorners = std::max(params.corners.maxCorners, params.escalateCorners);
+  s.refCorners = detectHarrisCorners(s.ref, hp);
+  s.imgCorners = detectHarrisCorners(s.img, hp);
+}
+
+StageCache::~StageCache() = default;
+
+RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& image,
+                                       const RegistrationParams& params) {
+  StageCache cache(refImage, image, params);
+  return registerStage(cache, params, true);
+}
+
+RegistrationResult registerStage(StageCache& cache, const RegistrationParams& params, bool widen) {
+  RegistrationResult result = matchStage(cache, params, widen);
+  if (result.status.ok()) refineStage(cache, params, result);
+  return result;
+}
+
+RegistrationResult matchStage(StageCache& cache, const RegistrationParams& params, bool widen) {
+  RegistrationResult result;
+  result.stage = params.affineRegions ? "harris-affine" : "harris";
+  StageCache::State& s = *cache.state;
+  if (!s.status.ok()) {
+    result.status = s.status;
+    return result;
+  }
+  StageCache::State::Detector& d = params.affineRegions ? s.affine : s.plain;
+  if (!d.first) {
+    describeUpTo(d.ref, s.refCorners, s.refPyramid, params, params.corners.maxCorners);
+    describeUpTo(d.img, s.imgCorners, s.imgPyramid, params, params.corners.maxCorners);
+    d.first =
+        matchGlobally(d.ref, d.img, params.corners.maxCorners, params.matching.minScore, params);
+  }
+  GlobalStage stage = *d.first;
+  if (widen && params.escalateCorners > params.corners.maxCorners &&
       static_cast<int>(stage.inliers.size()) < params.escalateBelowInliers) {
-    describeUpTo(fr, refPyramid, params, params.escalateCorners);
-    describeUpTo(fi, imgPyramid, params, params.escalateCorners);
+    describeUpTo(d.ref, s.refCorners, s.refPyramid, params, params.escalateCorners);
+    describeUpTo(d.img, s.imgCorners, s.imgPyramid, params, params.escalateCorners);
     GlobalStage wider =
-        matchGlobally(fr, fi, params.escalateCorners, params.escalateMinScore, params);
+        matchGlobally(d.ref, d.img, params.escalateCorners, params.escalateMinScore, params);
     if (wider.inliers.size() > stage.inliers.size() || (!stage.status.ok() && wider.status.ok()))
       stage = std::move(wider);
   }
@@ -348,26 +394,35 @@ RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& i
   result.H = stage.H;
   result.inliers = stage.inliers;
 
-  const std::size_t globalInliers = result.inliers.size();
-  result.globalInliers = static_cast<int>(globalInliers);
+  result.globalInliers = static_cast<int>(result.inliers.size());
+  return result;
+}
+
+void refineStage(StageCache& cache, const RegistrationParams& params, RegistrationResult& result) {
+  StageCache::State& s = *cache.state;
+  const auto globalInliers = static_cast<std::size_t>(result.globalInliers);
   if (params.refineIterations > 0) {
     TransformFitParams tight;
     tight.model = params.model;
     tight.inlierThreshold = params.finalThreshold;
     // The grid's cell is refineCell pixels of the finer view: where the image magnifies the
     // reference, a cell of the reference holds s^2 times more image pixels, each able to match.
-    const cv::Point2d centre((ref.cols - 1) / 2.0, (ref.rows - 1) / 2.0);
+    const cv::Point2d centre((s.ref.cols - 1) / 2.0, (s.ref.rows - 1) / 2.0);
     const double magnification = std::sqrt(std::abs(cv::determinant(jacobianAt(result.H, centre))));
     const int cell =
         magnification > 1.0
             ? std::max(1, static_cast<int>(std::lround(params.refineCell / magnification)))
             : params.refineCell;
-    const std::vector<HarrisCorner> dense = detectHarrisGrid(ref, cell, params.corners);
+    if (!s.grid || s.gridCell != cell) {
+      s.grid = detectHarrisGrid(s.ref, cell, params.corners);
+      s.gridCell = cell;
+    }
+    const std::vector<HarrisCorner>& dense = *s.grid;
     for (int it = 0; it < params.refineIterations; ++it) {
       // Once H rests on the dense pairs, the prediction is within a pixel or two.
       const int radius =
           it == 0 ? params.refineSearchRadius : std::min(params.refineSearchRadius, 3);
-      std::vector<FeatureMatch> rm = rematch(ref, img, dense, result.H, radius, params);
+      std::vector<FeatureMatch> rm = rematch(s.ref, s.img, dense, result.H, radius, params);
       std::vector<cv::Point2d> s2, d2;
       for (const auto& m : rm) {
         s2.push_back(m.ref);
@@ -389,13 +444,12 @@ RegistrationResult registerSingleStage(const cv::Mat& refImage, const cv::Mat& i
     // A transform resting on very few global matches must be confirmed by the re-matching.
     if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
         static_cast<int>(result.inliers.size()) < params.confirmInliers)
-      return failure(result, RegistrationFailure::TooFewInliers,
-                     std::to_string(globalInliers) +
-                         " global inliers, not confirmed by re-matching (" +
-                         std::to_string(result.inliers.size()) + " inliers, " +
-                         std::to_string(params.confirmInliers) + " needed)");
+      result.status = Status<RegistrationFailure>::failed(
+          RegistrationFailure::TooFewInliers,
+          std::to_string(globalInliers) + " global inliers, not confirmed by re-matching (" +
+              std::to_string(result.inliers.size()) + " inliers, " +
+              std::to_string(params.confirmInliers) + " needed)");
   }
-  return result;
 }
 
 }  // namespace facet

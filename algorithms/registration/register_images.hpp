@@ -7,6 +7,7 @@
 // The result H maps reference pixel coordinates to image pixel coordinates (homogeneous,
 // x right, y down, pixel centres at integers): q ~ H * (x, y, 1).
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -43,7 +44,8 @@ struct RegistrationParams {
   // Escalation for hard pairs (large viewpoint change): when the first global matching gives
   // fewer than `escalateBelowInliers` inliers, it is repeated with `escalateCorners` corners per
   // image and the minimum NCC lowered to `escalateMinScore`. escalateCorners <= maxCorners
-  // disables it.
+  // disables it. registerImages defers it in the plain stage when escalateToAffine is on (the
+  // affine stage comes first, this one only if neither finds a transform).
   int escalateCorners = 650;
   double escalateMinScore = 0.7;
   int escalateBelowInliers = 12;
@@ -100,5 +102,30 @@ RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
 // One stage only: the detector that params.affineRegions names, no escalation between them.
 RegistrationResult registerSingleStage(const cv::Mat& ref, const cv::Mat& image,
                                        const RegistrationParams& params = {});
+
+// What the stages of one pair share, computed once: the grey images, their sampling pyramids and
+// corners (detected with the larger of the two budgets), each detector's windows described so far
+// and its first global match, and the reference's grid points for the re-matching. Built for
+// `params`; the stages run on it may differ from them in affineRegions only.
+class StageCache {
+ public:
+  StageCache(const cv::Mat& ref, const cv::Mat& image, const RegistrationParams& params);
+  ~StageCache();
+  StageCache(const StageCache&) = delete;
+  StageCache& operator=(const StageCache&) = delete;
+  struct State;  // register_images.cpp
+  std::unique_ptr<State> state;
+};
+
+// One stage on the cache's pair: registerSingleStage, except that with `widen` false the
+// escalation to escalateCorners is left out (registerImages defers the plain stage's one).
+// It is matchStage, then refineStage when the global fit succeeded.
+RegistrationResult registerStage(StageCache& cache, const RegistrationParams& params, bool widen);
+// The global part of a stage: windows, all-pairs matching, robust fit (status, H, the window
+// matches and their inliers, globalInliers).
+RegistrationResult matchStage(StageCache& cache, const RegistrationParams& params, bool widen);
+// The warp-and-re-match of a global result (refineIterations), then the confirmation of a fit on
+// fewer than confirmBelowInliers inliers, which may turn the result into a failure.
+void refineStage(StageCache& cache, const RegistrationParams& params, RegistrationResult& result);
 
 }  // namespace facet

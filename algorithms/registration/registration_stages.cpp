@@ -42,19 +42,46 @@ void polishHomography(RegistrationResult& r, const RegistrationParams& params) {
   r.inliers = std::move(inliers);
 }
 
+// Re-matches a global result; true when it is then a registration (confirmed when it must be).
+bool refined(StageCache& cache, const RegistrationParams& params, RegistrationResult& r) {
+  if (!r.status.ok()) return false;
+  refineStage(cache, params, r);
+  return r.status.ok();
+}
+
 RegistrationResult registerStages(const cv::Mat& ref, const cv::Mat& image,
                                   const RegistrationParams& params) {
-  RegistrationResult fast = registerSingleStage(ref, image, params);
-  if (params.affineRegions || !params.escalateToAffine ||
-      (fast.status.ok() && fast.globalInliers >= params.affineBelowInliers))
+  StageCache cache(ref, image, params);
+  if (params.affineRegions || !params.escalateToAffine) return registerStage(cache, params, true);
+  // The plain stage's own escalation to escalateCorners is deferred. It runs when the first match
+  // has fewer than escalateBelowInliers inliers, and then the affine stage follows unless the
+  // wider match reaches affineBelowInliers, which it seldom does from there; the affine stage
+  // (which escalates in turn) costs about as much and is what such a pair needs.
+  RegistrationResult fast = matchStage(cache, params, false);
+  if (fast.status.ok() && fast.globalInliers >= params.affineBelowInliers &&
+      refined(cache, params, fast))
     return fast;
+  const bool fastRefined = fast.status.ok() && fast.globalInliers >= params.affineBelowInliers;
   RegistrationParams affine = params;
   affine.affineRegions = true;
-  RegistrationResult adapted = registerSingleStage(ref, image, affine);
+  RegistrationResult adapted = matchStage(cache, affine, true);
   adapted.escalated = fast.escalated = true;
-  if (!adapted.status.ok() && fast.status.ok()) return fast;
-  if (adapted.status.ok() && fast.status.ok() && adapted.globalInliers <= fast.globalInliers)
-    return fast;
+  // The result with more global inliers is kept (the plain one on a tie) if its re-matching
+  // confirms it, else the other one if its own does: only the kept one is re-matched, which
+  // saves the re-matching of the plain stage whenever the affine one wins.
+  const bool affineFirst =
+      adapted.status.ok() && (!fast.status.ok() || adapted.globalInliers > fast.globalInliers);
+  if (affineFirst && refined(cache, affine, adapted)) return adapted;
+  if (fast.status.ok() && (fastRefined || refined(cache, params, fast))) return fast;
+  if (!affineFirst && refined(cache, affine, adapted)) return adapted;
+  // Neither stage found a transform: the deferred plain escalation is the last resort (not when
+  // it would repeat the plain stage: no wider budget, or a first match that needs none).
+  if (params.escalateCorners > params.corners.maxCorners &&
+      fast.globalInliers < params.escalateBelowInliers) {
+    RegistrationResult wider = registerStage(cache, params, true);
+    wider.escalated = true;
+    if (wider.status.ok()) return wider;
+  }
   return adapted;
 }
 
