@@ -11,6 +11,7 @@
 #include <Eigen/Dense>
 
 #include "algorithms/circle/rim_band.hpp"
+#include "algorithms/circle/step_profile.hpp"
 #include "algorithms/edges/row_runs.hpp"
 #include "algorithms/geometry/levenberg_marquardt.hpp"
 
@@ -28,6 +29,8 @@ using rim_band::greyAt;
 using rim_band::medianOf;
 using rim_band::robustSigma;
 using rim_band::Sample;
+using step_profile::gaussian;
+using step_profile::upperTail;
 
 using Vector8 = Eigen::Matrix<double, 8, 1>;
 using Matrix8 = Eigen::Matrix<double, 8, 8>;
@@ -42,16 +45,39 @@ double diamondAngle(double dx, double dy) {
   return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
 }
 
-// Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): Abramowitz & Stegun
-// 7.1.26 for erfc (absolute error below 1.5e-7), which reuses the exponential the Jacobian needs.
-double upperTail(double z, double gauss) {
-  const double x = std::abs(z) / std::numbers::sqrt2;
-  const double t = 1.0 / (1.0 + 0.3275911 * x);
-  const double poly =
-      t *
-      (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
-  const double tail = 0.5 * poly * gauss;  // 0.5 erfc(x) with exp(-x^2) = gauss
-  return z >= 0.0 ? tail : 1.0 - tail;
+// One pass of the blurred-step model over the band at parameters q (cx, cy, R, s, level, ramp x,
+// ramp y, contrast b; pixel coordinates x, y relative to the starting centre): the residuals
+// grey - model and the Jacobian's columns that change (d/dcx, d/dcy, d/dR, d/ds, d/db). A
+// function of its own so that the arrays can be declared distinct (__restrict): otherwise the
+// compiler would check more pairs of them for overlap than it is willing to, and the loops would
+// not vectorise.
+void evaluateProfile(const Vector8& q, std::ptrdiff_t n, const double* __restrict x,
+                     const double* __restrict y, const double* __restrict grey,
+                     double* __restrict out, double* __restrict cx, double* __restrict cy,
+                     double* __restrict cr, double* __restrict cs, double* __restrict cb) {
+  const double cx0 = q(0), cy0 = q(1), radius = q(2), s = q(3), level = q(4), rampX = q(5),
+               rampY = q(6), b = q(7);
+  const double inv = 1.0 / s, bNorm = b * (1.0 / (std::sqrt(2.0 * kPi) * s));
+  // First pass: cx, cy hold ex / rho and ey / rho, cs holds z.
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const double ex = x[i] - cx0, ey = y[i] - cy0;
+    const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
+    cx[i] = ex / rho;
+    cy[i] = ey / rho;
+    cs[i] = (rho - radius) * inv;
+  }
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const double z = cs[i], gauss = gaussian(z);
+    const double phi = upperTail(z, gauss);  // Phi(-d / s)
+    const double bg = bNorm * gauss;         // b * pdf(d; s)
+    out[i] = grey[i] - (level + rampX * x[i] + rampY * y[i] + b * phi);
+    // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
+    cx[i] *= bg;
+    cy[i] *= bg;
+    cr[i] = bg;
+    cs[i] = bg * z;
+    cb[i] = phi;
+  }
 }
 
 }  // namespace
@@ -208,10 +234,13 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   std::vector<Sample> samples;
   samples.reserve(narrow ? static_cast<std::size_t>(std::min(1.0, share) * band.size()) + 64
                          : band.size());
+  // Which bins the share keeps, once per bin rather than per pixel.
+  std::vector<std::uint8_t> keptBin(bins, 1);
+  if (narrow && share < 1.0)
+    for (int b = 0; b < bins; ++b)
+      keptBin[b] = std::floor((b + 1) * share) != std::floor(b * share);
   for (const BandPixel& e : band) {
-    if (narrow && (!e.narrow ||
-                   (share < 1.0 && std::floor((e.bin + 1) * share) == std::floor(e.bin * share))))
-      continue;
+    if (narrow && (!e.narrow || !keptBin[e.bin])) continue;
     samples.push_back({e.column - centre.x, e.row - centre.y, greyAt(image, e.column, e.row), e.bin,
                        e.column, e.row});
   }
@@ -256,46 +285,24 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   };
   loadBand();
   auto evaluate = [&](const Vector8& q, Eigen::VectorXd& res, Columns& j) {
-    const double s = q(3), inv = 1.0 / s, norm = 1.0 / (std::sqrt(2.0 * kPi) * s);
-    const auto n = static_cast<Eigen::Index>(m);
-    const double* x = px.data();
-    const double* y = py.data();
-    const double* g = grey.data();
-    double* out = res.data();
-    double* cx = j.col(0).data();  // dI/dcx, after the first pass ex / rho
-    double* cy = j.col(1).data();  // dI/dcy, after the first pass ey / rho
-    double* cr = j.col(2).data();  // dI/dR, after the second pass the Gaussian
-    double* cs = j.col(3).data();  // dI/ds, after the first pass z
-    double* cb = j.col(7).data();  // dI/db
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double ex = x[i] - q(0), ey = y[i] - q(1);
-      const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
-      cx[i] = ex / rho;
-      cy[i] = ey / rho;
-      cs[i] = (rho - q(2)) * inv;
-    }
-    for (Eigen::Index i = 0; i < n; ++i) cr[i] = std::exp(-0.5 * cs[i] * cs[i]);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const double z = cs[i], gauss = cr[i];
-      const double phi = upperTail(z, gauss);  // Phi(-d / s)
-      const double bg = q(7) * norm * gauss;   // b * pdf(d; s)
-      out[i] = g[i] - (q(4) + q(5) * x[i] + q(6) * y[i] + q(7) * phi);
-      // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
-      cx[i] *= bg;
-      cy[i] *= bg;
-      cr[i] = bg;
-      cs[i] = bg * z;
-      cb[i] = phi;
-    }
+    evaluateProfile(q, static_cast<std::ptrdiff_t>(m), px.data(), py.data(), grey.data(),
+                    res.data(), j.col(0).data(), j.col(1).data(), j.col(2).data(), j.col(3).data(),
+                    j.col(7).data());
   };
   auto cost = [&](const Eigen::VectorXd& res) {
     return (weight.array() * res.array().square()).sum();
   };
   Matrix8 jtj;
   Vector8 jtr;
+  // J^T W J's upper triangle row by row (a weighted column times the columns from the diagonal
+  // on), mirrored: the matrix product packed both tall matrices first and computed the lower
+  // triangle too.
   auto normalEquations = [&] {
     weighted = jac.array().colwise() * weight.array();
-    jtj.noalias() = weighted.transpose() * jac;
+    for (int a = 0; a < 8; ++a) {
+      jtj.row(a).tail(8 - a).noalias() = weighted.col(a).transpose() * jac.rightCols(8 - a);
+      jtj.col(a).tail(7 - a) = jtj.row(a).tail(7 - a).transpose();
+    }
     jtr.noalias() = weighted.transpose() * r;
   };
   auto tukeyWeights = [&] {
