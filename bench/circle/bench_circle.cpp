@@ -5,7 +5,8 @@
 // both methods is off by up to 2 px. Cases: clean; hard (30% of the rim occluded, clutter on the
 // annulus off the rim, illumination gradient); low contrast (15 grey levels). Targets (issue 4),
 // "median over >= 30 scenes per radius": centre and radius error <= 0.01 px clean, <= 0.02 px
-// hard without failure, <= 0.03 px at low contrast; <= 1 ms at r = 100. The target column judges
+// hard without failure, <= 0.03 px at low contrast; <= 0.5 ms at r = 100 (issue 18; issue 4 asked
+// 1 ms), printed beside HOUGH_GRADIENT's time in the same run. The target column judges
 // the median error over the scenes a row measured, as the issue words it; the RMS is printed
 // beside it and judged too, since a median can hide a few gross errors.
 //
@@ -437,9 +438,10 @@ int main(int argc, char** argv) {
   const double ms = median(ours);
   std::printf(
       "\ntime per circle r=100 (%dx%d image, median of %d, thread CPU time): ours %.3f ms | "
-      "HOUGH_GRADIENT %.3f ms | HOUGH_GRADIENT_ALT %.3f ms | target <= 1 ms: %s\n",
-      t.image.cols, t.image.rows, reps, ms, median(hgT), median(altT),
-      ms <= 1.0 ? "met" : "MISSED");
+      "HOUGH_GRADIENT %.3f ms | HOUGH_GRADIENT_ALT %.3f ms | ours / HOUGH_GRADIENT %.2f | target "
+      "<= 0.5 ms: %s\n",
+      t.image.cols, t.image.rows, reps, ms, median(hgT), median(altT), ms / median(hgT),
+      ms <= 0.5 ? "met" : "MISSED");
   std::printf("accuracy targets by the median (the issue's statistic): %s; by the RMS: %s\n",
               allMedian ? "all met" : "NOT all met", allRms ? "all met" : "NOT all met");
   return 0;
