@@ -241,22 +241,31 @@ EdgeBlur fitBlurModel(const cv::Mat& image, const std::vector<const EdgeSeed*>& 
   // is left out of the search.
   std::vector<size_t> kept(seeds.size());
   for (size_t i = 0; i < seeds.size(); ++i) kept[i] = i;
+  // Per model, each seed's residual at sigma0: the misfit ranking below and the search's step 0.
+  std::array<std::vector<double>, 2> atSigma0;
   if (seeds.size() >= 8) {
     std::vector<double> misfit(seeds.size(), std::numeric_limits<double>::infinity());
     for (const bool grid : {false, true}) {
       if (onlyModel && *onlyModel != grid) continue;
       const auto profiles = apertureProfiles(sigma0, grid);
-      for (size_t i = 0; i < seeds.size(); ++i)
-        misfit[i] = std::min(
-            misfit[i],
-            fitResidual(samples[i], apertureView(*profiles, seeds[i]->normal), seeds[i]->offset));
+      std::vector<double>& residual = atSigma0[grid];
+      residual.resize(seeds.size());
+      for (size_t i = 0; i < seeds.size(); ++i) {
+        residual[i] =
+            fitResidual(samples[i], apertureView(*profiles, seeds[i]->normal), seeds[i]->offset);
+        misfit[i] = std::min(misfit[i], residual[i]);
+      }
     }
     std::sort(kept.begin(), kept.end(), [&](size_t a, size_t b) { return misfit[a] < misfit[b]; });
     kept.resize(seeds.size() - seeds.size() / 4);
   }
-  const auto rssAt = [&](double sigma, bool grid) {
-    const auto profiles = apertureProfiles(sigma, grid);
+  const auto rssAt = [&](int step, bool grid) {
     double rss = 0;
+    if (step == 0 && !atSigma0[grid].empty()) {
+      for (const size_t i : kept) rss += atSigma0[grid][i];
+      return rss;
+    }
+    const auto profiles = apertureProfiles(sigma0 + 0.02 * step, grid);
     for (const size_t i : kept)
       rss += fitResidual(samples[i], apertureView(*profiles, seeds[i]->normal), seeds[i]->offset);
     return rss;
@@ -270,9 +279,8 @@ EdgeBlur fitBlurModel(const cv::Mat& image, const std::vector<const EdgeSeed*>& 
     double modelBest = std::numeric_limits<double>::infinity();
     int bestStep = 0;
     const auto tryStep = [&](int step) {
-      const double sigma = sigma0 + 0.02 * step;
-      if (sigma < 0.2) return;
-      const double rss = rssAt(sigma, grid);
+      if (sigma0 + 0.02 * step < 0.2) return;
+      const double rss = rssAt(step, grid);
       if (rss < modelBest) modelBest = rss, bestStep = step;
     };
     for (int step = -6; step <= 6; step += 3) tryStep(step);

@@ -137,6 +137,15 @@ cv::Matx22d jacobianAt(const cv::Matx33d& H, cv::Point2d p) {
           (H(1, 1) - v * H(2, 1)) / w};
 }
 
+// The linear scale by which H magnifies the neighbourhood of p (square root of the area ratio).
+double magnificationAt(const cv::Matx33d& H, cv::Point2d p) {
+  return std::sqrt(std::abs(cv::determinant(jacobianAt(H, p))));
+}
+
+cv::Point2d centreOf(const cv::Mat& image) {
+  return {(image.cols - 1) / 2.0, (image.rows - 1) / 2.0};
+}
+
 double parabolaPeak(float a, float b, float c) {
   const double d = a - 2.0 * b + c;
   if (d >= 0) return 0.0;
@@ -148,8 +157,7 @@ double parabolaPeak(float a, float b, float c) {
 std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
                                   const std::vector<HarrisCorner>& corners, const cv::Matx33d& H,
                                   int R, const RegistrationParams& params) {
-  const cv::Point2d centre((refGrey.cols - 1) / 2.0, (refGrey.rows - 1) / 2.0);
-  const double s = std::sqrt(std::abs(cv::determinant(jacobianAt(H, centre))));
+  const double s = magnificationAt(H, centreOf(refGrey));
   // Match resolutions: blur whichever image is seen at the finer scale, into a buffer of its own
   // (a blur into `ref` or `img` while they share the caller's pixels would blur those in place,
   // and the next iteration would blur them again).
@@ -374,25 +382,27 @@ RegistrationResult matchStage(StageCache& cache, const RegistrationParams& param
     d.first =
         matchGlobally(d.ref, d.img, params.corners.maxCorners, params.matching.minScore, params);
   }
-  GlobalStage stage = *d.first;
+  // The first stage stays in the cache (the other detector's run or a later call reuses it); the
+  // result copies from whichever stage is kept.
+  const GlobalStage* stage = &*d.first;
+  GlobalStage wider;
   if (widen && params.escalateCorners > params.corners.maxCorners &&
-      static_cast<int>(stage.inliers.size()) < params.escalateBelowInliers) {
+      static_cast<int>(stage->inliers.size()) < params.escalateBelowInliers) {
     describeUpTo(d.ref, s.refCorners, s.refPyramid, params, params.escalateCorners);
     describeUpTo(d.img, s.imgCorners, s.imgPyramid, params, params.escalateCorners);
-    GlobalStage wider =
-        matchGlobally(d.ref, d.img, params.escalateCorners, params.escalateMinScore, params);
-    if (wider.inliers.size() > stage.inliers.size() || (!stage.status.ok() && wider.status.ok()))
-      stage = std::move(wider);
+    wider = matchGlobally(d.ref, d.img, params.escalateCorners, params.escalateMinScore, params);
+    if (wider.inliers.size() > stage->inliers.size() || (!stage->status.ok() && wider.status.ok()))
+      stage = &wider;
   }
-  result.refCorners = stage.refCorners;
-  result.imageCorners = stage.imageCorners;
-  result.matches = std::move(stage.matches);
-  if (!stage.status.ok()) {
-    result.status = std::move(stage.status);
+  result.refCorners = stage->refCorners;
+  result.imageCorners = stage->imageCorners;
+  result.matches = stage->matches;
+  if (!stage->status.ok()) {
+    result.status = stage->status;
     return result;
   }
-  result.H = stage.H;
-  result.inliers = stage.inliers;
+  result.H = stage->H;
+  result.inliers = stage->inliers;
 
   result.globalInliers = static_cast<int>(result.inliers.size());
   return result;
@@ -407,8 +417,7 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
     tight.inlierThreshold = params.finalThreshold;
     // The grid's cell is refineCell pixels of the finer view: where the image magnifies the
     // reference, a cell of the reference holds s^2 times more image pixels, each able to match.
-    const cv::Point2d centre((s.ref.cols - 1) / 2.0, (s.ref.rows - 1) / 2.0);
-    const double magnification = std::sqrt(std::abs(cv::determinant(jacobianAt(result.H, centre))));
+    const double magnification = magnificationAt(result.H, centreOf(s.ref));
     const int cell =
         magnification > 1.0
             ? std::max(1, static_cast<int>(std::lround(params.refineCell / magnification)))
