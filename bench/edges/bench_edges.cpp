@@ -1,7 +1,8 @@
 // bench_edges: accuracy of the facet subpixel edges on straight edges at every orientation and on
 // circles, and full-frame speed beside cv::Canny (pixel level) measured in the same run.
 //
-//   bench_edges [--smoke] [--model pixel-grid|lens] [--profile-model grid|lens]
+//   bench_edges [--smoke] [--model pixel-grid|lens] [--profile-model grid|lens] [--speed]
+//   (--speed: the speed table alone, e.g. under a profiler)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -141,11 +142,13 @@ double median(std::vector<double> v) {
 int main(int argc, char** argv) {
   bool smoke = false;
   const char* only = nullptr;  // --model pixel-grid|lens: that scene model alone
+  bool speedOnly = false;      // --speed: the speed table alone (for a profiler)
   for (int i = 1; i < argc; ++i) {
     smoke = smoke || std::strcmp(argv[i], "--smoke") == 0;
     if (std::strcmp(argv[i], "--profile-model") == 0 && i + 1 < argc)
       gProfileModel = std::strcmp(argv[++i], "grid") == 0;
     if (std::strcmp(argv[i], "--model") == 0 && i + 1 < argc) only = argv[++i];
+    speedOnly = speedOnly || std::strcmp(argv[i], "--speed") == 0;
   }
   // Development aid: --angle DEG BLUR NOISE [lens] prints every point's error for one straight
   // edge.
@@ -176,7 +179,8 @@ int main(int argc, char** argv) {
                 *gProfileModel ? "grid" : "lens");
   for (const BlurModel model : {BlurModel::PixelGrid, BlurModel::Lens})
     for (double blur : {0.5, 0.7, 1.0, 1.5}) {
-      if (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0) continue;
+      if (speedOnly || (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0))
+        continue;
       for (double noise : {0.0, 2.0}) {
         double sum = 0, worst = 0;
         int count = 0, worstDeg = 0;
@@ -204,7 +208,8 @@ int main(int argc, char** argv) {
       smoke ? std::vector<double>{10, 50} : std::vector<double>{10, 15, 20, 30, 50, 100, 200};
   for (const BlurModel model : {BlurModel::PixelGrid, BlurModel::Lens})
     for (double blur : smoke ? std::vector<double>{1.0} : std::vector<double>{0.7, 1.0, 1.5}) {
-      if (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0) continue;
+      if (speedOnly || (only && std::strcmp(only, facet::scene::blurModelName(model)) != 0))
+        continue;
       for (double r : radii) {
         const double raw = measureRadiusBias(r, blur, false, 5, model);
         const double cor = measureRadiusBias(r, blur, true, 5, model);
