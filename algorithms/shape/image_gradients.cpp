@@ -34,8 +34,9 @@ void normalise(const cv::Mat& gx, const cv::Mat& gy, float min2, cv::Mat& out) {
       const float a = static_cast<float>(px[x]), b = static_cast<float>(py[x]);
       const float m2 = a * a + b * b;
       const float inv = m2 >= min2 ? 127.0f / std::sqrt(m2) : 0.0f;
-      o[x] = {static_cast<uchar>(static_cast<signed char>(std::lround(a * inv))),
-              static_cast<uchar>(static_cast<signed char>(std::lround(b * inv)))};
+      // cvRound: an inlined conversion instruction (std::lround is a library call per value).
+      o[x] = {static_cast<uchar>(static_cast<signed char>(cvRound(a * inv))),
+              static_cast<uchar>(static_cast<signed char>(cvRound(b * inv)))};
     }
   }
 }

@@ -7,21 +7,24 @@
 #include <functional>
 #include <numbers>
 
+#include <opencv2/core/hal/intrin.hpp>
+
 #include "algorithms/shape/image_gradients.hpp"
+#include "algorithms/shape/response_sums.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
 
 namespace facet::shape_detail {
 namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr int kBins = 32;           // quantised orientations
-constexpr int kMaxTopPoints = 250;  // 16-bit sums: 250 * 127 < 32767
+constexpr int kBins = 32;  // quantised orientations
+// 16-bit sums: 250 * 128 < 32767 (a map value is at most 127.7 rounded: directions are rounded).
+constexpr int kMaxTopPoints = 250;
 
 struct TopTemplate {
   double angle = 0.0;
   double scale = 1.0;
-  std::vector<int> offsets;  // into a padded map plane
-  std::vector<int> bins;
+  std::vector<std::ptrdiff_t> sources;  // map plane of the point's bin + its offset in the plane
 };
 
 }  // namespace
@@ -44,11 +47,14 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
     radius = std::max(radius, std::hypot(double(p.position.x), double(p.position.y)));
   const int border = static_cast<int>(std::ceil(radius * scales.back())) + 2;
   const int w = field.cols, h = field.rows;
-  const int stride = w + 2 * border;
-  const std::size_t plane = static_cast<std::size_t>(stride) * (h + 2 * border);
+  // Rows are summed in whole blocks of kSumAlign; the pixels past w read zeros and are ignored.
+  const int paddedW = (w + kSumAlign - 1) / kSumAlign * kSumAlign;
+  const int stride = paddedW + 2 * border;
+  const auto plane = static_cast<std::ptrdiff_t>(stride) * (h + 2 * border);
   const bool local = polarity == Polarity::IgnoreLocal;
 
-  std::vector<std::int8_t> maps(plane * kBins, 0);
+  // 16-bit maps: the sums add them without widening each value first.
+  std::vector<std::int16_t> maps(static_cast<std::size_t>(plane) * kBins, 0);
   std::array<float, kBins> cosB{}, sinB{};
   for (int b = 0; b < kBins; ++b) {
     cosB[b] = static_cast<float>(std::cos(b * kTwoPi / kBins));
@@ -72,13 +78,14 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   inStripes([&](int y0, int y1) {
     for (int y = y0; y < y1; ++y) {
       const auto* row = field.ptr<Direction>(y);
-      const std::size_t base = static_cast<std::size_t>(y + border) * stride + border;
+      const std::ptrdiff_t base = static_cast<std::ptrdiff_t>(y + border) * stride + border;
       for (int x = 0; x < w; ++x) {
         if (row[x][0] == 0 && row[x][1] == 0) continue;
         for (int b = 0; b < kBins; ++b) {
           float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
           if (local) v = std::abs(v);
-          maps[b * plane + base + x] = static_cast<std::int8_t>(std::lround(v));
+          maps[static_cast<std::size_t>(b * plane + base + x)] =
+              static_cast<std::int16_t>(cvRound(v));
         }
       }
     }
@@ -87,39 +94,45 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   std::vector<TopTemplate> templates;
   for (double s : scales) {
     for (double a : angles) {
-      TopTemplate t{a, s, {}, {}};
+      TopTemplate t{a, s, {}};
       const PosedPoints posed = posePoints(points, a, s);
       for (std::size_t i = 0; i < points.size(); ++i) {
-        t.offsets.push_back(posed.offsets[i].y * stride + posed.offsets[i].x);
         const double theta = std::atan2(posed.directions[i].y, posed.directions[i].x);
-        t.bins.push_back(((static_cast<int>(std::lround(theta / kTwoPi * kBins)) % kBins) + kBins) %
-                         kBins);
+        const int bin =
+            ((static_cast<int>(std::lround(theta / kTwoPi * kBins)) % kBins) + kBins) % kBins;
+        t.sources.push_back(bin * plane + posed.offsets[i].y * stride + posed.offsets[i].x);
       }
       templates.push_back(std::move(t));
     }
   }
 
-  // Best template per pixel.
-  std::vector<std::int16_t> best(static_cast<std::size_t>(w) * h, 0);
+  // Best template per pixel (the first one of equal sums).
+  std::vector<std::int16_t> best(static_cast<std::size_t>(paddedW) * h, 0);
   std::vector<std::int32_t> bestTemplate(best.size(), -1);
   const bool global = polarity == Polarity::IgnoreGlobal;
   auto work = [&](int y0, int y1) {
-    std::vector<std::int16_t> acc(w);
+    alignas(16) std::int16_t sums[kSumBlock];
     for (int y = y0; y < y1; ++y) {
-      const std::size_t rowBase = static_cast<std::size_t>(y + border) * stride + border;
-      std::int16_t* bestRow = best.data() + static_cast<std::size_t>(y) * w;
-      std::int32_t* bestIdx = bestTemplate.data() + static_cast<std::size_t>(y) * w;
+      const std::int16_t* row =
+          maps.data() + static_cast<std::ptrdiff_t>(y + border) * stride + border;
+      std::int16_t* bestRow = best.data() + static_cast<std::size_t>(y) * paddedW;
+      std::int32_t* bestIdx = bestTemplate.data() + static_cast<std::size_t>(y) * paddedW;
       for (std::size_t t = 0; t < templates.size(); ++t) {
-        const TopTemplate& tpl = templates[t];
-        std::fill(acc.begin(), acc.end(), 0);
-        std::int16_t* a = acc.data();
-        for (std::size_t i = 0; i < tpl.offsets.size(); ++i) {
-          const std::int8_t* src = maps.data() + tpl.bins[i] * plane + rowBase + tpl.offsets[i];
-          for (int x = 0; x < w; ++x) a[x] = static_cast<std::int16_t>(a[x] + src[x]);
-        }
-        for (int x = 0; x < w; ++x) {
-          const std::int16_t v = global ? static_cast<std::int16_t>(std::abs(a[x])) : a[x];
-          if (v > bestRow[x]) bestRow[x] = v, bestIdx[x] = static_cast<std::int32_t>(t);
+        const std::vector<std::ptrdiff_t>& sources = templates[t].sources;
+        for (int x0 = 0; x0 < paddedW; x0 += kSumBlock) {
+          const int n = std::min(kSumBlock, paddedW - x0);
+          sumResponses(row + x0, sources.data(), sources.size(), n, sums);
+          for (int k = 0; k < n; k += 8) {
+            cv::v_int16x8 v = cv::v_load_aligned(sums + k);
+            if (global) v = cv::v_reinterpret_as_s16(cv::v_abs(v));
+            std::int16_t* b = bestRow + x0 + k;
+            // Improvements become rare after the first templates: test 8 pixels at once.
+            if (!cv::v_check_any(v > cv::v_load(b))) continue;
+            cv::v_store_aligned(sums + k, v);
+            for (int j = k; j < k + 8; ++j)
+              if (sums[j] > b[j - k])
+                b[j - k] = sums[j], bestIdx[x0 + j] = static_cast<std::int32_t>(t);
+          }
         }
       }
     }
@@ -133,14 +146,14 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   constexpr int r = 2;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const std::int16_t v = best[static_cast<std::size_t>(y) * w + x];
+      const std::int16_t v = best[static_cast<std::size_t>(y) * paddedW + x];
       if (v < minSum || v <= 0) continue;
       bool isMax = true;
       for (int dy = -r; dy <= r && isMax; ++dy)
         for (int dx = -r; dx <= r; ++dx) {
           const int xx = x + dx, yy = y + dy;
           if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-          const std::int16_t u = best[static_cast<std::size_t>(yy) * w + xx];
+          const std::int16_t u = best[static_cast<std::size_t>(yy) * paddedW + xx];
           // Strict on one side so that a plateau yields one maximum.
           if (u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0)))) {
             isMax = false;
@@ -148,7 +161,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
           }
         }
       if (!isMax) continue;
-      const TopTemplate& tpl = templates[bestTemplate[static_cast<std::size_t>(y) * w + x]];
+      const TopTemplate& tpl = templates[bestTemplate[static_cast<std::size_t>(y) * paddedW + x]];
       candidates.push_back({double(x), double(y), tpl.angle, tpl.scale, v / norm});
     }
   }
