@@ -18,7 +18,7 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr int kBins = 32;  // quantised orientations
-// 16-bit sums: 250 * 128 < 32767 (a map value is at most 127.7 rounded: directions are rounded).
+// 16-bit sums: 250 * 127 < 32767.
 constexpr int kMaxTopPoints = 250;
 
 struct TopTemplate {
@@ -53,8 +53,8 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   const auto plane = static_cast<std::ptrdiff_t>(stride) * (h + 2 * border);
   const bool local = polarity == Polarity::IgnoreLocal;
 
-  // 16-bit maps: the sums add them without widening each value first.
-  std::vector<std::int16_t> maps(static_cast<std::size_t>(plane) * kBins, 0);
+  // 8-bit maps (half the memory the sums read), widened as they are added.
+  std::vector<std::int8_t> maps(static_cast<std::size_t>(plane) * kBins, 0);
   std::array<float, kBins> cosB{}, sinB{};
   for (int b = 0; b < kBins; ++b) {
     cosB[b] = static_cast<float>(std::cos(b * kTwoPi / kBins));
@@ -84,8 +84,9 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
         for (int b = 0; b < kBins; ++b) {
           float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
           if (local) v = std::abs(v);
+          // A rounded direction may be up to 127.7 long: clamped, so that 128 cannot wrap.
           maps[static_cast<std::size_t>(b * plane + base + x)] =
-              static_cast<std::int16_t>(cvRound(v));
+              static_cast<std::int8_t>(std::min(cvRound(v), 127));
         }
       }
     }
@@ -113,7 +114,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   auto work = [&](int y0, int y1) {
     alignas(16) std::int16_t sums[kSumBlock];
     for (int y = y0; y < y1; ++y) {
-      const std::int16_t* row =
+      const std::int8_t* row =
           maps.data() + static_cast<std::ptrdiff_t>(y + border) * stride + border;
       std::int16_t* bestRow = best.data() + static_cast<std::size_t>(y) * paddedW;
       std::int32_t* bestIdx = bestTemplate.data() + static_cast<std::size_t>(y) * paddedW;

@@ -12,10 +12,11 @@ namespace facet::shape_detail {
 constexpr int kSumBlock = 64;  // pixels summed at once, at most
 constexpr int kSumAlign = 16;  // block widths are a multiple of this
 
-// out[x] = sum over i < count of row[offsets[i] + x], for 0 <= x < width (16-bit, saturating;
-// the caller keeps the sums below 32767). width: a multiple of kSumAlign, at most kSumBlock.
+// out[x] = sum over i < count of row[offsets[i] + x], for 0 <= x < width: 8-bit values summed in
+// 16 bits, saturating (the caller keeps the sums below 32767). width: a multiple of kSumAlign, at
+// most kSumBlock.
 // Uses AVX2 where the processor has it (the build itself targets the plain instruction set).
-void sumResponses(const std::int16_t* row, const std::ptrdiff_t* offsets, std::size_t count,
+void sumResponses(const std::int8_t* row, const std::ptrdiff_t* offsets, std::size_t count,
                   int width, std::int16_t* out);
 
 }  // namespace facet::shape_detail
