@@ -8,6 +8,7 @@
 #include <numbers>
 
 #include <opencv2/core/hal/intrin.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/response_sums.hpp"
@@ -93,10 +94,18 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   });
 
   std::vector<TopTemplate> templates;
+  int sharing = 1;  // the most points of one template that land on the same pixel
   for (double s : scales) {
     for (double a : angles) {
       TopTemplate t{a, s, {}};
       const PosedPoints posed = posePoints(points, a, s);
+      std::vector<std::ptrdiff_t> pixels;
+      for (const cv::Point& o : posed.offsets) pixels.push_back(o.y * stride + o.x);
+      std::sort(pixels.begin(), pixels.end());
+      for (std::size_t i = 0, j = 0; i < pixels.size(); i = j) {
+        while (j < pixels.size() && pixels[j] == pixels[i]) ++j;
+        sharing = std::max(sharing, static_cast<int>(j - i));
+      }
       for (std::size_t i = 0; i < points.size(); ++i) {
         const double theta = std::atan2(posed.directions[i].y, posed.directions[i].x);
         const int bin =
@@ -104,6 +113,39 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
         t.sources.push_back(bin * plane + posed.offsets[i].y * stride + posed.offsets[i].x);
       }
       templates.push_back(std::move(t));
+    }
+  }
+
+  const double norm = 127.0 * static_cast<double>(points.size());
+  const auto minSum = static_cast<std::int16_t>(std::min(32767.0, threshold * norm));
+
+  // A point adds at most 127, and only on a pixel that has a direction: a pixel whose
+  // neighbourhood (the model's reach) holds fewer than minSum / (127 sharing) such pixels scores
+  // below the threshold at every angle and scale. Such pixels are neither candidates nor
+  // neighbours that could suppress one, so blocks of them are skipped without changing the
+  // result: on plain background, most of the image.
+  const int blockW = std::min(kSumBlock, paddedW);
+  const int blocksPerRow = (paddedW + blockW - 1) / blockW;
+  std::vector<std::uint8_t> live(static_cast<std::size_t>(h) * blocksPerRow, 0);
+  {
+    cv::Mat directed(h, w, CV_8U), count;
+    for (int y = 0; y < h; ++y) {
+      const auto* row = field.ptr<Direction>(y);
+      auto* d = directed.ptr<uchar>(y);
+      for (int x = 0; x < w; ++x) d[x] = (row[x][0] != 0 || row[x][1] != 0) ? 1 : 0;
+    }
+    cv::integral(directed, count, CV_32S);
+    const int reach = border;
+    for (int y = 0; y < h; ++y) {
+      const int ya = std::max(0, y - reach), yb = std::min(h, y + reach + 1);
+      const int* top = count.ptr<int>(ya);
+      const int* bottom = count.ptr<int>(yb);
+      for (int x = 0; x < w; ++x) {
+        const int xa = std::max(0, x - reach), xb = std::min(w, x + reach + 1);
+        const int directedNear = bottom[xb] - bottom[xa] - top[xb] + top[xa];
+        if (127LL * sharing * directedNear >= minSum)
+          live[static_cast<std::size_t>(y) * blocksPerRow + x / blockW] = 1;
+      }
     }
   }
 
@@ -118,10 +160,11 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
           maps.data() + static_cast<std::ptrdiff_t>(y + border) * stride + border;
       std::int16_t* bestRow = best.data() + static_cast<std::size_t>(y) * paddedW;
       std::int32_t* bestIdx = bestTemplate.data() + static_cast<std::size_t>(y) * paddedW;
-      for (std::size_t t = 0; t < templates.size(); ++t) {
-        const std::vector<std::ptrdiff_t>& sources = templates[t].sources;
-        for (int x0 = 0; x0 < paddedW; x0 += kSumBlock) {
-          const int n = std::min(kSumBlock, paddedW - x0);
+      for (int x0 = 0; x0 < paddedW; x0 += blockW) {
+        if (!live[static_cast<std::size_t>(y) * blocksPerRow + x0 / blockW]) continue;
+        const int n = std::min(blockW, paddedW - x0);
+        for (std::size_t t = 0; t < templates.size(); ++t) {
+          const std::vector<std::ptrdiff_t>& sources = templates[t].sources;
           sumResponses(row + x0, sources.data(), sources.size(), n, sums);
           for (int k = 0; k < n; k += 8) {
             cv::v_int16x8 v = cv::v_load_aligned(sums + k);
@@ -141,8 +184,6 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   inStripes(work);
 
   // Local maxima above the threshold.
-  const double norm = 127.0 * static_cast<double>(points.size());
-  const auto minSum = static_cast<std::int16_t>(std::min(32767.0, threshold * norm));
   std::vector<Candidate> candidates;
   constexpr int r = 2;
   for (int y = 0; y < h; ++y) {
