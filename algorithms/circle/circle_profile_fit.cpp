@@ -262,7 +262,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // vectorise; the Jacobian's columns of the levels and the ramp (1, x, y) never change.
   std::size_t m = samples.size();
   Eigen::VectorXd px, py, grey, r, rTry, weight;
-  Columns jac, jacTry, weighted;
+  Columns jac, jacTry;
+  Eigen::VectorXd weighted;  // one column of W J
   auto loadBand = [&] {
     const auto n = static_cast<Eigen::Index>(m);
     px.resize(n);
@@ -294,16 +295,22 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   };
   Matrix8 jtj;
   Vector8 jtr;
-  // J^T W J's upper triangle row by row (a weighted column times the columns from the diagonal
-  // on), mirrored: the matrix product packed both tall matrices first and computed the lower
-  // triangle too.
-  auto normalEquations = [&] {
-    weighted = jac.array().colwise() * weight.array();
+  // J^T W J and J^T W r over the free parameters only; a fixed parameter's row and column are
+  // the identity's, so that the step leaves it alone (the ramp is fixed in the first solve, and
+  // its products were a quarter of the work). Each entry is one dot product of two contiguous
+  // columns, which vectorises; the matrix products with a row of weighted columns did not.
+  using Free = std::array<bool, 8>;
+  constexpr Free kAll{true, true, true, true, true, true, true, true};
+  auto normalEquations = [&](const Free& free) {
+    jtj.setIdentity();
+    jtr.setZero();
     for (int a = 0; a < 8; ++a) {
-      jtj.row(a).tail(8 - a).noalias() = weighted.col(a).transpose() * jac.rightCols(8 - a);
-      jtj.col(a).tail(7 - a) = jtj.row(a).tail(7 - a).transpose();
+      if (!free[a]) continue;
+      weighted = jac.col(a).cwiseProduct(weight);
+      jtr(a) = weighted.dot(r);
+      for (int b = a; b < 8; ++b)
+        if (free[b]) jtj(b, a) = jtj(a, b) = weighted.dot(jac.col(b));
     }
-    jtr.noalias() = weighted.transpose() * r;
   };
   auto tukeyWeights = [&] {
     const double sigma = std::max(robustSigma({r.data(), m}), 0.25);
@@ -317,7 +324,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
 
   // Levenberg-Marquardt over the parameters marked free (a fixed one keeps its value).
   double sigma = 0.0;
-  auto solve = [&](const std::array<bool, 8>& free, int maxIterations, bool reweight) {
+  auto solve = [&](const Free& free, int maxIterations, bool reweight) {
     LevenbergMarquardtCallbacks problem{
         [&](const Vector8& q) {
           evaluate(q, r, jac);
@@ -331,14 +338,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
             sigma = tukeyWeights();
             current = cost(r);
           }
-          normalEquations();
-          for (int k = 0; k < 8; ++k)
-            if (!free[k]) {
-              jtj.row(k).setZero();
-              jtj.col(k).setZero();
-              jtj(k, k) = 1.0;
-              jtr(k) = 0.0;
-            }
+          normalEquations(free);
           h = jtj;
           g = -jtr;  // the residuals here are grey - model
         },
@@ -366,7 +366,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // has a ramp worth fitting.
   bool withRamp = false;
   if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
-  normalEquations();
+  normalEquations(kAll);
   {
     constexpr int kRamp[2] = {5, 6};
     constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
@@ -385,7 +385,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     const double statistic = score.dot(schur.ldlt().solve(score)) / std::max(sigma * sigma, 1e-12);
     if (std::isfinite(statistic) && statistic > 13.8) {
       withRamp = true;
-      if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
+      if (!solve(kAll, 10, true)) return std::nullopt;
     }
   }
 
