@@ -37,12 +37,27 @@ using Matrix8 = Eigen::Matrix<double, 8, 8>;
 using Columns = Eigen::Matrix<double, Eigen::Dynamic, 8>;
 
 // A monotonic stand-in for the polar angle, in [0, 4) (no atan2 in the pixel loops); bins of
-// equal width in it are within a factor 1.5 of equal angles.
+// equal width in it are within a factor 1.5 of equal angles. 0 at the centre itself. Without a
+// branch, so that the loops over the band's rows vectorise.
 double diamondAngle(double dx, double dy) {
   const double sum = std::abs(dx) + std::abs(dy);
-  if (sum == 0.0) return 0.0;
-  const double q = dy / sum;
+  const double q = dy / (sum > 0.0 ? sum : 1.0);
   return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
+}
+
+// The angular bins (as binOf in fitCircleProfile) of the n pixels from column x0 on of the row
+// dy below the centre, and whether each lies within the narrow band (squared distance from the
+// centre in [lo2, hi2]). Distinct arrays and no branch: the loop vectorises.
+void rowBins(int x0, int n, double centreX, double dy, int bins, double lo2, double hi2,
+             int* __restrict bin, std::uint8_t* __restrict narrow) {
+  double x = x0;  // whole numbers: exact, as (x0 + i) would be
+  for (int i = 0; i < n; ++i, x += 1.0) {
+    const double dx = x - centreX;
+    const int b = static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins);
+    bin[i] = b < bins - 1 ? b : bins - 1;
+    const double rho2 = dx * dx + dy * dy;
+    narrow[i] = static_cast<std::uint8_t>((rho2 >= lo2) & (rho2 <= hi2));
+  }
 }
 
 // One pass of the blurred-step model over the band at parameters q (cx, cy, R, s, level, ramp x,
@@ -179,12 +194,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     const double dy = run.y - centre.y;
     runBins.resize(run.x1 - run.x0);
     runNarrow.resize(run.x1 - run.x0);
-    for (int x = run.x0; x < run.x1; ++x) {
-      const double dx = x - centre.x;
-      runBins[x - run.x0] = binOf(dx, dy);
-      const double rho2 = dx * dx + dy * dy;
-      runNarrow[x - run.x0] = !(rho2 < lo * lo || rho2 > hi * hi);
-    }
+    rowBins(run.x0, run.x1 - run.x0, centre.x, dy, bins, lo * lo, hi * hi, runBins.data(),
+            runNarrow.data());
     const auto* taint = tainted.empty() ? nullptr : tainted.ptr<std::uint8_t>(run.y - y0) - x0;
     for (int x = run.x0; x < run.x1; ++x) {
       const int bin = runBins[x - run.x0];
