@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 
@@ -72,14 +73,22 @@ std::string checkParams(const cv::Mat& image, const CircleMeasureParams& p) {
 
 // Geometric fit of the rim: twice, collect the points within the RANSAC threshold of the current
 // circle and fit them (plain least squares, then reweighted). `in` receives the final inliers.
+// When the second round collects the same points as the first, its fit would start from the
+// first one's result and converge to it again: it is skipped.
 std::optional<Circle> fitRim(const std::vector<Eigen::Vector2d>& pts, Circle circle,
                              const CircleMeasureParams& params, std::vector<Eigen::Vector2d>& in) {
   std::vector<double> w;
+  std::vector<std::uint8_t> taken, takenBefore;
   for (int round = 0; round < 2; ++round) {
     in.clear();
-    for (const auto& p : pts)
-      if (std::abs(residual(circle, p)) <= params.ransacThreshold) in.push_back(p);
-    if (static_cast<int>(in.size()) < params.minInliers) break;
+    taken.assign(pts.size(), 0);
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (std::abs(residual(circle, pts[i])) <= params.ransacThreshold) {
+        in.push_back(pts[i]);
+        taken[i] = 1;
+      }
+    if (static_cast<int>(in.size()) < params.minInliers || taken == takenBefore) break;
+    std::swap(taken, takenBefore);
     w.assign(in.size(), 1.0);
     const int irls = params.robustWeight == CircleRobustWeight::None ? 1 : 2;
     for (int k = 0; k < irls; ++k) {

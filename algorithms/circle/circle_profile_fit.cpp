@@ -37,12 +37,27 @@ using Matrix8 = Eigen::Matrix<double, 8, 8>;
 using Columns = Eigen::Matrix<double, Eigen::Dynamic, 8>;
 
 // A monotonic stand-in for the polar angle, in [0, 4) (no atan2 in the pixel loops); bins of
-// equal width in it are within a factor 1.5 of equal angles.
+// equal width in it are within a factor 1.5 of equal angles. 0 at the centre itself. Without a
+// branch, so that the loops over the band's rows vectorise.
 double diamondAngle(double dx, double dy) {
   const double sum = std::abs(dx) + std::abs(dy);
-  if (sum == 0.0) return 0.0;
-  const double q = dy / sum;
+  const double q = dy / (sum > 0.0 ? sum : 1.0);
   return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
+}
+
+// The angular bins (as binOf in fitCircleProfile) of the n pixels from column x0 on of the row
+// dy below the centre, and whether each lies within the narrow band (squared distance from the
+// centre in [lo2, hi2]). Distinct arrays and no branch: the loop vectorises.
+void rowBins(int x0, int n, double centreX, double dy, int bins, double lo2, double hi2,
+             int* __restrict bin, std::uint8_t* __restrict narrow) {
+  double x = x0;  // whole numbers: exact, as (x0 + i) would be
+  for (int i = 0; i < n; ++i, x += 1.0) {
+    const double dx = x - centreX;
+    const int b = static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins);
+    bin[i] = b < bins - 1 ? b : bins - 1;
+    const double rho2 = dx * dx + dy * dy;
+    narrow[i] = static_cast<std::uint8_t>((rho2 >= lo2) & (rho2 <= hi2));
+  }
 }
 
 // One pass of the blurred-step model over the band at parameters q (cx, cy, R, s, level, ramp x,
@@ -179,12 +194,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     const double dy = run.y - centre.y;
     runBins.resize(run.x1 - run.x0);
     runNarrow.resize(run.x1 - run.x0);
-    for (int x = run.x0; x < run.x1; ++x) {
-      const double dx = x - centre.x;
-      runBins[x - run.x0] = binOf(dx, dy);
-      const double rho2 = dx * dx + dy * dy;
-      runNarrow[x - run.x0] = !(rho2 < lo * lo || rho2 > hi * hi);
-    }
+    rowBins(run.x0, run.x1 - run.x0, centre.x, dy, bins, lo * lo, hi * hi, runBins.data(),
+            runNarrow.data());
     const auto* taint = tainted.empty() ? nullptr : tainted.ptr<std::uint8_t>(run.y - y0) - x0;
     for (int x = run.x0; x < run.x1; ++x) {
       const int bin = runBins[x - run.x0];
@@ -262,7 +273,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // vectorise; the Jacobian's columns of the levels and the ramp (1, x, y) never change.
   std::size_t m = samples.size();
   Eigen::VectorXd px, py, grey, r, rTry, weight;
-  Columns jac, jacTry, weighted;
+  Columns jac, jacTry;
+  Eigen::VectorXd weighted;  // one column of W J
   auto loadBand = [&] {
     const auto n = static_cast<Eigen::Index>(m);
     px.resize(n);
@@ -294,16 +306,22 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   };
   Matrix8 jtj;
   Vector8 jtr;
-  // J^T W J's upper triangle row by row (a weighted column times the columns from the diagonal
-  // on), mirrored: the matrix product packed both tall matrices first and computed the lower
-  // triangle too.
-  auto normalEquations = [&] {
-    weighted = jac.array().colwise() * weight.array();
+  // J^T W J and J^T W r over the free parameters only; a fixed parameter's row and column are
+  // the identity's, so that the step leaves it alone (the ramp is fixed in the first solve, and
+  // its products were a quarter of the work). Each entry is one dot product of two contiguous
+  // columns, which vectorises; the matrix products with a row of weighted columns did not.
+  using Free = std::array<bool, 8>;
+  constexpr Free kAll{true, true, true, true, true, true, true, true};
+  auto normalEquations = [&](const Free& free) {
+    jtj.setIdentity();
+    jtr.setZero();
     for (int a = 0; a < 8; ++a) {
-      jtj.row(a).tail(8 - a).noalias() = weighted.col(a).transpose() * jac.rightCols(8 - a);
-      jtj.col(a).tail(7 - a) = jtj.row(a).tail(7 - a).transpose();
+      if (!free[a]) continue;
+      weighted = jac.col(a).cwiseProduct(weight);
+      jtr(a) = weighted.dot(r);
+      for (int b = a; b < 8; ++b)
+        if (free[b]) jtj(b, a) = jtj(a, b) = weighted.dot(jac.col(b));
     }
-    jtr.noalias() = weighted.transpose() * r;
   };
   auto tukeyWeights = [&] {
     const double sigma = std::max(robustSigma({r.data(), m}), 0.25);
@@ -317,7 +335,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
 
   // Levenberg-Marquardt over the parameters marked free (a fixed one keeps its value).
   double sigma = 0.0;
-  auto solve = [&](const std::array<bool, 8>& free, int maxIterations, bool reweight) {
+  auto solve = [&](const Free& free, int maxIterations, bool reweight) {
     LevenbergMarquardtCallbacks problem{
         [&](const Vector8& q) {
           evaluate(q, r, jac);
@@ -331,14 +349,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
             sigma = tukeyWeights();
             current = cost(r);
           }
-          normalEquations();
-          for (int k = 0; k < 8; ++k)
-            if (!free[k]) {
-              jtj.row(k).setZero();
-              jtj.col(k).setZero();
-              jtj(k, k) = 1.0;
-              jtr(k) = 0.0;
-            }
+          normalEquations(free);
           h = jtj;
           g = -jtr;  // the residuals here are grey - model
         },
@@ -366,7 +377,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // has a ramp worth fitting.
   bool withRamp = false;
   if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
-  normalEquations();
+  normalEquations(kAll);
   {
     constexpr int kRamp[2] = {5, 6};
     constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
@@ -385,7 +396,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     const double statistic = score.dot(schur.ldlt().solve(score)) / std::max(sigma * sigma, 1e-12);
     if (std::isfinite(statistic) && statistic > 13.8) {
       withRamp = true;
-      if (!solve({true, true, true, true, true, true, true, true}, 10, true)) return std::nullopt;
+      if (!solve(kAll, 10, true)) return std::nullopt;
     }
   }
 

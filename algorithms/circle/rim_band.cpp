@@ -55,18 +55,17 @@ std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
 
 namespace {
 
-// The 3x3 Sobel gradient (divided by 8: unit gain) at pixel (x, y), on the 8-bit scale.
+// The 3x3 Sobel gradient (divided by 8: unit gain) at pixel (x, y), on the 8-bit scale. The taps
+// are summed in integers and scaled once: the same value as scaling each (the scale is a power of
+// two and every sum is exact).
 template <typename T>
 cv::Point2d sobel3(const cv::Mat& image, int x, int y, double scale) {
   const T* a = image.ptr<T>(y - 1) + x;
   const T* b = image.ptr<T>(y) + x;
   const T* c = image.ptr<T>(y + 1) + x;
-  auto at = [&](const T* row, int dx) { return row[dx] * scale; };
-  const double gx =
-      (at(a, 1) + 2.0 * at(b, 1) + at(c, 1) - at(a, -1) - 2.0 * at(b, -1) - at(c, -1)) / 8.0;
-  const double gy =
-      (at(c, -1) + 2.0 * at(c, 0) + at(c, 1) - at(a, -1) - 2.0 * at(a, 0) - at(a, 1)) / 8.0;
-  return {gx, gy};
+  const int gx = a[1] + 2 * b[1] + c[1] - a[-1] - 2 * b[-1] - c[-1];
+  const int gy = c[-1] + 2 * c[0] + c[1] - a[-1] - 2 * a[0] - a[1];
+  return {gx * scale / 8.0, gy * scale / 8.0};
 }
 
 template <typename T>

@@ -74,6 +74,50 @@ void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask,
                    area.x + area.width, gradientRow0, state, strong);
 }
 
+// The vertical passes of one run's columns: smooth[i] and deriv[i] for column first + i,
+// i < n. Columns outside the image repeat the border column; only a run's ends can reach
+// outside, so the middle needs no clamp and vectorises.
+template <typename T>
+void verticalPasses(const T* const (&r)[5], int first, int n, int cols, int* __restrict smooth,
+                    int* __restrict deriv) {
+  auto column = [&](int i, int x) {
+    const int a = r[0][x], b = r[1][x], c = r[2][x], d = r[3][x], e = r[4][x];
+    smooth[i] = a + 4 * b + 6 * c + 4 * d + e;
+    deriv[i] = e - a + 2 * (d - b);
+  };
+  int i = 0;
+  for (; i < n && first + i < 0; ++i) column(i, 0);
+  const int middle = std::clamp(cols - first, i, n) - i;
+  const T* __restrict r0 = r[0] + first + i;
+  const T* __restrict r1 = r[1] + first + i;
+  const T* __restrict r2 = r[2] + first + i;
+  const T* __restrict r3 = r[3] + first + i;
+  const T* __restrict r4 = r[4] + first + i;
+  int* __restrict s = smooth + i;
+  int* __restrict t = deriv + i;
+  for (int k = 0; k < middle; ++k) {
+    const int a = r0[k], b = r1[k], c = r2[k], d = r3[k], e = r4[k];
+    s[k] = a + 4 * b + 6 * c + 4 * d + e;
+    t[k] = e - a + 2 * (d - b);
+  }
+  for (i += middle; i < n; ++i) column(i, cols - 1);
+}
+
+// The horizontal passes of one run of n pixels from the vertical ones (s[k], d[k] for the
+// run's columns from two before its first pixel on): derivatives and magnitude. Distinct
+// arrays (__restrict), so that the loop vectorises.
+template <typename D>
+void horizontalPasses(const int* __restrict s, const int* __restrict d, int n, float scale,
+                      D* __restrict gx, D* __restrict gy, float* __restrict mag) {
+  for (int i = 0; i < n; ++i) {
+    const int k = i + 2;
+    gx[i] = static_cast<D>(s[k + 2] - s[k - 2] + 2 * (s[k + 1] - s[k - 1]));
+    gy[i] = static_cast<D>(d[k - 2] + 4 * d[k - 1] + 6 * d[k] + 4 * d[k + 1] + d[k + 2]);
+    const float fa = static_cast<float>(gx[i]), fb = static_cast<float>(gy[i]);
+    mag[i] = scale * std::sqrt(fa * fa + fb * fb);
+  }
+}
+
 // The 5x5 Sobel derivatives and the magnitude at the pixels of `runs` (image coordinates, inside
 // g.area), separably: the vertical passes of the run's columns (two more either side), then the
 // horizontal ones. Integer sums, so equal to cv::Sobel's (CV_16S for 8-bit input; CV_32F for
@@ -90,24 +134,10 @@ void gradientOnRuns(const cv::Mat& image, const RowRuns& runs, EdgeGradient& g) 
     const int n = run.x1 - run.x0 + 4;
     smooth.resize(n);
     deriv.resize(n);
-    for (int i = 0; i < n; ++i) {
-      const int x = std::clamp(run.x0 - 2 + i, 0, image.cols - 1);
-      const int a = r[0][x], b = r[1][x], c = r[2][x], d = r[3][x], e = r[4][x];
-      smooth[i] = a + 4 * b + 6 * c + 4 * d + e;
-      deriv[i] = e - a + 2 * (d - b);
-    }
-    const int row = run.y - g.area.y;
-    D* gx = g.gx.ptr<D>(row) - g.area.x;
-    D* gy = g.gy.ptr<D>(row) - g.area.x;
-    float* mag = g.magnitude.ptr<float>(row) - g.area.x;
-    const int* s = smooth.data() + 2 - run.x0;  // s[x]: the vertical pass of column x
-    const int* d = deriv.data() + 2 - run.x0;
-    for (int x = run.x0; x < run.x1; ++x) {
-      gx[x] = static_cast<D>(s[x + 2] - s[x - 2] + 2 * (s[x + 1] - s[x - 1]));
-      gy[x] = static_cast<D>(d[x - 2] + 4 * d[x - 1] + 6 * d[x] + 4 * d[x + 1] + d[x + 2]);
-      const float fa = static_cast<float>(gx[x]), fb = static_cast<float>(gy[x]);
-      mag[x] = scale * std::sqrt(fa * fa + fb * fb);
-    }
+    verticalPasses<T>(r, run.x0 - 2, n, image.cols, smooth.data(), deriv.data());
+    const int row = run.y - g.area.y, x0 = run.x0 - g.area.x;
+    horizontalPasses<D>(smooth.data(), deriv.data(), run.x1 - run.x0, scale, g.gx.ptr<D>(row) + x0,
+                        g.gy.ptr<D>(row) + x0, g.magnitude.ptr<float>(row) + x0);
   }
 }
 
