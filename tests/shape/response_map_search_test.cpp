@@ -1,0 +1,145 @@
+// The top-level search against its definition: every candidate's score is the sum over the
+// model's points of the response map at the point's pixel, 127 cos(theta - theta_bin) rounded
+// and kept within 8 bits, over 127 n; and every pixel whose best sum reaches the threshold and is
+// a local maximum is a candidate. The search computes those sums with vector intrinsics (AVX2
+// where the processor has it) and skips blocks of background; neither may change a value.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/image_gradients.hpp"
+#include "algorithms/shape/response_map_search.hpp"
+#include "algorithms/shape/shape_model.hpp"
+#include "algorithms/shape/shape_similarity.hpp"
+#include "tests/shape/bracket_scenes.hpp"
+
+namespace facet {
+namespace {
+
+using shape_detail::Candidate;
+using shape_detail::Direction;
+
+constexpr int kBins = 32;
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+
+// The response of the map of `bin` at a pixel with direction d: the search's float arithmetic
+// and rounding (half to even), kept within 8 bits.
+int response(const Direction& d, int bin) {
+  const auto c = static_cast<float>(std::cos(bin * kTwoPi / kBins));
+  const auto s = static_cast<float>(std::sin(bin * kTwoPi / kBins));
+  const float v = d[0] * c + d[1] * s;
+  return std::min(cvRound(v), 127);
+}
+
+// A template (one angle and scale): each point's pixel offset and map bin.
+struct Template {
+  std::vector<cv::Point> offsets;
+  std::vector<int> bins;
+};
+
+Template templateOf(const std::vector<ShapePoint>& points, double angle, double scale) {
+  const shape_detail::PosedPoints posed = shape_detail::posePoints(points, angle, scale);
+  Template t{posed.offsets, {}};
+  for (const auto& d : posed.directions) {
+    const double theta = std::atan2(d.y, d.x);
+    t.bins.push_back(((static_cast<int>(std::lround(theta / kTwoPi * kBins)) % kBins) + kBins) %
+                     kBins);
+  }
+  return t;
+}
+
+// The template's sum with its reference point at (x, y); pixels outside the field add nothing.
+int directSum(const cv::Mat& field, const Template& t, int x, int y) {
+  int sum = 0;
+  for (std::size_t i = 0; i < t.offsets.size(); ++i) {
+    const int u = x + t.offsets[i].x, v = y + t.offsets[i].y;
+    if (u < 0 || v < 0 || u >= field.cols || v >= field.rows) continue;
+    sum += response(field.at<Direction>(v, u), t.bins[i]);
+  }
+  return sum;
+}
+
+TEST(TopLevelSearch, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
+  // A model's top level and a scene's top level (pyramid level 3 of a 640x480 scene).
+  const ShapeModel model = createShapeModel(testing::bracketTemplate());
+  const int top = model.numLevels() - 1;
+  const std::vector<ShapePoint>& points = model.levels[top].points;
+  ASSERT_GT(points.size(), 10u);
+  ASSERT_LE(points.size(), 250u);  // the search subsamples beyond 250 points; the sums here do not
+  cv::Mat grey = testing::bracketScene({640, 480}, {{300, 220, 0.4, 1.0}, {150, 330, -2.0, 1.0}});
+  for (int l = 0; l < top; ++l) cv::pyrDown(grey, grey);
+  shape_detail::DirectionField directions(grey, model.minContrast);
+  directions.ensureAll();
+  const cv::Mat& field = directions.directions();
+
+  std::vector<double> angles;
+  for (int k = 0; k < 24; ++k) angles.push_back(k * kTwoPi / 24);
+  const double threshold = 0.4;
+  const auto candidates = shape_detail::searchTopLevel(field, points, angles, {1.0}, Polarity::Use,
+                                                       threshold, 1, 100000);
+  ASSERT_FALSE(candidates.empty());
+
+  // Best sum and template per pixel, directly.
+  const double norm = 127.0 * static_cast<double>(points.size());
+  cv::Mat best(field.size(), CV_32S, cv::Scalar(0));
+  std::vector<Template> templates;
+  for (const double a : angles) templates.push_back(templateOf(points, a, 1.0));
+  for (int y = 0; y < field.rows; ++y)
+    for (int x = 0; x < field.cols; ++x)
+      for (const Template& t : templates)
+        best.at<int>(y, x) = std::max(best.at<int>(y, x), directSum(field, t, x, y));
+
+  for (const Candidate& c : candidates) {
+    const int x = static_cast<int>(c.x), y = static_cast<int>(c.y);
+    EXPECT_DOUBLE_EQ(c.score, best.at<int>(y, x) / norm) << "at " << x << "," << y;
+    EXPECT_EQ(directSum(field, templateOf(points, c.angle, c.scale), x, y), best.at<int>(y, x));
+  }
+  // Every local maximum over 5x5 (strict towards the top-left, as the search) is a candidate.
+  int maxima = 0;
+  for (int y = 0; y < field.rows; ++y)
+    for (int x = 0; x < field.cols; ++x) {
+      const int v = best.at<int>(y, x);
+      if (v <= 0 || v < static_cast<int>(threshold * norm)) continue;
+      bool isMax = true;
+      for (int dy = -2; dy <= 2; ++dy)
+        for (int dx = -2; dx <= 2; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= field.cols || yy >= field.rows)
+            continue;
+          const int u = best.at<int>(yy, xx);
+          if (u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0)))) isMax = false;
+        }
+      if (!isMax) continue;
+      ++maxima;
+      const bool found = std::any_of(candidates.begin(), candidates.end(), [&](const Candidate& c) {
+        return static_cast<int>(c.x) == x && static_cast<int>(c.y) == y;
+      });
+      EXPECT_TRUE(found) << "local maximum " << v / norm << " at " << x << "," << y << " missing";
+    }
+  EXPECT_EQ(maxima, static_cast<int>(candidates.size()));
+}
+
+TEST(TopLevelSearch, AnAlignedDirectionLongerThan127DoesNotWrap) {
+  // A rounded direction can be longer than 127: (117, 51) is 127.6 long, and its response on
+  // bin 2 (22.5 degrees) rounds to 128, which does not fit in 8 bits. Kept as 127, a field of
+  // such pixels matches a model of 22.5-degree points perfectly; wrapped to -128 it would match
+  // worst of all.
+  cv::Mat field(40, 40, CV_8SC2, cv::Scalar(117, 51));
+  std::vector<ShapePoint> points;
+  const cv::Point2f along(static_cast<float>(std::cos(kTwoPi / 16)),
+                          static_cast<float>(std::sin(kTwoPi / 16)));
+  for (int k = -5; k <= 5; ++k) points.push_back({{static_cast<float>(k), 0.0f}, along});
+  const auto candidates =
+      shape_detail::searchTopLevel(field, points, {0.0}, {1.0}, Polarity::Use, 0.9, 1, 10);
+  ASSERT_FALSE(candidates.empty());
+  EXPECT_NEAR(candidates.front().score, 1.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace facet
