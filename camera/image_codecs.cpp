@@ -11,6 +11,7 @@
 #include "camera/decoded_frame.hpp"
 #include "camera/image_codec_table.hpp"
 #include "camera/image_file_reader.hpp"
+#include "camera/jpeg_file.hpp"
 #include "camera/png_file.hpp"
 
 // Baked in by camera/CMakeLists.txt.
@@ -96,11 +97,31 @@ std::optional<cv::Mat> imreadOfPlainPng(const fs::path& file, int flags) {
   return std::move(png->pixels);
 }
 
+// cv::imread's result for a plain JPEG: the flags facet reads with, and no EXIF orientation to
+// apply (cv::imread applies one to any read but IMREAD_UNCHANGED).
+std::optional<cv::Mat> imreadOfPlainJpeg(const fs::path& file, int flags) {
+  const bool unchanged = flags == cv::IMREAD_UNCHANGED;
+  const bool grey =
+      flags == cv::IMREAD_GRAYSCALE || flags == (cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
+  if (!unchanged && !grey) return std::nullopt;
+  auto jpeg = readPlainJpeg(file, kImreadMaxPixels, grey ? JpegOutput::Grey : JpegOutput::Stored);
+  if (!jpeg || (grey && jpeg->hasExif)) return std::nullopt;
+  return std::move(jpeg->pixels);
+}
+
 // readImageFile's result for a plain PNG: what the module's decoder makes of it.
 std::optional<ImageFileContent> frameOfPlainPng(const fs::path& file, std::uint64_t max_pixels) {
   auto png = readPlainPng(file, max_pixels);
   if (!png) return std::nullopt;
   return frameOfDecodedPixels(std::move(png->pixels));
+}
+
+// readImageFile's result for a plain JPEG: OpenImageIO in the module reads the stored components
+// with the same library and settings (and applies no EXIF orientation).
+std::optional<ImageFileContent> frameOfPlainJpeg(const fs::path& file, std::uint64_t max_pixels) {
+  auto jpeg = readPlainJpeg(file, max_pixels, JpegOutput::Stored);
+  if (!jpeg) return std::nullopt;
+  return frameOfDecodedPixels(std::move(jpeg->pixels));
 }
 
 }  // namespace
@@ -111,6 +132,7 @@ const std::string& imageCodecsProblem() {
 
 cv::Mat readImage(const fs::path& file, int flags) {
   if (auto png = imreadOfPlainPng(file, flags)) return *png;
+  if (auto jpeg = imreadOfPlainJpeg(file, flags)) return *jpeg;
   const ImageCodecTable* table = loaded().table;
   return table ? table->read(file.string(), flags) : cv::Mat();
 }
@@ -133,6 +155,7 @@ cv::Mat decodeImage(const cv::Mat& bytes, int flags) {
 
 ImageFileContent readImageFile(const fs::path& file, std::uint64_t max_pixels) {
   if (auto png = frameOfPlainPng(file, max_pixels)) return std::move(*png);
+  if (auto jpeg = frameOfPlainJpeg(file, max_pixels)) return std::move(*jpeg);
   const LoadedCodecs& codecs = loaded();
   if (codecs.table) return codecs.table->readFile(file, max_pixels);
   ImageFileContent content;

@@ -2,8 +2,9 @@
 # The image codecs are a module loaded on first use (camera/image_codecs.hpp): facet and facetd
 # must not link OpenImageIO or OpenCV's imgcodecs (each start would map ~200 more libraries), an
 # image command must find the module in the build tree and in the installed layout, and a missing
-# module must be a clear error, not a crash. Plain PNG files are read without the module
-# (camera/png_file.hpp); a TIFF copy of the same image (made with OpenImageIO's oiiotool) needs it.
+# module must be a clear error, not a crash. Plain PNG and JPEG files are read without the module
+# (camera/png_file.hpp, camera/jpeg_file.hpp); a TIFF copy of the same image (made with
+# OpenImageIO's oiiotool) needs it.
 #   usage: image_codecs_module_test.sh FACET FACETD BUILD_DIR   (from the repository root)
 set -uo pipefail
 facet=$1 facetd=$2 build=$3
@@ -34,6 +35,13 @@ png_out=$(FACET_IMAGE_CODECS=$missing "$facet" "${png_match[@]}" 2>&1) ||
 [[ $(grep -o '"score":[0-9.]*' <<<"$png_out") == $(grep -o '"score":[0-9.]*' <<<"$out") ]] ||
   fail "the PNG read without the module must match as the TIFF read by it: $png_out / $out"
 grep -q "image codecs not loaded" <<<"$png_out" && fail "a plain PNG loaded the module: $png_out"
+
+jpeg=$work/part_000.jpg
+oiiotool "$png" --compression jpeg:95 -o "$jpeg" || fail "oiiotool could not write $jpeg"
+jpeg_out=$(FACET_IMAGE_CODECS=$missing "$facet" match --model recipes/models/bracket.shape \
+  --image "$jpeg" --json 2>&1) || fail "a plain JPEG must be read without the module: $jpeg_out"
+grep -q '"score"' <<<"$jpeg_out" || fail "facet match found nothing in the JPEG: $jpeg_out"
+grep -q "image codecs not loaded" <<<"$jpeg_out" && fail "a plain JPEG loaded the module: $jpeg_out"
 
 err=$(FACET_IMAGE_CODECS=$missing "$facet" "${match[@]}" 2>&1 >/dev/null)
 rc=$?

@@ -1,9 +1,10 @@
 // libFuzzer target: the replay backend's image decoders: the one inside the image-codec module
 // (camera/image_file_decoder.hpp: OpenImageIO and, for 16-bit PNM, OpenCV) and the plain-PNG
-// reader that runs in the process before it (camera/png_file.hpp). The first byte picks the file
+// and plain-JPEG readers that run in the process before it (camera/png_file.hpp,
+// camera/jpeg_file.hpp). The first byte picks the file
 // extension the replay folder accepts, the rest is the file. Expected outcome for bad input: an
-// error naming the file (module) or no image (plain PNG: the module then decides). An image that
-// reads must have the size its header announced and a frame format; where both read a file,
+// error naming the file (module) or no image (plain PNG or JPEG: the module then decides). An image
+// that reads must have the size its header announced and a frame format; where both read a file,
 // they agree on its size.
 //
 // The pixel limit is lower than the camera's default (2^28) so that runs stay within the
@@ -16,6 +17,7 @@
 #include <string>
 
 #include "camera/image_file_decoder.hpp"
+#include "camera/jpeg_file.hpp"
 #include "camera/png_file.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
@@ -39,6 +41,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         (p.depth() != CV_8U && p.depth() != CV_16U))
       std::abort();
     if (content.ok() && content.image.size() != p.size()) std::abort();
+  }
+  for (const auto output : {facet::JpegOutput::Stored, facet::JpegOutput::Grey}) {
+    if (const auto plain = facet::readPlainJpeg(file, kMaxPixels, output)) {
+      const cv::Mat& p = plain->pixels;
+      if (p.empty() || p.total() > kMaxPixels || p.depth() != CV_8U ||
+          (p.channels() != 1 && p.channels() != 3) ||
+          (output == facet::JpegOutput::Grey && p.channels() != 1))
+        std::abort();
+      if (content.ok() && content.image.size() != p.size()) std::abort();
+    }
   }
   return 0;
 }
