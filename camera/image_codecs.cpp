@@ -80,13 +80,22 @@ const LoadedCodecs& loaded() {
 // OpenCV's own limit on the pixels cv::imread decodes (CV_IO_MAX_IMAGE_PIXELS' default).
 constexpr std::uint64_t kImreadMaxPixels = std::uint64_t{1} << 30;
 
+// The cv::imread flags the in-process readers serve: as stored, or grey (any depth asked or not).
+// Every other read goes to the module.
+enum class PlainRead { Unchanged, Grey, Other };
+PlainRead plainReadOf(int flags) {
+  if (flags == cv::IMREAD_UNCHANGED) return PlainRead::Unchanged;
+  if (flags == cv::IMREAD_GRAYSCALE || flags == (cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH))
+    return PlainRead::Grey;
+  return PlainRead::Other;
+}
+
 // cv::imread's result for a plain PNG, where it is the file's pixels as stored: the flags
 // facet reads with, and no conversion or EXIF orientation to apply.
 std::optional<cv::Mat> imreadOfPlainPng(const fs::path& file, int flags) {
-  const bool unchanged = flags == cv::IMREAD_UNCHANGED;
-  const bool grey =
-      flags == cv::IMREAD_GRAYSCALE || flags == (cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (!unchanged && !grey) return std::nullopt;
+  const PlainRead read = plainReadOf(flags);
+  if (read == PlainRead::Other) return std::nullopt;
+  const bool unchanged = read == PlainRead::Unchanged, grey = read == PlainRead::Grey;
   // OpenCV gives grey+alpha as BGRA, and a grey read of a deep file as 8 bits unless asked.
   const auto stored = [&](int type) {
     if (unchanged) return CV_MAT_CN(type) != 2;
@@ -100,10 +109,9 @@ std::optional<cv::Mat> imreadOfPlainPng(const fs::path& file, int flags) {
 // cv::imread's result for a plain JPEG: the flags facet reads with, and no EXIF orientation to
 // apply (cv::imread applies one to any read but IMREAD_UNCHANGED).
 std::optional<cv::Mat> imreadOfPlainJpeg(const fs::path& file, int flags) {
-  const bool unchanged = flags == cv::IMREAD_UNCHANGED;
-  const bool grey =
-      flags == cv::IMREAD_GRAYSCALE || flags == (cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH);
-  if (!unchanged && !grey) return std::nullopt;
+  const PlainRead read = plainReadOf(flags);
+  if (read == PlainRead::Other) return std::nullopt;
+  const bool grey = read == PlainRead::Grey;
   auto jpeg = readPlainJpeg(file, kImreadMaxPixels, grey ? JpegOutput::Grey : JpegOutput::Stored);
   if (!jpeg || (grey && jpeg->hasExif)) return std::nullopt;
   return std::move(jpeg->pixels);

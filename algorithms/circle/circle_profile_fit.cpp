@@ -45,16 +45,21 @@ double diamondAngle(double dx, double dy) {
   return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
 }
 
-// The angular bins (as binOf in fitCircleProfile) of the n pixels from column x0 on of the row
-// dy below the centre, and whether each lies within the narrow band (squared distance from the
-// centre in [lo2, hi2]). Distinct arrays and no branch: the loop vectorises.
+// The angular bin, of `bins` equal widths in diamondAngle, of the offset (dx, dy) from the centre.
+int angularBin(double dx, double dy, int bins) {
+  const int b = static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins);
+  return b < bins - 1 ? b : bins - 1;
+}
+
+// The angular bins of the n pixels from column x0 on of the row dy below the centre, and whether
+// each lies within the narrow band (squared distance from the centre in [lo2, hi2]). Distinct
+// arrays and no branch: the loop vectorises.
 void rowBins(int x0, int n, double centreX, double dy, int bins, double lo2, double hi2,
              int* __restrict bin, std::uint8_t* __restrict narrow) {
   double x = x0;  // whole numbers: exact, as (x0 + i) would be
   for (int i = 0; i < n; ++i, x += 1.0) {
     const double dx = x - centreX;
-    const int b = static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins);
-    bin[i] = b < bins - 1 ? b : bins - 1;
+    bin[i] = angularBin(dx, dy, bins);
     const double rho2 = dx * dx + dy * dy;
     narrow[i] = static_cast<std::uint8_t>((rho2 >= lo2) & (rho2 <= hi2));
   }
@@ -106,11 +111,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
 
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
   const int bins = std::max(16, static_cast<int>(2.0 * kPi * radius / 2.0));
-  auto binOf = [&](double dx, double dy) {
-    return std::min(bins - 1, static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins));
-  };
   std::vector<std::uint8_t> covered(bins, 0);
-  for (const auto& q : rimPoints) covered[binOf(q.x - centre.x, q.y - centre.y)] = 1;
+  for (const auto& q : rimPoints) covered[angularBin(q.x - centre.x, q.y - centre.y, bins)] = 1;
   // A small rim (under kSmallRim px) has few bins to spare: it keeps a wider band and the ends of
   // its covered runs (below); a long rim trades a little information for less contamination.
   constexpr double kSmallRim = 25.0;

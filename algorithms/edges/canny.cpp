@@ -77,13 +77,17 @@ void suppress(const EdgeGradient& g, float low, float high, const cv::Mat& mask,
 // The vertical passes of one run's columns: smooth[i] and deriv[i] for column first + i,
 // i < n. Columns outside the image repeat the border column; only a run's ends can reach
 // outside, so the middle needs no clamp and vectorises.
+// Column (a..e top to bottom) -> its 5-tap smoothing and derivative sums.
+inline void verticalTaps(int a, int b, int c, int d, int e, int& smooth, int& deriv) {
+  smooth = a + 4 * b + 6 * c + 4 * d + e;
+  deriv = e - a + 2 * (d - b);
+}
+
 template <typename T>
 void verticalPasses(const T* const (&r)[5], int first, int n, int cols, int* __restrict smooth,
                     int* __restrict deriv) {
   auto column = [&](int i, int x) {
-    const int a = r[0][x], b = r[1][x], c = r[2][x], d = r[3][x], e = r[4][x];
-    smooth[i] = a + 4 * b + 6 * c + 4 * d + e;
-    deriv[i] = e - a + 2 * (d - b);
+    verticalTaps(r[0][x], r[1][x], r[2][x], r[3][x], r[4][x], smooth[i], deriv[i]);
   };
   int i = 0;
   for (; i < n && first + i < 0; ++i) column(i, 0);
@@ -95,11 +99,7 @@ void verticalPasses(const T* const (&r)[5], int first, int n, int cols, int* __r
   const T* __restrict r4 = r[4] + first + i;
   int* __restrict s = smooth + i;
   int* __restrict t = deriv + i;
-  for (int k = 0; k < middle; ++k) {
-    const int a = r0[k], b = r1[k], c = r2[k], d = r3[k], e = r4[k];
-    s[k] = a + 4 * b + 6 * c + 4 * d + e;
-    t[k] = e - a + 2 * (d - b);
-  }
+  for (int k = 0; k < middle; ++k) verticalTaps(r0[k], r1[k], r2[k], r3[k], r4[k], s[k], t[k]);
   for (i += middle; i < n; ++i) column(i, cols - 1);
 }
 
