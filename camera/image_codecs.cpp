@@ -13,6 +13,7 @@
 #include "camera/image_file_reader.hpp"
 #include "camera/jpeg_file.hpp"
 #include "camera/png_file.hpp"
+#include "camera/tiff_file.hpp"
 
 // Baked in by camera/CMakeLists.txt.
 #ifndef FACET_IMAGE_CODECS_FILE
@@ -117,6 +118,21 @@ std::optional<cv::Mat> imreadOfPlainJpeg(const fs::path& file, int flags) {
   return std::move(jpeg->pixels);
 }
 
+// cv::imread's result for a plain TIFF: the stored samples, read as stored or, for a grey file,
+// as grey (8 bits, or 16 when any depth is asked). A colour file read as grey, or a 16-bit one
+// read as 8 bits, is converted by OpenCV's own rules: the module.
+std::optional<cv::Mat> imreadOfPlainTiff(const fs::path& file, int flags) {
+  const PlainRead read = plainReadOf(flags);
+  if (read == PlainRead::Other) return std::nullopt;
+  auto tiff = readPlainTiff(file, kImreadMaxPixels);
+  if (!tiff) return std::nullopt;
+  const bool stored =
+      read == PlainRead::Unchanged ||
+      (tiff->channels() == 1 && (tiff->depth() == CV_8U || (flags & cv::IMREAD_ANYDEPTH)));
+  if (!stored) return std::nullopt;
+  return std::move(*tiff);
+}
+
 // readImageFile's result for a plain PNG: what the module's decoder makes of it.
 std::optional<ImageFileContent> frameOfPlainPng(const fs::path& file, std::uint64_t max_pixels) {
   auto png = readPlainPng(file, max_pixels);
@@ -132,6 +148,14 @@ std::optional<ImageFileContent> frameOfPlainJpeg(const fs::path& file, std::uint
   return frameOfDecodedPixels(std::move(jpeg->pixels));
 }
 
+// readImageFile's result for a plain TIFF: OpenImageIO in the module reads the stored samples
+// with the same library.
+std::optional<ImageFileContent> frameOfPlainTiff(const fs::path& file, std::uint64_t max_pixels) {
+  auto tiff = readPlainTiff(file, max_pixels);
+  if (!tiff) return std::nullopt;
+  return frameOfDecodedPixels(std::move(*tiff));
+}
+
 }  // namespace
 
 const std::string& imageCodecsProblem() {
@@ -141,6 +165,7 @@ const std::string& imageCodecsProblem() {
 cv::Mat readImage(const fs::path& file, int flags) {
   if (auto png = imreadOfPlainPng(file, flags)) return *png;
   if (auto jpeg = imreadOfPlainJpeg(file, flags)) return *jpeg;
+  if (auto tiff = imreadOfPlainTiff(file, flags)) return *tiff;
   const ImageCodecTable* table = loaded().table;
   return table ? table->read(file.string(), flags) : cv::Mat();
 }
@@ -164,6 +189,7 @@ cv::Mat decodeImage(const cv::Mat& bytes, int flags) {
 ImageFileContent readImageFile(const fs::path& file, std::uint64_t max_pixels) {
   if (auto png = frameOfPlainPng(file, max_pixels)) return std::move(*png);
   if (auto jpeg = frameOfPlainJpeg(file, max_pixels)) return std::move(*jpeg);
+  if (auto tiff = frameOfPlainTiff(file, max_pixels)) return std::move(*tiff);
   const LoadedCodecs& codecs = loaded();
   if (codecs.table) return codecs.table->readFile(file, max_pixels);
   ImageFileContent content;

@@ -11,7 +11,7 @@ packages=(
   # algorithms
   libopencv-dev libeigen3-dev libnanoflann-dev
   # camera
-  libopenimageio-dev openimageio-tools libaravis-dev aravis-tools-cli libusb-1.0-0-dev zlib1g-dev libpng-dev libjpeg-dev
+  libopenimageio-dev openimageio-tools libaravis-dev aravis-tools-cli libusb-1.0-0-dev zlib1g-dev libpng-dev libjpeg-dev libtiff-dev
   libv4l-dev
   # plc, config, service
   libmodbus-dev libyaml-cpp-dev libcli11-dev libspdlog-dev libfmt-dev libsqlite3-dev sqlite3

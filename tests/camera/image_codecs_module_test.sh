@@ -2,9 +2,9 @@
 # The image codecs are a module loaded on first use (camera/image_codecs.hpp): facet and facetd
 # must not link OpenImageIO or OpenCV's imgcodecs (each start would map ~200 more libraries), an
 # image command must find the module in the build tree and in the installed layout, and a missing
-# module must be a clear error, not a crash. Plain PNG and JPEG files are read without the module
-# (camera/png_file.hpp, camera/jpeg_file.hpp); a TIFF copy of the same image (made with
-# OpenImageIO's oiiotool) needs it.
+# module must be a clear error, not a crash. Plain PNG, JPEG and TIFF files are read without the
+# module (camera/png_file.hpp, camera/jpeg_file.hpp, camera/tiff_file.hpp); a PGM copy of the same
+# image (made with OpenImageIO's oiiotool) needs it.
 #   usage: image_codecs_module_test.sh FACET FACETD BUILD_DIR   (from the repository root)
 set -uo pipefail
 facet=$1 facetd=$2 build=$3
@@ -14,10 +14,10 @@ work=$(mktemp -d)
 prefix=$work/prefix
 trap 'rm -rf "$work"' EXIT
 png=recipes/demo/bracket_shape/part_000.png
-tiff=$work/part_000.tif
-oiiotool "$png" -o "$tiff" || fail "oiiotool could not write $tiff"
+pgm=$work/part_000.pgm
+oiiotool "$png" -o "$pgm" || fail "oiiotool could not write $pgm"
 png_match=(match --model recipes/models/bracket.shape --image "$png" --json)
-match=(match --model recipes/models/bracket.shape --image "$tiff" --json)
+match=(match --model recipes/models/bracket.shape --image "$pgm" --json)
 
 for program in "$facet" "$facetd"; do
   needed=$(readelf -d "$program" | grep NEEDED) || fail "readelf -d $program"
@@ -33,7 +33,7 @@ missing=/nonexistent/libfacet_image_codecs.so
 png_out=$(FACET_IMAGE_CODECS=$missing "$facet" "${png_match[@]}" 2>&1) ||
   fail "a plain PNG must be read without the module: $png_out"
 [[ $(grep -o '"score":[0-9.]*' <<<"$png_out") == $(grep -o '"score":[0-9.]*' <<<"$out") ]] ||
-  fail "the PNG read without the module must match as the TIFF read by it: $png_out / $out"
+  fail "the PNG read without the module must match as the PGM read by it: $png_out / $out"
 grep -q "image codecs not loaded" <<<"$png_out" && fail "a plain PNG loaded the module: $png_out"
 
 jpeg=$work/part_000.jpg
@@ -43,10 +43,18 @@ jpeg_out=$(FACET_IMAGE_CODECS=$missing "$facet" match --model recipes/models/bra
 grep -q '"score"' <<<"$jpeg_out" || fail "facet match found nothing in the JPEG: $jpeg_out"
 grep -q "image codecs not loaded" <<<"$jpeg_out" && fail "a plain JPEG loaded the module: $jpeg_out"
 
+tiff=$work/part_000.tif
+oiiotool "$png" --compression lzw -o "$tiff" || fail "oiiotool could not write $tiff"
+tiff_out=$(FACET_IMAGE_CODECS=$missing "$facet" match --model recipes/models/bracket.shape \
+  --image "$tiff" --json 2>&1) || fail "a plain TIFF must be read without the module: $tiff_out"
+[[ $(grep -o '"score":[0-9.]*' <<<"$tiff_out") == $(grep -o '"score":[0-9.]*' <<<"$out") ]] ||
+  fail "the TIFF read without the module must match as the PGM read by it: $tiff_out / $out"
+grep -q "image codecs not loaded" <<<"$tiff_out" && fail "a plain TIFF loaded the module: $tiff_out"
+
 err=$(FACET_IMAGE_CODECS=$missing "$facet" "${match[@]}" 2>&1 >/dev/null)
 rc=$?
 [[ $rc -eq 1 ]] || fail "a missing module must exit 1 (an unreadable image), got $rc: $err"
-grep -q "part_000.tif: cannot read image: image codecs not loaded" <<<"$err" &&
+grep -q "part_000.pgm: cannot read image: image codecs not loaded" <<<"$err" &&
   grep -q "$missing: cannot open shared object file" <<<"$err" ||
   fail "the error must name the image, the path tried and dlerror(): $err"
 

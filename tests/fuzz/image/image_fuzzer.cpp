@@ -1,9 +1,9 @@
 // libFuzzer target: the replay backend's image decoders: the one inside the image-codec module
 // (camera/image_file_decoder.hpp: OpenImageIO and, for 16-bit PNM, OpenCV) and the plain-PNG
-// and plain-JPEG readers that run in the process before it (camera/png_file.hpp,
-// camera/jpeg_file.hpp). The first byte picks the file
+// plain-JPEG and plain-TIFF readers that run in the process before it (camera/png_file.hpp,
+// camera/jpeg_file.hpp, camera/tiff_file.hpp). The first byte picks the file
 // extension the replay folder accepts, the rest is the file. Expected outcome for bad input: an
-// error naming the file (module) or no image (plain PNG or JPEG: the module then decides). An image
+// error naming the file (module) or no image (plain readers: the module then decides). An image
 // that reads must have the size its header announced and a frame format; where both read a file,
 // they agree on its size.
 //
@@ -19,6 +19,7 @@
 #include "camera/image_file_decoder.hpp"
 #include "camera/jpeg_file.hpp"
 #include "camera/png_file.hpp"
+#include "camera/tiff_file.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
@@ -51,6 +52,13 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::abort();
       if (content.ok() && content.image.size() != p.size()) std::abort();
     }
+  }
+  if (const auto plain = facet::readPlainTiff(file, kMaxPixels)) {
+    const cv::Mat& p = *plain;
+    if (p.empty() || p.total() > kMaxPixels || (p.depth() != CV_8U && p.depth() != CV_16U) ||
+        (p.channels() != 1 && p.channels() != 3))
+      std::abort();
+    if (content.ok() && content.image.size() != p.size()) std::abort();
   }
   return 0;
 }
