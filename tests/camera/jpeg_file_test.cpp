@@ -10,18 +10,17 @@
 #include <iterator>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "camera/image_codecs.hpp"
 #include "camera/image_file_reader.hpp"
+#include "tests/camera/module_reference.hpp"
 #include "tests/camera/temp_folder.hpp"
 
 namespace facet {
 namespace {
-namespace OIIO = OIIO_NAMESPACE;
 
 bool same(const cv::Mat& a, const cv::Mat& b) {
   return a.size() == b.size() && a.type() == b.type() && cv::norm(a, b, cv::NORM_INF) == 0;
@@ -39,30 +38,6 @@ cv::Mat scene(int channels) {
       else
         image.at<uchar>(y, x) = static_cast<uchar>((v + w) / 2);
     }
-  return image;
-}
-
-std::vector<char> bytesOf(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
-
-// cv::imdecode in the module: the reference the in-process reader must meet.
-cv::Mat moduleRead(const std::filesystem::path& file, int flags) {
-  std::vector<char> b = bytesOf(file);
-  return decodeImage(cv::Mat(1, static_cast<int>(b.size()), CV_8UC1, b.data()), flags);
-}
-
-// What the module's replay reader does with a JPEG (camera/image_file_decoder.cpp): OpenImageIO
-// reads the stored channels as 8 bits, colour in RGB order.
-cv::Mat moduleFrame(const std::filesystem::path& file) {
-  auto input = OIIO::ImageInput::open(file.string());
-  if (!input) return {};
-  const OIIO::ImageSpec& spec = input->spec();
-  const int channels = spec.nchannels >= 3 ? 3 : 1;
-  cv::Mat image(spec.height, spec.width, CV_8UC(channels));
-  if (!input->read_image(0, 0, 0, channels, OIIO::TypeDesc::UINT8, image.data)) return {};
-  if (channels == 3) cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
   return image;
 }
 
@@ -86,10 +61,10 @@ TEST(PlainJpeg, GivesTheModulesPixelsForColourAndGreyFiles) {
       EXPECT_EQ(stored->pixels.channels(), channels);
       EXPECT_EQ(grey->pixels.channels(), 1);
       EXPECT_FALSE(stored->hasExif);
-      EXPECT_TRUE(same(stored->pixels, moduleRead(file, cv::IMREAD_UNCHANGED))) << file;
-      EXPECT_TRUE(same(grey->pixels, moduleRead(file, cv::IMREAD_GRAYSCALE))) << file;
+      EXPECT_TRUE(same(stored->pixels, test::moduleRead(file, cv::IMREAD_UNCHANGED))) << file;
+      EXPECT_TRUE(same(grey->pixels, test::moduleRead(file, cv::IMREAD_GRAYSCALE))) << file;
       // The replay reader's result (OpenImageIO in the module) is the stored pixels too.
-      EXPECT_TRUE(same(stored->pixels, moduleFrame(file))) << file;
+      EXPECT_TRUE(same(stored->pixels, test::moduleFrame(file))) << file;
       // readImage and readImageFile take this path.
       EXPECT_TRUE(same(readImageFile(file, 1u << 30).image, stored->pixels));
       EXPECT_TRUE(same(readImage(file, cv::IMREAD_UNCHANGED), stored->pixels));
@@ -104,10 +79,10 @@ TEST(PlainJpeg, TheRepositorysPhotographsReadAsTheModuleReadsThem) {
     const auto grey = readPlainJpeg(file, 1u << 30, JpegOutput::Grey);
     ASSERT_TRUE(stored && grey) << file;
     EXPECT_GT(stored->pixels.total(), 10000u);
-    EXPECT_TRUE(same(stored->pixels, moduleRead(file, cv::IMREAD_UNCHANGED))) << file;
-    EXPECT_TRUE(same(stored->pixels, moduleFrame(file))) << file;
+    EXPECT_TRUE(same(stored->pixels, test::moduleRead(file, cv::IMREAD_UNCHANGED))) << file;
+    EXPECT_TRUE(same(stored->pixels, test::moduleFrame(file))) << file;
     if (!grey->hasExif) {
-      EXPECT_TRUE(same(grey->pixels, moduleRead(file, cv::IMREAD_GRAYSCALE))) << file;
+      EXPECT_TRUE(same(grey->pixels, test::moduleRead(file, cv::IMREAD_GRAYSCALE))) << file;
     }
   }
 }
@@ -116,7 +91,7 @@ TEST(PlainJpeg, DamagedTruncatedOversizedAndForeignFilesAreLeftToTheModule) {
   const test::TempFolder dir;
   const auto good = dir.path() / "good.jpg";
   ASSERT_TRUE(writeImage(good, scene(3), {cv::IMWRITE_JPEG_QUALITY, 90}));
-  const std::vector<char> bytes = bytesOf(good);
+  const std::vector<char> bytes = test::fileBytes(good);
   ASSERT_TRUE(readPlainJpeg(good, 1u << 30, JpegOutput::Stored));
 
   // More pixels than allowed: refused before any is decoded.
@@ -142,7 +117,7 @@ TEST(PlainJpeg, AnExifSegmentIsReported) {
   const test::TempFolder dir;
   const auto plain = dir.path() / "plain.jpg";
   ASSERT_TRUE(writeImage(plain, scene(3)));
-  std::vector<char> bytes = bytesOf(plain);
+  std::vector<char> bytes = test::fileBytes(plain);
   const char exif[] = {'\xFF', '\xE1', 0,   16, 'E', 'x', 'i', 'f', 0,
                        0,      'M',    'M', 0,  42,  0,   0,   0,   8};
   bytes.insert(bytes.begin() + 2, std::begin(exif), std::end(exif));
@@ -151,7 +126,7 @@ TEST(PlainJpeg, AnExifSegmentIsReported) {
   const auto read = readPlainJpeg(tagged, 1u << 30, JpegOutput::Stored);
   ASSERT_TRUE(read);
   EXPECT_TRUE(read->hasExif);
-  EXPECT_TRUE(same(read->pixels, moduleRead(plain, cv::IMREAD_UNCHANGED)));
+  EXPECT_TRUE(same(read->pixels, test::moduleRead(plain, cv::IMREAD_UNCHANGED)));
 }
 
 }  // namespace

@@ -16,20 +16,18 @@
 #include <string>
 #include <vector>
 
-#include <OpenImageIO/imageio.h>
 #include <tiffio.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "camera/decoded_frame.hpp"
 #include "camera/image_codecs.hpp"
 #include "camera/image_file_reader.hpp"
+#include "tests/camera/module_reference.hpp"
 #include "tests/camera/temp_folder.hpp"
 
 namespace facet {
 namespace {
-namespace OIIO = OIIO_NAMESPACE;
 
 bool same(const cv::Mat& a, const cv::Mat& b) {
   if (a.empty() || b.empty()) return a.empty() && b.empty();
@@ -123,33 +121,6 @@ cv::Mat inFileOrder(const cv::Mat& bgr) {
   return bgr.channels() == 3 ? rgb : bgr;
 }
 
-std::vector<char> bytesOf(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
-
-// cv::imdecode in the module: the reference of readImage.
-cv::Mat moduleRead(const std::filesystem::path& file, int flags) {
-  std::vector<char> b = bytesOf(file);
-  return decodeImage(cv::Mat(1, static_cast<int>(b.size()), CV_8UC1, b.data()), flags);
-}
-
-// What the module's replay reader does with a TIFF (camera/image_file_decoder.cpp): OpenImageIO
-// reads the stored channels at their depth, colour in RGB order; the frame rule follows.
-cv::Mat moduleFrame(const std::filesystem::path& file) {
-  auto input = OIIO::ImageInput::open(file.string());
-  if (!input) return {};
-  const OIIO::ImageSpec& spec = input->spec();
-  const bool eight = spec.format.size() == 1;
-  const int channels = spec.nchannels >= 3 ? 3 : 1;
-  cv::Mat image(spec.height, spec.width, CV_MAKETYPE(eight ? CV_8U : CV_16U, channels));
-  if (!input->read_image(0, 0, 0, channels, eight ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::UINT16,
-                         image.data))
-    return {};
-  if (channels == 3) cv::cvtColor(image, image, cv::COLOR_RGB2BGR);
-  return frameOfDecodedPixels(std::move(image)).image;
-}
-
 TEST(PlainTiff, GivesTheModulesPixelsForEveryPlainKind) {
   const test::TempFolder dir;
   int files = 0;
@@ -175,7 +146,7 @@ TEST(PlainTiff, GivesTheModulesPixelsForEveryPlainKind) {
             EXPECT_TRUE(same(*plain, bgr)) << what.str();
             // cv::imdecode of OpenCV 4.6 fails on uncompressed tiled files (its TIFFReadRGBATile
             // call fails); where it reads one, it gives the stored samples too.
-            const cv::Mat module = moduleRead(file, cv::IMREAD_UNCHANGED);
+            const cv::Mat module = test::moduleRead(file, cv::IMREAD_UNCHANGED);
             if (!module.empty()) {
               EXPECT_TRUE(same(module, bgr)) << what.str();
             }
@@ -184,7 +155,7 @@ TEST(PlainTiff, GivesTheModulesPixelsForEveryPlainKind) {
                  {int(cv::IMREAD_GRAYSCALE), cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH}) {
               // Grey as stored; a colour or a 16-bit file read as 8-bit grey: OpenCV's rules.
               const bool stored = channels == 1 && (depth == CV_8U || (grey & cv::IMREAD_ANYDEPTH));
-              const cv::Mat moduleGrey = moduleRead(file, grey);
+              const cv::Mat moduleGrey = test::moduleRead(file, grey);
               if (!stored && moduleGrey.empty()) continue;  // the imdecode failure above
               EXPECT_TRUE(same(readImage(file, grey), stored ? bgr : moduleGrey))
                   << what.str() << " grey";
@@ -194,7 +165,7 @@ TEST(PlainTiff, GivesTheModulesPixelsForEveryPlainKind) {
             }
             const ImageFileContent frame = readImageFile(file, 1u << 20);
             ASSERT_TRUE(frame.ok()) << what.str() << ": " << frame.error;
-            EXPECT_TRUE(same(frame.image, moduleFrame(file))) << what.str();
+            EXPECT_TRUE(same(frame.image, test::moduleFrame(file))) << what.str();
           }
 }
 
@@ -209,7 +180,7 @@ TEST(PlainTiff, ReadsTheFirstPage) {
   const auto plain = readPlainTiff(file, 1u << 20);
   ASSERT_TRUE(plain.has_value());
   EXPECT_TRUE(same(*plain, grey));
-  EXPECT_TRUE(same(*plain, moduleRead(file, cv::IMREAD_UNCHANGED)));
+  EXPECT_TRUE(same(*plain, test::moduleRead(file, cv::IMREAD_UNCHANGED)));
 }
 
 TEST(PlainTiff, LeavesEveryOtherKindToTheModule) {
@@ -244,7 +215,7 @@ TEST(PlainTiff, LeavesEveryOtherKindToTheModule) {
     writeTiff(file, c.image, c.written);
     EXPECT_FALSE(readPlainTiff(file, 1u << 20).has_value()) << c.name;
     // Left to the module, which reads it as it always has.
-    const cv::Mat module = moduleRead(file, cv::IMREAD_UNCHANGED);
+    const cv::Mat module = test::moduleRead(file, cv::IMREAD_UNCHANGED);
     EXPECT_EQ(!module.empty(), c.moduleReads) << c.name;
     EXPECT_TRUE(same(readImage(file, cv::IMREAD_UNCHANGED), module)) << c.name;
   }
@@ -254,7 +225,7 @@ TEST(PlainTiff, LeavesEveryOtherKindToTheModule) {
   writeTiff(plainFile, samples(CV_8U, 1), Written{});
   EXPECT_TRUE(readPlainTiff(plainFile, 45 * 37).has_value());
   EXPECT_FALSE(readPlainTiff(plainFile, 45 * 37 - 1).has_value());
-  std::vector<char> bytes = bytesOf(plainFile);
+  std::vector<char> bytes = test::fileBytes(plainFile);
   const auto cut = dir.path() / "cut.tif";
   std::ofstream(cut, std::ios::binary)
       .write(bytes.data(), static_cast<std::streamsize>(bytes.size() / 2));
