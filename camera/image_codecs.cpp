@@ -9,6 +9,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "camera/decoded_frame.hpp"
+#include "camera/exif_orientation.hpp"
 #include "camera/image_codec_table.hpp"
 #include "camera/image_file_reader.hpp"
 #include "camera/jpeg_file.hpp"
@@ -107,14 +108,15 @@ std::optional<cv::Mat> imreadOfPlainPng(const fs::path& file, int flags) {
   return std::move(png->pixels);
 }
 
-// cv::imread's result for a plain JPEG: the flags facet reads with, and no EXIF orientation to
-// apply (cv::imread applies one to any read but IMREAD_UNCHANGED).
+// cv::imread's result for a plain JPEG: the flags facet reads with, and the Exif orientation
+// applied as cv::imread applies it to any read but IMREAD_UNCHANGED.
 std::optional<cv::Mat> imreadOfPlainJpeg(const fs::path& file, int flags) {
   const PlainRead read = plainReadOf(flags);
   if (read == PlainRead::Other) return std::nullopt;
   const bool grey = read == PlainRead::Grey;
   auto jpeg = readPlainJpeg(file, kImreadMaxPixels, grey ? JpegOutput::Grey : JpegOutput::Stored);
-  if (!jpeg || (grey && jpeg->hasExif)) return std::nullopt;
+  if (!jpeg || (grey && !jpeg->orientation)) return std::nullopt;
+  if (grey) applyExifOrientation(jpeg->pixels, *jpeg->orientation);
   return std::move(jpeg->pixels);
 }
 

@@ -2,13 +2,14 @@
 
 #include <csetjmp>
 #include <cstdio>
-#include <cstring>
 #include <memory>
 
 // jpeglib.h needs FILE and size_t declared before it.
 #include <jpeglib.h>
 
 #include <opencv2/imgproc.hpp>
+
+#include "camera/exif_orientation.hpp"
 
 namespace facet {
 namespace {
@@ -40,12 +41,11 @@ struct Decompressor {
   }
 };
 
-bool hasExifSegment(const jpeg_decompress_struct& cinfo) {
+// OpenCV reads the Exif block from the first APP1 segment, whatever it holds.
+std::optional<int> orientationOf(const jpeg_decompress_struct& cinfo) {
   for (jpeg_saved_marker_ptr m = cinfo.marker_list; m; m = m->next)
-    if (m->marker == JPEG_APP0 + 1 && m->data_length >= 6 &&
-        std::memcmp(m->data, "Exif\0\0", 6) == 0)
-      return true;
-  return false;
+    if (m->marker == JPEG_APP0 + 1) return exifOrientation(m->data, m->data_length);
+  return 1;
 }
 
 // The decode itself, between setjmp and the last libjpeg call; false on any error.
@@ -58,7 +58,7 @@ bool readInto(Decompressor& d, FILE* in, std::uint64_t maxPixels, JpegOutput out
   jpeg_stdio_src(&cinfo, in);
   jpeg_save_markers(&cinfo, JPEG_APP0 + 1, 0xffff);
   jpeg_read_header(&cinfo, TRUE);
-  out.hasExif = hasExifSegment(cinfo);  // saved markers live until the decompression ends
+  out.orientation = orientationOf(cinfo);  // saved markers live until the decompression ends
   const int components = cinfo.num_components;
   if (components != 1 && components != 3) return false;  // CMYK and others: the module
   // A Motion-JPEG frame leaves the Huffman tables out; OpenCV fills in the standard ones.

@@ -7,7 +7,7 @@
 // Only plain files are read here: 8-bit grey or three-component colour, with their Huffman
 // tables, within the pixel limit. Anything else (CMYK, Motion-JPEG frames without tables, any
 // error or warning of the library) is left to the module, which reads every format and words
-// every error.
+// every error. The Exif orientation is reported, not applied: the caller turns what needs it.
 
 #include <cstdint>
 #include <filesystem>
@@ -18,8 +18,11 @@
 namespace facet {
 
 struct PlainJpeg {
-  cv::Mat pixels;        // CV_8UC1, or CV_8UC3 in OpenCV's order (BGR)
-  bool hasExif = false;  // an Exif APP1 segment (an orientation cv::imread may apply)
+  cv::Mat pixels;  // CV_8UC1, or CV_8UC3 in OpenCV's order (BGR), as stored
+  // The orientation cv::imread applies to any read but IMREAD_UNCHANGED: that of the Exif block
+  // in the first APP1 segment, which is where OpenCV looks (exif_orientation.hpp); 1 without
+  // one. Empty when that segment is not an Exif block read the same way everywhere.
+  std::optional<int> orientation = 1;
 };
 
 enum class JpegOutput {

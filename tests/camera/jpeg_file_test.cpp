@@ -60,7 +60,7 @@ TEST(PlainJpeg, GivesTheModulesPixelsForColourAndGreyFiles) {
       ASSERT_TRUE(stored && grey) << file;
       EXPECT_EQ(stored->pixels.channels(), channels);
       EXPECT_EQ(grey->pixels.channels(), 1);
-      EXPECT_FALSE(stored->hasExif);
+      EXPECT_EQ(stored->orientation, 1);
       EXPECT_TRUE(same(stored->pixels, test::moduleRead(file, cv::IMREAD_UNCHANGED))) << file;
       EXPECT_TRUE(same(grey->pixels, test::moduleRead(file, cv::IMREAD_GRAYSCALE))) << file;
       // The replay reader's result (OpenImageIO in the module) is the stored pixels too.
@@ -81,9 +81,9 @@ TEST(PlainJpeg, TheRepositorysPhotographsReadAsTheModuleReadsThem) {
     EXPECT_GT(stored->pixels.total(), 10000u);
     EXPECT_TRUE(same(stored->pixels, test::moduleRead(file, cv::IMREAD_UNCHANGED))) << file;
     EXPECT_TRUE(same(stored->pixels, test::moduleFrame(file))) << file;
-    if (!grey->hasExif) {
-      EXPECT_TRUE(same(grey->pixels, test::moduleRead(file, cv::IMREAD_GRAYSCALE))) << file;
-    }
+    EXPECT_TRUE(
+        same(readImage(file, cv::IMREAD_GRAYSCALE), test::moduleRead(file, cv::IMREAD_GRAYSCALE)))
+        << file;
   }
 }
 
@@ -111,22 +111,93 @@ TEST(PlainJpeg, DamagedTruncatedOversizedAndForeignFilesAreLeftToTheModule) {
   EXPECT_FALSE(readPlainJpeg(dir.path() / "missing.jpg", 1u << 30, JpegOutput::Stored));
 }
 
-TEST(PlainJpeg, AnExifSegmentIsReported) {
-  // An APP1 "Exif" segment right after SOI: cv::imread would apply its orientation to a grey
-  // read, so the caller leaves such a read to the module.
+// An APP1 segment right after SOI holding an Exif block: a TIFF header and one directory with
+// a camera make (ASCII, 4 bytes inline) and, unless 0, an orientation.
+std::vector<char> exifSegment(bool bigEndian, int orientation) {
+  std::vector<unsigned char> tiff;
+  const auto u16 = [&](unsigned v) {
+    const unsigned char hi = static_cast<unsigned char>(v >> 8), lo = static_cast<unsigned char>(v);
+    tiff.insert(tiff.end(), bigEndian ? std::initializer_list<unsigned char>{hi, lo}
+                                      : std::initializer_list<unsigned char>{lo, hi});
+  };
+  const auto u32 = [&](unsigned v) {
+    bigEndian ? (u16(v >> 16), u16(v & 0xFFFF)) : (u16(v & 0xFFFF), u16(v >> 16));
+  };
+  tiff.push_back(bigEndian ? 'M' : 'I');
+  tiff.push_back(bigEndian ? 'M' : 'I');
+  u16(42);
+  u32(8);
+  u16(orientation ? 2 : 1);
+  u16(271), u16(2), u32(4), tiff.insert(tiff.end(), {'a', 'b', 'c', 0});  // Make "abc"
+  if (orientation) u16(274), u16(3), u32(1), u16(static_cast<unsigned>(orientation)), u16(0);
+  u32(0);  // no next directory
+  std::vector<char> segment = {'\xFF', '\xE1', 0, 0, 'E', 'x', 'i', 'f', 0, 0};
+  for (const unsigned char c : tiff) segment.push_back(static_cast<char>(c));
+  const std::size_t length = segment.size() - 2;
+  segment[2] = static_cast<char>(length >> 8);
+  segment[3] = static_cast<char>(length & 0xFF);
+  return segment;
+}
+
+std::filesystem::path withSegment(const std::filesystem::path& plain, const std::string& name,
+                                  const std::vector<char>& segment) {
+  std::vector<char> bytes = test::fileBytes(plain);
+  bytes.insert(bytes.begin() + 2, segment.begin(), segment.end());
+  const auto tagged = plain.parent_path() / name;
+  writeBytes(tagged, bytes);
+  return tagged;
+}
+
+// A camera's JPEG carries an Exif block, usually with an orientation. A grey read applies it as
+// cv::imread does, in the process; an unchanged read and the replay reader leave the pixels.
+TEST(PlainJpeg, AGreyReadTurnsByTheExifOrientationAsTheModuleDoes) {
   const test::TempFolder dir;
   const auto plain = dir.path() / "plain.jpg";
   ASSERT_TRUE(writeImage(plain, scene(3)));
-  std::vector<char> bytes = test::fileBytes(plain);
-  const char exif[] = {'\xFF', '\xE1', 0,   16, 'E', 'x', 'i', 'f', 0,
-                       0,      'M',    'M', 0,  42,  0,   0,   0,   8};
-  bytes.insert(bytes.begin() + 2, std::begin(exif), std::end(exif));
-  const auto tagged = dir.path() / "tagged.jpg";
-  writeBytes(tagged, bytes);
-  const auto read = readPlainJpeg(tagged, 1u << 30, JpegOutput::Stored);
-  ASSERT_TRUE(read);
-  EXPECT_TRUE(read->hasExif);
-  EXPECT_TRUE(same(read->pixels, test::moduleRead(plain, cv::IMREAD_UNCHANGED)));
+  const cv::Mat stored = test::moduleRead(plain, cv::IMREAD_UNCHANGED);
+  const cv::Mat grey = test::moduleRead(plain, cv::IMREAD_GRAYSCALE);
+  int turned = 0;
+  for (const bool bigEndian : {false, true})
+    for (int orientation = 0; orientation <= 8; ++orientation) {
+      const std::string name =
+          std::to_string(orientation) + (bigEndian ? "_motorola.jpg" : "_intel.jpg");
+      const auto file = withSegment(plain, name, exifSegment(bigEndian, orientation));
+      const auto read = readPlainJpeg(file, 1u << 30, JpegOutput::Stored);
+      ASSERT_TRUE(read) << name;
+      EXPECT_EQ(read->orientation, std::max(orientation, 1)) << name;
+      const cv::Mat module = test::moduleRead(file, cv::IMREAD_GRAYSCALE);
+      EXPECT_TRUE(same(readImage(file, cv::IMREAD_GRAYSCALE), module)) << name;
+      EXPECT_TRUE(same(readImage(file, cv::IMREAD_UNCHANGED), stored)) << name;
+      EXPECT_TRUE(same(readImageFile(file, 1u << 30).image, stored)) << name;
+      turned += !same(module, grey);
+    }
+  EXPECT_EQ(turned, 2 * 7);  // the case is real: the module turns orientations 2 to 8
+}
+
+// A block the reader does not trust (cut short, not Exif, an orientation out of range) leaves
+// a grey read to the module; the pixels as stored are still read in the process.
+TEST(PlainJpeg, AnExifBlockItCannotReadIsLeftToTheModule) {
+  const test::TempFolder dir;
+  const auto plain = dir.path() / "plain.jpg";
+  ASSERT_TRUE(writeImage(plain, scene(3)));
+  std::vector<char> cutShort = exifSegment(true, 6);
+  cutShort.resize(cutShort.size() - 10);
+  cutShort[3] = static_cast<char>(cutShort.size() - 2);
+  std::vector<char> outOfRange = exifSegment(false, 6);
+  outOfRange[outOfRange.size() - 8] = 9;  // the orientation's low byte
+  std::vector<char> xmp = {'\xFF', '\xE1', 0, 12, 'h', 't', 't', 'p', ':', '/', '/', 'n', 's', '.'};
+  const std::vector<std::pair<std::string, std::vector<char>>> blocks = {
+      {"cut.jpg", cutShort}, {"range.jpg", outOfRange}, {"xmp.jpg", xmp}};
+  for (const auto& [name, segment] : blocks) {
+    const auto file = withSegment(plain, name, segment);
+    const auto read = readPlainJpeg(file, 1u << 30, JpegOutput::Stored);
+    ASSERT_TRUE(read) << name;
+    EXPECT_FALSE(read->orientation) << name;
+    EXPECT_TRUE(same(read->pixels, test::moduleRead(plain, cv::IMREAD_UNCHANGED))) << name;
+    EXPECT_TRUE(
+        same(readImage(file, cv::IMREAD_GRAYSCALE), test::moduleRead(file, cv::IMREAD_GRAYSCALE)))
+        << name;
+  }
 }
 
 }  // namespace
