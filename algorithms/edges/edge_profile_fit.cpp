@@ -30,7 +30,8 @@ using Lanes = float __attribute__((vector_size(16)));
 using IntLanes = int __attribute__((vector_size(16)));
 
 struct Samples {
-  int count = 0;  // padded to a multiple of 4 with zero-weight samples
+  int count = 0;   // padded to a multiple of 4 with zero-weight samples
+  int filled = 0;  // the samples before the padding
   float mean = 0;
   // across, along, grey value minus mean, weight (1, or 0 for padding)
   alignas(16) std::array<float, kCapacity> s, t, v, weight;
@@ -113,7 +114,7 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
     }
     out.count += std::max(0, last - first + 1);
   }
-  const int real = out.count;
+  const int real = out.filled = out.count;
   out.mean = real ? sum / static_cast<float>(real) : 0.0f;
   for (int i = 0; i < real; ++i) out.v[i] -= out.mean;
   while (out.count % 4) {
@@ -156,12 +157,14 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
               vPhi = Lanes{} + static_cast<float>(phi);
   const Lanes vLow = Lanes{}, vHigh = Lanes{} + (static_cast<float>(profile.size) - 1.001f);
   Lanes acc[N][N + 1] = {};
-  for (int i = 0; i < smp.count; i += 4) {
-    Lanes ss, tt, vv, ww;
+  // Four samples; their weights are all 1 before the padding, which spares the products with
+  // them there (a product with 1 is exact: the sums are the same).
+  const auto accumulate = [&](int i, auto padded) {
+    Lanes ss, tt, vv, ww = Lanes{} + 1.0f;
     std::memcpy(&ss, &smp.s[i], sizeof ss);
     std::memcpy(&tt, &smp.t[i], sizeof tt);
     std::memcpy(&vv, &smp.v[i], sizeof vv);
-    std::memcpy(&ww, &smp.weight[i], sizeof ww);
+    if constexpr (decltype(padded)::value) std::memcpy(&ww, &smp.weight[i], sizeof ww);
     const Lanes z = (ss + vPhi * tt - vE) * vScale;
     Lanes f = (z + profile.range) * profile.perUnit;
     f = f < vLow ? vLow : f;
@@ -178,7 +181,10 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
       acc[row][N] += basis[row] * vv;
       for (int k = 0; k <= row; ++k) acc[row][k] += basis[row] * basis[k];
     }
-  }
+  };
+  int i = 0;
+  for (; i + 4 <= smp.filled; i += 4) accumulate(i, std::false_type{});
+  for (; i < smp.count; i += 4) accumulate(i, std::true_type{});
   std::array<std::array<double, N>, N> m{};
   std::array<double, N> y{};
   for (int r = 0; r < N; ++r) {
