@@ -30,7 +30,8 @@ using Lanes = float __attribute__((vector_size(16)));
 using IntLanes = int __attribute__((vector_size(16)));
 
 struct Samples {
-  int count = 0;  // padded to a multiple of 4 with zero-weight samples
+  int count = 0;   // padded to a multiple of 4 with zero-weight samples
+  int filled = 0;  // the samples before the padding
   float mean = 0;
   // across, along, grey value minus mean, weight (1, or 0 for padding)
   alignas(16) std::array<float, kCapacity> s, t, v, weight;
@@ -113,13 +114,33 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
     }
     out.count += std::max(0, last - first + 1);
   }
-  const int real = out.count;
+  const int real = out.filled = out.count;
   out.mean = real ? sum / static_cast<float>(real) : 0.0f;
   for (int i = 0; i < real; ++i) out.v[i] -= out.mean;
   while (out.count % 4) {
     const int i = out.count++;
     out.s[i] = out.t[i] = out.v[i] = out.weight[i] = 0.0f;
   }
+}
+
+// The table intervals of four lanes, one field per vector: each interval is one 16-byte load,
+// and a 4x4 transpose sorts them into fields (fewer instructions than sixteen single loads).
+struct Table {
+  Lanes cdf, cdfSlope, pdf, pdfSlope;
+};
+
+Table tableLanes(const ProfileInterval* packed, IntLanes idx) {
+  static_assert(sizeof(ProfileInterval) == sizeof(Lanes));
+  Lanes q[4];
+  for (int k = 0; k < 4; ++k) std::memcpy(&q[k], &packed[idx[k]], sizeof(Lanes));
+  const Lanes low01 = __builtin_shufflevector(q[0], q[1], 0, 4, 1, 5);
+  const Lanes low23 = __builtin_shufflevector(q[2], q[3], 0, 4, 1, 5);
+  const Lanes high01 = __builtin_shufflevector(q[0], q[1], 2, 6, 3, 7);
+  const Lanes high23 = __builtin_shufflevector(q[2], q[3], 2, 6, 3, 7);
+  return {__builtin_shufflevector(low01, low23, 0, 1, 4, 5),
+          __builtin_shufflevector(low01, low23, 2, 3, 6, 7),
+          __builtin_shufflevector(high01, high23, 0, 1, 4, 5),
+          __builtin_shufflevector(high01, high23, 2, 3, 6, 7)};
 }
 
 // One Gauss-Newton step of the model v = a + b Phi(z), z = (s + phi t - e) / w, for (a, b, e)
@@ -136,27 +157,23 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
               vPhi = Lanes{} + static_cast<float>(phi);
   const Lanes vLow = Lanes{}, vHigh = Lanes{} + (static_cast<float>(profile.size) - 1.001f);
   Lanes acc[N][N + 1] = {};
-  for (int i = 0; i < smp.count; i += 4) {
-    Lanes ss, tt, vv, ww;
+  // Four samples; their weights are all 1 before the padding, which spares the products with
+  // them there (a product with 1 is exact: the sums are the same).
+  const auto accumulate = [&](int i, auto padded) {
+    Lanes ss, tt, vv, ww = Lanes{} + 1.0f;
     std::memcpy(&ss, &smp.s[i], sizeof ss);
     std::memcpy(&tt, &smp.t[i], sizeof tt);
     std::memcpy(&vv, &smp.v[i], sizeof vv);
-    std::memcpy(&ww, &smp.weight[i], sizeof ww);
+    if constexpr (decltype(padded)::value) std::memcpy(&ww, &smp.weight[i], sizeof ww);
     const Lanes z = (ss + vPhi * tt - vE) * vScale;
     Lanes f = (z + profile.range) * profile.perUnit;
     f = f < vLow ? vLow : f;
     f = f > vHigh ? vHigh : f;
     const IntLanes idx = __builtin_convertvector(f, IntLanes);
     const Lanes r = f - __builtin_convertvector(idx, Lanes);
-    const auto& q0 = packed[idx[0]];
-    const auto& q1 = packed[idx[1]];
-    const auto& q2 = packed[idx[2]];
-    const auto& q3 = packed[idx[3]];
-    const Lanes cdf = Lanes{q0.cdf, q1.cdf, q2.cdf, q3.cdf} +
-                      r * Lanes{q0.cdfSlope, q1.cdfSlope, q2.cdfSlope, q3.cdfSlope};
-    const Lanes pdf = (Lanes{q0.pdf, q1.pdf, q2.pdf, q3.pdf} +
-                       r * Lanes{q0.pdfSlope, q1.pdfSlope, q2.pdfSlope, q3.pdfSlope}) *
-                      ww;
+    const Table table = tableLanes(packed, idx);
+    const Lanes cdf = table.cdf + r * table.cdfSlope;
+    const Lanes pdf = (table.pdf + r * table.pdfSlope) * ww;
     Lanes basis[4] = {ww, cdf * ww, pdf, Lanes{}};
     if constexpr (X == Extra::Width) basis[3] = z * pdf;
     if constexpr (X == Extra::Turn) basis[3] = tt * pdf;
@@ -164,7 +181,10 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
       acc[row][N] += basis[row] * vv;
       for (int k = 0; k <= row; ++k) acc[row][k] += basis[row] * basis[k];
     }
-  }
+  };
+  int i = 0;
+  for (; i + 4 <= smp.filled; i += 4) accumulate(i, std::false_type{});
+  for (; i < smp.count; i += 4) accumulate(i, std::true_type{});
   std::array<std::array<double, N>, N> m{};
   std::array<double, N> y{};
   for (int r = 0; r < N; ++r) {
@@ -228,7 +248,8 @@ EdgeBlur fitBlurModel(const cv::Mat& image, const std::vector<const EdgeSeed*>& 
   // for 1.00; over +-2 px the sagitta is 0.13 px, and the test of that disc reads 1.00 +- 0.1).
   EdgeProfileParams stretch = params;
   stretch.halfAlong = std::min(params.halfAlong, kBlurHalfAlong);
-  std::vector<Samples> samples(seeds.size());
+  // Default-initialised (gather writes every sample it counts): 8 KB each need no zeroing.
+  const std::unique_ptr<Samples[]> samples(new Samples[seeds.size()]);
   for (size_t i = 0; i < seeds.size(); ++i) {
     if (image.depth() == CV_16U)
       gatherAny<ushort>(image, *seeds[i], stretch, samples[i]);

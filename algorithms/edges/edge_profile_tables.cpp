@@ -224,13 +224,17 @@ std::shared_ptr<ApertureProfiles> apertureProfiles(double sigma, bool gridBlur) 
   static std::mutex mutex;
   static std::vector<std::shared_ptr<ApertureProfiles>> cache;
   const double key = std::round(sigma * 50) / 50;
+  // The profile fit asks for the same profiles at every point of an image: the thread's last
+  // answer spares the lock and the search (an entry evicted meanwhile holds the same values).
+  thread_local std::shared_ptr<ApertureProfiles> last;
+  if (last && last->sigma == key && last->gridBlur == gridBlur) return last;
   std::lock_guard lock(mutex);
   for (const auto& p : cache)
-    if (p->sigma == key && p->gridBlur == gridBlur) return p;
+    if (p->sigma == key && p->gridBlur == gridBlur) return last = p;
   auto made = std::make_shared<ApertureProfiles>(key, gridBlur);
   if (cache.size() >= 64) cache.erase(cache.begin());
   cache.push_back(made);
-  return made;
+  return last = made;
 }
 
 ProfileView erfView(double w) {

@@ -1,8 +1,10 @@
 #include "algorithms/shape/image_gradients.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <type_traits>
+#include <vector>
 
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
@@ -76,6 +78,42 @@ void normalise(const cv::Mat& gx, const cv::Mat& gy, float min2, cv::Mat& out) {
   }
 }
 
+// The 3x3 Sobel derivatives of the pixels x0 <= x < x1 of row y of an 8-bit image, its border
+// replicated: cv::Sobel's CV_16S values (integer sums, so equal), without the filter engine that
+// each cv::Sobel call sets up for a few tiles. s and d are the columns' vertical passes (smoothing
+// [1 2 1] and difference), from column x0 - 1 to x1.
+void sobelRow(const cv::Mat& grey, int y, int x0, int x1, std::vector<int>& s, std::vector<int>& d,
+              short* __restrict gx, short* __restrict gy) {
+  const uchar* a = grey.ptr<uchar>(std::max(y - 1, 0));
+  const uchar* b = grey.ptr<uchar>(y);
+  const uchar* c = grey.ptr<uchar>(std::min(y + 1, grey.rows - 1));
+  const int n = x1 - x0 + 2;
+  s.resize(static_cast<std::size_t>(n));
+  d.resize(static_cast<std::size_t>(n));
+  int* __restrict sp = s.data();
+  int* __restrict dp = d.data();
+  const int lastColumn = grey.cols - 1;
+  // Only the first and last columns can lie outside the image.
+  const auto column = [&](int i) {
+    const int x = std::clamp(x0 - 1 + i, 0, lastColumn);
+    sp[i] = a[x] + 2 * b[x] + c[x];
+    dp[i] = c[x] - a[x];
+  };
+  column(0);
+  const uchar* __restrict ra = a + x0;
+  const uchar* __restrict rb = b + x0;
+  const uchar* __restrict rc = c + x0;
+  for (int i = 1; i < n - 1; ++i) {
+    sp[i] = ra[i - 1] + 2 * rb[i - 1] + rc[i - 1];
+    dp[i] = rc[i - 1] - ra[i - 1];
+  }
+  column(n - 1);
+  for (int i = 0; i < n - 2; ++i) {
+    gx[i] = static_cast<short>(sp[i + 2] - sp[i]);
+    gy[i] = static_cast<short>(dp[i] + 2 * dp[i + 1] + dp[i + 2]);
+  }
+}
+
 }  // namespace
 
 DirectionField::DirectionField(cv::Mat grey, double minContrast)
@@ -91,6 +129,7 @@ void DirectionField::ensure(cv::Rect region) {
   const int tx0 = region.x / kTile, tx1 = (region.x + region.width - 1) / kTile;
   const int ty0 = region.y / kTile, ty1 = (region.y + region.height - 1) / kTile;
   // Rows of missing tiles are computed as runs, so that Sobel sees long rows.
+  std::vector<int> sums, differences;
   for (int ty = ty0; ty <= ty1; ++ty) {
     for (int tx = tx0; tx <= tx1;) {
       if (done_.at<uchar>(ty, tx)) {
@@ -106,8 +145,11 @@ void DirectionField::ensure(cv::Rect region) {
       cv::Mat gx, gy;
       cv::Mat out = field_(run);
       if (grey_.depth() == CV_8U) {
-        cv::Sobel(grey_(run), gx, CV_16S, 1, 0, 3, 1.0, 0.0, cv::BORDER_REPLICATE);
-        cv::Sobel(grey_(run), gy, CV_16S, 0, 1, 3, 1.0, 0.0, cv::BORDER_REPLICATE);
+        gx.create(run.size(), CV_16S);
+        gy.create(run.size(), CV_16S);
+        for (int y = 0; y < run.height; ++y)
+          sobelRow(grey_, run.y + y, run.x, run.br().x, sums, differences, gx.ptr<short>(y),
+                   gy.ptr<short>(y));
         normalise<short>(gx, gy, static_cast<float>(64.0 * minContrast_ * minContrast_), out);
       } else {
         cv::Sobel(grey_(run), gx, CV_32F, 1, 0, 3, 1.0, 0.0, cv::BORDER_REPLICATE);

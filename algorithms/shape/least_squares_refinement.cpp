@@ -45,21 +45,24 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
   // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
   const auto correspond = [&](const Pose2D& at, int radius, bool anySign) {
     const double c = std::cos(at.angle), s = std::sin(at.angle);
+    // Pose2D::apply's products, its cosine and sine taken once for all points.
+    const double cs = c * at.scale, ss = s * at.scale;
     double polaritySum = 0.0;
     pairs.clear();
     for (const auto& mp : model.finePoints) {
       const double px = mp.position.x, py = mp.position.y;
-      const cv::Point2d q = at.apply({px, py});
+      const cv::Point2d q(at.x + cs * px + ss * py, at.y - ss * px + cs * py);
       const double dx = c * mp.direction.x + s * mp.direction.y;
       const double dy = -s * mp.direction.x + c * mp.direction.y;
       const int cx = cvRound(q.x) - roi.x, cy = cvRound(q.y) - roi.y;
       int bestIdx = -1;
       double bestD2 = 1e30, bestDot = 0.0;
-      for (int v = cy - radius; v <= cy + radius; ++v) {
-        if (v < 0 || v >= roi.height) continue;
+      const int u0 = std::max(cx - radius, 0), u1 = std::min(cx + radius, roi.width - 1);
+      const int v0 = std::max(cy - radius, 0), v1 = std::min(cy + radius, roi.height - 1);
+      for (int v = v0; v <= v1; ++v) {
         const int* row = cell.ptr<int>(v);
-        for (int u = cx - radius; u <= cx + radius; ++u) {
-          if (u < 0 || u >= roi.width || row[u] < 0) continue;
+        for (int u = u0; u <= u1; ++u) {
+          if (row[u] < 0) continue;
           const EdgePoint& e = edges.points[row[u]];
           const double dot = e.normal.x * dx + e.normal.y * dy;
           const double agree = polarity == Polarity::IgnoreLocal    ? std::abs(dot)

@@ -262,6 +262,45 @@ TEST(Canny, HysteresisKeepsWeakPartsConnectedToStrongOnes) {
   EXPECT_GE(count(cannyEdges(image, 5, 9), 58, 3, 77), 70);
 }
 
+TEST(Canny, GradientEqualsTheFiveByFiveSobelOfTheImage) {
+  // The definition: cv::Sobel's 5x5 derivatives of the whole image with its border replicated,
+  // for areas inside the image, on its border and on a corner, 8-bit and 16-bit.
+  for (int depth : {CV_8U, CV_16U}) {
+    SceneSpec spec;
+    spec.size = {61, 47};
+    spec.background = 30;
+    spec.blurSigma = 0.8;
+    spec.noiseSigma = 4.0;
+    spec.depth = depth;
+    Scene scene(spec);
+    scene.addDisc({28.4, 22.1}, 17.0, 220);
+    const cv::Mat image = scene.render();
+    const int type = depth == CV_8U ? CV_16S : CV_32F;
+    cv::Mat dx, dy;
+    cv::Sobel(image, dx, type, 1, 0, 5, 1, 0, cv::BORDER_REPLICATE);
+    cv::Sobel(image, dy, type, 0, 1, 5, 1, 0, cv::BORDER_REPLICATE);
+    // scale * |(gx, gy)| in float, as the maps hold it.
+    const auto scale = static_cast<float>((depth == CV_8U ? 1.0 : 1.0 / 256.0) / 128.0);
+    cv::Mat fx, fy, magnitude(image.size(), CV_32F);
+    dx.convertTo(fx, CV_32F);
+    dy.convertTo(fy, CV_32F);
+    for (int y = 0; y < image.rows; ++y)
+      for (int x = 0; x < image.cols; ++x) {
+        const float a = fx.at<float>(y, x), b = fy.at<float>(y, x);
+        magnitude.at<float>(y, x) = scale * std::sqrt(a * a + b * b);
+      }
+    for (const cv::Rect area : {cv::Rect(0, 0, 61, 47), cv::Rect(9, 7, 30, 18),
+                                cv::Rect(-3, 20, 12, 40), cv::Rect(50, 0, 20, 1)}) {
+      const EdgeGradient g = computeEdgeGradient(image, area);
+      const cv::Rect inside = area & cv::Rect(0, 0, image.cols, image.rows);
+      ASSERT_EQ(g.area, inside);
+      EXPECT_EQ(cv::countNonZero(g.gx != dx(inside)), 0) << "depth " << depth << " " << area;
+      EXPECT_EQ(cv::countNonZero(g.gy != dy(inside)), 0) << "depth " << depth << " " << area;
+      EXPECT_EQ(cv::countNonZero(g.magnitude != magnitude(inside)), 0) << "depth " << depth;
+    }
+  }
+}
+
 // A ring of runs (as an annulus is measured) that reaches the image's border, where the
 // gradient replicates the border pixels.
 RowRuns ringRuns(cv::Size size, cv::Point2d centre, double rIn, double rOut) {
