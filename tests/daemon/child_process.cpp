@@ -80,6 +80,13 @@ std::optional<int> ChildProcess::wait(std::chrono::milliseconds timeout) {
     const pid_t r = ::waitpid(pid_, &status, WNOHANG);
     if (r == pid_) {
       exitCode_ = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+      // The reader thread may not have taken the last lines from the pipe yet: lines() right
+      // after wait() must see everything the child printed. A grandchild that keeps the pipe
+      // open must not hold the test for long, hence the bound.
+      std::unique_lock lock(mutex_);
+      changed_.wait_until(
+          lock, std::min(until, std::chrono::steady_clock::now() + std::chrono::seconds(5)),
+          [this] { return eof_; });
       return exitCode_;
     }
     if (std::chrono::steady_clock::now() > until) return std::nullopt;
