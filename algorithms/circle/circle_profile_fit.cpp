@@ -328,13 +328,14 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // columns, which vectorises; the matrix products with a row of weighted columns did not.
   using Free = std::array<bool, 8>;
   constexpr Free kAll{true, true, true, true, true, true, true, true};
-  auto normalEquations = [&](const Free& free) {
+  // `gradient`: the entries of J^T W r wanted (the ramp's score test below needs two).
+  auto normalEquations = [&](const Free& free, const Free& gradient) {
     jtj.setIdentity();
     jtr.setZero();
     for (int a = 0; a < 8; ++a) {
       if (!free[a]) continue;
       weighted = jac.col(a).cwiseProduct(weight);
-      jtr(a) = weighted.dot(r);
+      if (gradient[a]) jtr(a) = weighted.dot(r);
       for (int b = a; b < 8; ++b)
         if (free[b]) jtj(b, a) = jtj(a, b) = weighted.dot(jac.col(b));
     }
@@ -365,7 +366,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
             sigma = tukeyWeights();
             current = cost(r);
           }
-          normalEquations(free);
+          normalEquations(free, free);
           h = jtj;
           g = -jtr;  // the residuals here are grey - model
         },
@@ -393,7 +394,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // has a ramp worth fitting.
   bool withRamp = false;
   if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
-  normalEquations(kAll);
+  normalEquations(kAll, {false, false, false, false, false, true, true, false});
   {
     constexpr int kRamp[2] = {5, 6};
     constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
