@@ -20,12 +20,37 @@ double median(std::vector<float>& v) {
   return v[v.size() / 2];
 }
 
+// The same element as median() of non-negative integers below `bound`, by counting them: a
+// selection's comparisons branch on the data, and the noise mask's responses on an 8-bit image
+// are whole numbers of at most 16 x 255.
+int medianByCounting(const std::vector<int>& v, int bound) {
+  if (v.empty()) return 0;
+  std::vector<int> count(bound, 0);
+  for (int a : v) ++count[a];
+  const std::size_t rank = v.size() / 2;  // median(): the element at index size / 2 once sorted
+  std::size_t below = 0;
+  int value = 0;
+  while (below + static_cast<std::size_t>(count[value]) <= rank) below += count[value++];
+  return value;
+}
+
+// The sectors of the n pixels from column x0 on of the row dy below the centre, from the "diamond
+// angle" in [0, 4), a monotonic stand-in for atan2. A function of its own with a distinct output
+// array (__restrict), so that the loop vectorises.
+void rowSectors(int x0, int n, double centreX, double dy, int sectors, int* __restrict sector) {
+  for (int i = 0; i < n; ++i) {
+    const double dx = static_cast<double>(x0 + i) - centreX;
+    const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);
+    const double turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
+    sector[i] = std::min(sectors - 1, static_cast<int>(turn * sectors));
+  }
+}
+
 // The largest gradient magnitude in each angular sector and Immerkaer's noise response on every
-// third pixel of the annulus.
+// third pixel of the annulus (its absolute value, in the image's own grey levels).
 template <typename T>
 void annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const RowRuns& runs,
-                       cv::Point2d centre, double scale, std::vector<float>& peak,
-                       std::vector<float>& noise) {
+                       cv::Point2d centre, std::vector<float>& peak, std::vector<int>& noise) {
   const int sectors = static_cast<int>(peak.size());
   const cv::Rect crop = gradient.area;
   std::vector<int> sector;  // of each pixel of a run
@@ -33,15 +58,8 @@ void annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const
     const int y = run.y;
     const double dy = y - centre.y;
     const float* magnitude = gradient.magnitude.ptr<float>(y - crop.y) - crop.x;
-    // Sector from the "diamond angle" in [0, 4), a monotonic stand-in for atan2; a loop of its
-    // own so that it vectorises.
     sector.resize(run.x1 - run.x0);
-    for (int x = run.x0; x < run.x1; ++x) {
-      const double dx = x - centre.x;
-      const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);
-      const double turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
-      sector[x - run.x0] = std::min(sectors - 1, static_cast<int>(turn * sectors));
-    }
+    rowSectors(run.x0, run.x1 - run.x0, centre.x, dy, sectors, sector.data());
     for (int x = run.x0; x < run.x1; ++x) {
       float& sectorPeak = peak[sector[x - run.x0]];
       sectorPeak = std::max(sectorPeak, magnitude[x]);
@@ -51,11 +69,10 @@ void annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const
     const T* above = image.ptr<T>(y - 1);
     const T* here = image.ptr<T>(y);
     const T* below = image.ptr<T>(y + 1);
-    // Summed in integers and scaled once: the same value (the scale is a power of two).
     for (int x = run.x0 + ((3 - (run.x0 + y) % 3) % 3); x < run.x1; x += 3) {
       const int n = above[x - 1] - 2 * above[x] + above[x + 1] - 2 * here[x - 1] + 4 * here[x] -
                     2 * here[x + 1] + below[x - 1] - 2 * below[x] + below[x + 1];
-      noise.push_back(static_cast<float>(std::abs(n * scale)));
+      noise.push_back(std::abs(n));
     }
   }
 }
@@ -86,14 +103,22 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
   const double scale = image.depth() == CV_16U ? 1.0 / 256.0 : 1.0;
   const int sectors = std::clamp(static_cast<int>(2.0 * std::numbers::pi * rOut / 6.0), 8, 120);
   const EdgeGradient gradient = computeEdgeGradientOnRuns(image, crop, runs);
-  std::vector<float> noise, peak(sectors, 0.0f);
+  std::vector<float> peak(sectors, 0.0f);
+  std::vector<int> noise;
   noise.reserve(out.annulusPixels / 3 + runs.size());
-  if (image.depth() == CV_16U)
-    annulusStatistics<std::uint16_t>(image, gradient, runs, centre, scale, peak, noise);
-  else
-    annulusStatistics<std::uint8_t>(image, gradient, runs, centre, scale, peak, noise);
-
-  out.noiseSigma = median(noise) / (0.6745 * 6.0);
+  int noiseMedian = 0;
+  if (image.depth() == CV_16U) {
+    annulusStatistics<std::uint16_t>(image, gradient, runs, centre, peak, noise);
+    if (!noise.empty()) {
+      std::nth_element(noise.begin(), noise.begin() + noise.size() / 2, noise.end());
+      noiseMedian = noise[noise.size() / 2];
+    }
+  } else {
+    annulusStatistics<std::uint8_t>(image, gradient, runs, centre, peak, noise);
+    noiseMedian = medianByCounting(noise, 16 * 255 + 1);
+  }
+  // Scaled once: the same value as scaling each response (the scale is a power of two).
+  out.noiseSigma = noiseMedian * scale / (0.6745 * 6.0);
   if (low && high) {
     out.lowThreshold = *low;
     out.highThreshold = *high;

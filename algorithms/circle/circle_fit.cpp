@@ -110,7 +110,12 @@ double coverageDeg(const std::vector<Eigen::Vector2d>& pts, const Circle& c) {
   a.reserve(pts.size());
   for (const auto& p : pts) a.push_back(std::atan2(p.y() - c.centre.y(), p.x() - c.centre.x()));
   std::sort(a.begin(), a.end());
-  const double maxGap = std::max(3.0 / std::max(c.radius, 1e-6), 2.0 * kPi / 180.0);
+  return coverageDeg(a, c.radius);
+}
+
+double coverageDeg(const std::vector<double>& a, double radius) {
+  if (a.size() < 2) return 0.0;
+  const double maxGap = std::max(3.0 / std::max(radius, 1e-6), 2.0 * kPi / 180.0);
   double uncovered = 0;
   for (std::size_t i = 0; i < a.size(); ++i) {
     const double gap = i + 1 < a.size() ? a[i + 1] - a[i] : a.front() + 2.0 * kPi - a.back();

@@ -38,4 +38,8 @@ std::optional<Circle> fitGeometric(const std::vector<Eigen::Vector2d>& pts,
 // between neighbouring points wider than a few pixels of arc (the natural spacing of edge points).
 double coverageDeg(const std::vector<Eigen::Vector2d>& pts, const Circle& c);
 
+// The same from the points' polar angles around the centre (atan2, radians), sorted, for a circle
+// of `radius`: for a caller that has sorted them already.
+double coverageDeg(const std::vector<double>& sortedAngles, double radius);
+
 }  // namespace facet::circle_fit

@@ -110,14 +110,17 @@ std::optional<Circle> fitRim(const std::vector<Eigen::Vector2d>& pts, Circle cir
 }
 
 // Angular runs of inliers (split where neighbours are more than maxGap apart), as index lists
-// into `in`, around the circle's centre.
+// into `in`, around the circle's centre. `angles` receives the inliers' polar angles, sorted.
 std::vector<std::vector<std::size_t>> inlierArcs(const std::vector<Eigen::Vector2d>& in,
-                                                 const Circle& c, double maxGap) {
+                                                 const Circle& c, double maxGap,
+                                                 std::vector<double>& angles) {
   std::vector<std::pair<double, std::size_t>> a;
   a.reserve(in.size());
   for (std::size_t i = 0; i < in.size(); ++i)
     a.emplace_back(std::atan2(in[i].y() - c.centre.y(), in[i].x() - c.centre.x()), i);
   std::sort(a.begin(), a.end());
+  angles.clear();
+  for (const auto& [angle, i] : a) angles.push_back(angle);
   std::vector<std::vector<std::size_t>> arcs;
   for (std::size_t k = 0; k < a.size(); ++k) {
     if (k == 0 || a[k].first - a[k - 1].first > maxGap) arcs.emplace_back();
@@ -137,11 +140,13 @@ std::vector<std::vector<std::size_t>> inlierArcs(const std::vector<Eigen::Vector
 // off five of its points). Each run holding under a third of the inliers is judged against a
 // plain fit of the others, when those cover at least the minimum coverage: a real piece of the
 // rim lies on that circle within its noise, a foreign one off it by more than the RANSAC
-// threshold. Returns the points to drop (empty when every run belongs).
+// threshold. Returns the points to drop (empty when every run belongs); `angles` receives the
+// inliers' polar angles around `c`, sorted.
 std::vector<Eigen::Vector2d> strayArc(const std::vector<Eigen::Vector2d>& in, const Circle& c,
-                                      const CircleMeasureParams& params) {
+                                      const CircleMeasureParams& params,
+                                      std::vector<double>& angles) {
   const double maxGap = std::max(3.0 / std::max(c.radius, 1e-6), 2.0 * kPi / 180.0);
-  const auto arcs = inlierArcs(in, c, maxGap);
+  const auto arcs = inlierArcs(in, c, maxGap, angles);
   if (arcs.size() < 2) return {};
   double worst = 0.0;
   std::vector<Eigen::Vector2d> stray;
@@ -310,10 +315,17 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   std::vector<Eigen::Vector2d> in;
   const std::vector<Eigen::Vector2d> rimCandidates = bestPts;  // before stray arcs leave
   std::optional<Circle> fitted = fitRim(bestPts, *best, params, in);
-  // Drop runs of inliers the rest of the rim disagrees with, worst first, and refit.
+  // Drop runs of inliers the rest of the rim disagrees with, worst first, and refit. When the
+  // last look finds none, its sorted angles are those of the final inliers around the final
+  // circle: the coverage below takes them instead of computing and sorting them again.
+  std::vector<double> angles;
+  bool anglesFinal = false;
   for (int round = 0; round < 3 && fitted; ++round) {
-    const std::vector<Eigen::Vector2d> stray = strayArc(in, *fitted, params);
-    if (stray.empty()) break;
+    const std::vector<Eigen::Vector2d> stray = strayArc(in, *fitted, params, angles);
+    if (stray.empty()) {
+      anglesFinal = true;
+      break;
+    }
     std::erase_if(bestPts, [&](const Eigen::Vector2d& p) {
       return std::find(stray.begin(), stray.end(), p) != stray.end();
     });
@@ -334,7 +346,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   }
   m.rms = in.empty() ? 0.0 : std::sqrt(sum2 / static_cast<double>(in.size()));
   m.roundness = hi - lo;
-  m.coverageDeg = coverageDeg(in, circle);
+  m.coverageDeg = anglesFinal ? coverageDeg(angles, circle.radius) : coverageDeg(in, circle);
   m.centre = {circle.centre.x(), circle.centre.y()};
   m.radius = circle.radius + (params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0);
   m.diameter = 2.0 * m.radius;

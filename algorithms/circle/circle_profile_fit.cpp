@@ -56,9 +56,10 @@ int angularBin(double dx, double dy, int bins) {
 // arrays and no branch: the loop vectorises.
 void rowBins(int x0, int n, double centreX, double dy, int bins, double lo2, double hi2,
              int* __restrict bin, std::uint8_t* __restrict narrow) {
-  double x = x0;  // whole numbers: exact, as (x0 + i) would be
-  for (int i = 0; i < n; ++i, x += 1.0) {
-    const double dx = x - centreX;
+  // The column from the integer counter: a floating-point counter (x += 1) keeps the loop from
+  // vectorising.
+  for (int i = 0; i < n; ++i) {
+    const double dx = static_cast<double>(x0 + i) - centreX;
     bin[i] = angularBin(dx, dy, bins);
     const double rho2 = dx * dx + dy * dy;
     narrow[i] = static_cast<std::uint8_t>((rho2 >= lo2) & (rho2 <= hi2));
@@ -185,28 +186,35 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
             tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
     }
   }
-  band.reserve(static_cast<std::size_t>(kPi * (rOut * rOut - rIn * rIn) + 4.0 * (rOut + rIn)) + 16);
-  // Bins and the narrow band's test in loops of their own, which vectorise.
+  // Bins and the narrow band's test in loops of their own, which vectorise; the band is then
+  // filled without a branch per pixel (whether a bin is covered follows no pattern the branch
+  // predictor learns) and cut to the pixels kept.
   const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
+  const RowRuns runs =
+      annulusRowRuns(centre, rIn, rOut, cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
+  std::size_t runPixels = 0;
+  for (const RowRun& run : runs) runPixels += static_cast<std::size_t>(run.x1 - run.x0);
+  band.resize(runPixels);
   std::vector<int> runBins;
   std::vector<std::uint8_t> runNarrow;
-  std::size_t narrowPixels = 0;
-  for (const RowRun& run :
-       annulusRowRuns(centre, rIn, rOut, cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1))) {
+  std::size_t inBand = 0, narrowPixels = 0;
+  for (const RowRun& run : runs) {
+    const int n = run.x1 - run.x0;
     const double dy = run.y - centre.y;
-    runBins.resize(run.x1 - run.x0);
-    runNarrow.resize(run.x1 - run.x0);
-    rowBins(run.x0, run.x1 - run.x0, centre.x, dy, bins, lo * lo, hi * hi, runBins.data(),
-            runNarrow.data());
+    runBins.resize(n);
+    runNarrow.resize(n);
+    rowBins(run.x0, n, centre.x, dy, bins, lo * lo, hi * hi, runBins.data(), runNarrow.data());
     const auto* taint = tainted.empty() ? nullptr : tainted.ptr<std::uint8_t>(run.y - y0) - x0;
-    for (int x = run.x0; x < run.x1; ++x) {
-      const int bin = runBins[x - run.x0];
-      if (!covered[bin] || (taint && taint[x])) continue;
-      const bool narrow = runNarrow[x - run.x0] != 0;
-      band.push_back({x, run.y, bin, narrow});
-      narrowPixels += narrow;
+    for (int i = 0; i < n; ++i) {
+      const int bin = runBins[i];
+      const bool narrow = runNarrow[i] != 0;
+      band[inBand] = {run.x0 + i, run.y, bin, narrow};
+      const bool keep = (covered[bin] != 0) & (taint == nullptr || taint[run.x0 + i] == 0);
+      inBand += keep;
+      narrowPixels += keep & narrow;
     }
   }
+  band.resize(inBand);
   if (band.size() < 30) return std::nullopt;
 
   // Start: outside and inside levels from the band's two halves, blur 1.2 px, no ramp.
@@ -245,15 +253,21 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     }
   }
   std::vector<Sample> samples;
-  samples.reserve(narrow ? static_cast<std::size_t>(std::min(1.0, share) * band.size()) + 64
-                         : band.size());
   // Which bins the share keeps, once per bin rather than per pixel.
   std::vector<std::uint8_t> keptBin(bins, 1);
   if (narrow && share < 1.0)
     for (int b = 0; b < bins; ++b)
       keptBin[b] = std::floor((b + 1) * share) != std::floor(b * share);
-  for (const BandPixel& e : band) {
-    if (narrow && (!e.narrow || !keptBin[e.bin])) continue;
+  // The band's pixels the share keeps, listed without a branch per pixel, then read.
+  std::vector<std::uint32_t> picks(band.size());
+  std::size_t picked = 0;
+  for (std::size_t i = 0; i < band.size(); ++i) {
+    picks[picked] = static_cast<std::uint32_t>(i);
+    picked += !narrow || (band[i].narrow & (keptBin[band[i].bin] != 0));
+  }
+  samples.reserve(picked);
+  for (std::size_t k = 0; k < picked; ++k) {
+    const BandPixel& e = band[picks[k]];
     samples.push_back({e.column - centre.x, e.row - centre.y, greyAt(image, e.column, e.row), e.bin,
                        e.column, e.row});
   }
@@ -314,13 +328,14 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // columns, which vectorises; the matrix products with a row of weighted columns did not.
   using Free = std::array<bool, 8>;
   constexpr Free kAll{true, true, true, true, true, true, true, true};
-  auto normalEquations = [&](const Free& free) {
+  // `gradient`: the entries of J^T W r wanted (the ramp's score test below needs two).
+  auto normalEquations = [&](const Free& free, const Free& gradient) {
     jtj.setIdentity();
     jtr.setZero();
     for (int a = 0; a < 8; ++a) {
       if (!free[a]) continue;
       weighted = jac.col(a).cwiseProduct(weight);
-      jtr(a) = weighted.dot(r);
+      if (gradient[a]) jtr(a) = weighted.dot(r);
       for (int b = a; b < 8; ++b)
         if (free[b]) jtj(b, a) = jtj(a, b) = weighted.dot(jac.col(b));
     }
@@ -351,7 +366,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
             sigma = tukeyWeights();
             current = cost(r);
           }
-          normalEquations(free);
+          normalEquations(free, free);
           h = jtj;
           g = -jtr;  // the residuals here are grey - model
         },
@@ -379,7 +394,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // has a ramp worth fitting.
   bool withRamp = false;
   if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
-  normalEquations(kAll);
+  normalEquations(kAll, {false, false, false, false, false, true, true, false});
   {
     constexpr int kRamp[2] = {5, 6};
     constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};

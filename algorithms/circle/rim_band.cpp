@@ -84,8 +84,12 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d
     const double dx = x - centre.x, dy = y - centre.y;
     const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
     const double tangential = (g.y * dx - g.x * dy) / rho;
-    const bool foreign = std::abs(rho - radius) > kFlatZone ? g.x * g.x + g.y * g.y > limit * limit
-                                                            : std::abs(tangential) > limit;
+    // Both tests, then a choice without a branch: which one applies (the narrow band reaches
+    // 4 px from the rim) follows no pattern the branch predictor learns.
+    const bool far = std::abs(rho - radius) > kFlatZone;
+    const bool steep = g.x * g.x + g.y * g.y > limit * limit;
+    const bool across = std::abs(tangential) > limit;
+    const bool foreign = (far & steep) | (!far & across);
     if (!foreign) continue;
     if (flagged.empty())
       flagged = cv::Mat::zeros(box.height + 2, box.width + 2, CV_8U);  // 1 px margin
