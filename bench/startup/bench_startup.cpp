@@ -1,6 +1,6 @@
 // Cold start (warm page cache) of the facet tool: wall time from exec to exit, median of N runs,
-// for `facet version` (no image: must stay <= 30 ms), `facet match` on a demo image (a PNG, read
-// without the image-codec module) and on the same image as TIFF (which loads the module).
+// for `facet version` (no image: must stay <= 30 ms), `facet match` on a demo image as PNG and as
+// TIFF (both read without the image-codec module) and as PGM (which loads the module).
 // Baseline: the same tool linked with OpenImageIO and OpenCV's imgcodecs, as it was before the
 // codecs became a module.
 // --smoke: 3 runs per case, same table.
@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -63,35 +64,43 @@ int main(int argc, char** argv) {
   const int runs = smoke ? 3 : 21;
   const std::vector<std::string> version = {"version"};
   const std::string png = "recipes/demo/bracket_shape/part_000.png";
-  const std::string tiff = (std::filesystem::temp_directory_path() /
-                            ("bench_startup_" + std::to_string(getpid()) + ".tif"))
-                               .string();
-  if (!cv::imwrite(tiff, cv::imread(png, cv::IMREAD_UNCHANGED))) {
-    std::fprintf(stderr, "bench_startup: cannot read %s or write %s (run from the repository)\n",
-                 png.c_str(), tiff.c_str());
-    return 1;
-  }
+  const auto copyAs = [&](const char* extension) {
+    const std::string copy = (std::filesystem::temp_directory_path() /
+                              ("bench_startup_" + std::to_string(getpid()) + extension))
+                                 .string();
+    if (!cv::imwrite(copy, cv::imread(png, cv::IMREAD_UNCHANGED))) {
+      std::fprintf(stderr, "bench_startup: cannot read %s or write %s (run from the repository)\n",
+                   png.c_str(), copy.c_str());
+      std::exit(1);
+    }
+    return copy;
+  };
+  const std::string tiff = copyAs(".tif"), pgm = copyAs(".pgm");
   const std::vector<std::string> match = {"match", "--model", "recipes/models/bracket.shape",
                                           "--image", png};
   const std::vector<std::string> matchTiff = {"match", "--model", "recipes/models/bracket.shape",
                                               "--image", tiff};
+  const std::vector<std::string> matchPgm = {"match", "--model", "recipes/models/bracket.shape",
+                                             "--image", pgm};
   std::printf("bench_startup%s: median wall time of %d runs (warm page cache)\n",
               smoke ? " --smoke" : "", runs);
-  std::printf("%-16s %14s %22s %8s\n", "command", "facet ms", "linked codecs ms", "ratio");
+  std::printf("%-18s %12s %22s %8s\n", "command", "facet ms", "linked codecs ms", "ratio");
   int failed = 0;
-  for (const auto& [name, args] : {std::pair{"version", version}, std::pair{"match png", match},
-                                   std::pair{"match tiff", matchTiff}}) {
+  for (const auto& [name, args] :
+       {std::pair{"version", version}, std::pair{"match png", match},
+        std::pair{"match tiff", matchTiff}, std::pair{"match pgm (module)", matchPgm}}) {
     std::vector<std::string> now = {FACET_TOOL}, old = {FACET_LINKED_CODECS_TOOL};
     now.insert(now.end(), args.begin(), args.end());
     old.insert(old.end(), args.begin(), args.end());
     const double t = medianMs(now, runs), baseline = medianMs(old, runs);
     if (t < 0 || baseline < 0) {
-      std::printf("%-16s failed\n", name);
+      std::printf("%-18s failed\n", name);
       ++failed;
       continue;
     }
-    std::printf("%-16s %14.1f %22.1f %7.2fx\n", name, t, baseline, baseline / t);
+    std::printf("%-18s %12.1f %22.1f %7.2fx\n", name, t, baseline, baseline / t);
   }
   std::filesystem::remove(tiff);
+  std::filesystem::remove(pgm);
   return failed == 0 ? 0 : 1;
 }
