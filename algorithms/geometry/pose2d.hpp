@@ -32,12 +32,17 @@ struct Pose2D {
   double angle = 0.0;  // a, radians, counter-clockwise on screen
   double scale = 1.0;  // s, unitless
 
+  // apply() with s * cos a and s * sin a taken once, for mapping many points.
+  struct Map {
+    double x, y, c, s;
+    [[nodiscard]] cv::Point2d operator()(cv::Point2d p) const {
+      return {x + c * p.x + s * p.y, y - s * p.x + c * p.y};
+    }
+  };
+  [[nodiscard]] Map map() const { return {x, y, std::cos(angle) * scale, std::sin(angle) * scale}; }
+
   // q = t + s * R(a) * p
-  [[nodiscard]] cv::Point2d apply(cv::Point2d p) const {
-    const double c = std::cos(angle) * scale;
-    const double s = std::sin(angle) * scale;
-    return {x + c * p.x + s * p.y, y - s * p.x + c * p.y};
-  }
+  [[nodiscard]] cv::Point2d apply(cv::Point2d p) const { return map()(p); }
 
   // Rotates and scales a direction vector (no translation).
   [[nodiscard]] cv::Point2d applyToVector(cv::Point2d v) const {

@@ -339,7 +339,8 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     m.score = best->score;
     m.residual = best->residual;
     m.contour.reserve(model.finePoints.size());
-    for (const auto& p : model.finePoints) m.contour.push_back(best->pose.apply(p.position));
+    const Pose2D::Map toImage = best->pose.map();
+    for (const auto& p : model.finePoints) m.contour.push_back(toImage(p.position));
     keptBoxes.push_back(placedBox(box, best->pose));
     matches.push_back(std::move(m));
   }

@@ -45,13 +45,12 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
   // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
   const auto correspond = [&](const Pose2D& at, int radius, bool anySign) {
     const double c = std::cos(at.angle), s = std::sin(at.angle);
-    // Pose2D::apply's products, its cosine and sine taken once for all points.
-    const double cs = c * at.scale, ss = s * at.scale;
+    const Pose2D::Map toImage = at.map();
     double polaritySum = 0.0;
     pairs.clear();
     for (const auto& mp : model.finePoints) {
       const double px = mp.position.x, py = mp.position.y;
-      const cv::Point2d q(at.x + cs * px + ss * py, at.y - ss * px + cs * py);
+      const cv::Point2d q = toImage({px, py});
       const double dx = c * mp.direction.x + s * mp.direction.y;
       const double dy = -s * mp.direction.x + c * mp.direction.y;
       const int cx = cvRound(q.x) - roi.x, cy = cvRound(q.y) - roi.y;

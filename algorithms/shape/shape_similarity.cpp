@@ -49,9 +49,10 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
 double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
                     Polarity polarity) {
   const double c = std::cos(pose.angle), s = std::sin(pose.angle);
+  const Pose2D::Map toImage = pose.map();
   double sum = 0.0;
   for (const auto& mp : model.finePoints) {
-    const cv::Point2d q = pose.apply(mp.position);
+    const cv::Point2d q = toImage(mp.position);
     const int x0 = static_cast<int>(std::floor(q.x)), y0 = static_cast<int>(std::floor(q.y));
     if (x0 < 0 || y0 < 0 || x0 + 1 >= field.cols || y0 + 1 >= field.rows) continue;
     const double fx = q.x - x0, fy = q.y - y0;
