@@ -126,13 +126,11 @@ std::optional<cv::Mat> imreadOfPlainJpeg(const fs::path& file, int flags) {
 std::optional<cv::Mat> imreadOfPlainTiff(const fs::path& file, int flags) {
   const PlainRead read = plainReadOf(flags);
   if (read == PlainRead::Other) return std::nullopt;
-  auto tiff = readPlainTiff(file, kImreadMaxPixels);
-  if (!tiff) return std::nullopt;
-  const bool stored =
-      read == PlainRead::Unchanged ||
-      (tiff->channels() == 1 && (tiff->depth() == CV_8U || (flags & cv::IMREAD_ANYDEPTH)));
-  if (!stored) return std::nullopt;
-  return std::move(*tiff);
+  const auto stored = [&](int type) {
+    return read == PlainRead::Unchanged ||
+           (CV_MAT_CN(type) == 1 && (CV_MAT_DEPTH(type) == CV_8U || (flags & cv::IMREAD_ANYDEPTH)));
+  };
+  return readPlainTiff(file, kImreadMaxPixels, stored);
 }
 
 // readImageFile's result for a plain PNG: what the module's decoder makes of it.

@@ -67,7 +67,7 @@ int channelsOf(int colour) {
 }  // namespace
 
 std::optional<PlainPng> readPlainPng(const std::filesystem::path& file, std::uint64_t maxPixels,
-                                     const PngLayoutFilter& wanted) {
+                                     const StoredLayoutFilter& wanted) {
   const std::unique_ptr<FILE, int (*)(FILE*)> in(std::fopen(file.c_str(), "rb"), &std::fclose);
   if (!in) return std::nullopt;
   unsigned char signature[8];

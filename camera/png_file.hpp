@@ -11,10 +11,11 @@
 
 #include <cstdint>
 #include <filesystem>
-#include <functional>
 #include <optional>
 
 #include <opencv2/core/mat.hpp>
+
+#include "camera/stored_layout_filter.hpp"
 
 namespace facet {
 
@@ -25,14 +26,10 @@ struct PlainPng {
   bool hasExif = false;  // an eXIf chunk (an orientation OpenCV's reader may apply)
 };
 
-// Which stored layouts a caller can use, by the OpenCV type the pixels would have (CV_8UC3 for
-// 8-bit RGB...); asked after the header, so that a file the caller would pass on is not decoded.
-using PngLayoutFilter = std::function<bool(int type)>;
-
 // Reads `file` when it is a plain PNG of at most `maxPixels` pixels whose layout `wanted` accepts
 // (an empty filter accepts every plain layout); nullopt otherwise (the caller hands the file to
 // the module).
 std::optional<PlainPng> readPlainPng(const std::filesystem::path& file, std::uint64_t maxPixels,
-                                     const PngLayoutFilter& wanted = {});
+                                     const StoredLayoutFilter& wanted = {});
 
 }  // namespace facet

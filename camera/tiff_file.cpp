@@ -144,7 +144,8 @@ bool readTiles(TIFF* tif, cv::Mat& out) {
 
 }  // namespace
 
-std::optional<cv::Mat> readPlainTiff(const std::filesystem::path& file, std::uint64_t maxPixels) {
+std::optional<cv::Mat> readPlainTiff(const std::filesystem::path& file, std::uint64_t maxPixels,
+                                     const StoredLayoutFilter& wanted) {
   if (!hasTiffSignature(file)) return std::nullopt;
   bool problem = false;
   const std::unique_ptr<TIFFOpenOptions, OptionsFreer> options(TIFFOpenOptionsAlloc());
@@ -155,9 +156,9 @@ std::optional<cv::Mat> readPlainTiff(const std::filesystem::path& file, std::uin
   const std::unique_ptr<TIFF, TiffCloser> tif(TIFFOpenExt(file.c_str(), "r", options.get()));
   if (!tif || problem) return std::nullopt;
   const std::optional<Layout> layout = plainLayout(tif.get(), maxPixels);
-  if (!layout) return std::nullopt;
-  cv::Mat pixels(static_cast<int>(layout->height), static_cast<int>(layout->width),
-                 CV_MAKETYPE(layout->depth, layout->channels));
+  const int type = layout ? CV_MAKETYPE(layout->depth, layout->channels) : -1;
+  if (!layout || (wanted && !wanted(type))) return std::nullopt;
+  cv::Mat pixels(static_cast<int>(layout->height), static_cast<int>(layout->width), type);
   const bool read =
       TIFFIsTiled(tif.get()) ? readTiles(tif.get(), pixels) : readStrips(tif.get(), pixels);
   if (!read || problem) return std::nullopt;

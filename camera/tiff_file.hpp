@@ -18,11 +18,14 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include "camera/stored_layout_filter.hpp"
+
 namespace facet {
 
 // CV_8UC1 or CV_16UC1 for grey; CV_8UC3 or CV_16UC3 in OpenCV's order (BGR) for colour. Empty
-// when the file is not a plain TIFF (see above), cannot be read or holds more than `maxPixels`
-// pixels.
-std::optional<cv::Mat> readPlainTiff(const std::filesystem::path& file, std::uint64_t maxPixels);
+// when the file is not a plain TIFF (see above) whose layout `wanted` accepts (an empty filter
+// accepts every one), cannot be read or holds more than `maxPixels` pixels.
+std::optional<cv::Mat> readPlainTiff(const std::filesystem::path& file, std::uint64_t maxPixels,
+                                     const StoredLayoutFilter& wanted = {});
 
 }  // namespace facet
