@@ -11,6 +11,7 @@
 #include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/least_squares_refinement.hpp"
 #include "algorithms/shape/level_search.hpp"
+#include "algorithms/shape/refinement_choice.hpp"
 #include "algorithms/shape/response_map_search.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
 
@@ -168,17 +169,9 @@ struct Finisher {
     if (!r.status.ok() || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0)
       return interpolated;
     const Finished refined{r.pose, scoreAt(r.pose), r.residual};
-    // Where the refinement fitted the part fully (its scale too, within the tolerance), it is
-    // kept unless it lays the model on the image's edges less well than its start: the score
-    // cannot judge it, since a pose tilted towards a displaced hole may score higher than the
-    // one that fits the rest of the part (Refined::support). A part held at a scale it does
-    // not have fits nowhere exactly; there the pose that agrees best overall (the score) wins.
-    if (!fitScale || scaleMisfit)
-      return refined.score >= interpolated.score ? refined : interpolated;
-    // Nor may it turn a part found into one missed.
-    if (refined.score < params.minScore && interpolated.score >= params.minScore)
-      return interpolated;
-    return r.support >= r.startSupport ? refined : interpolated;
+    const shape_detail::RefinementOutcome outcome{interpolated.score, refined.score, r.startSupport,
+                                                  r.support, fitScale && !scaleMisfit};
+    return shape_detail::keepsRefinedPose(outcome, params.minScore) ? refined : interpolated;
   }
 };
 

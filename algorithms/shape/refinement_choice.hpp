@@ -1,0 +1,31 @@
+#pragma once
+// Which pose a match keeps (internal to facet_shape): the interpolated start or its least-squares
+// refinement. Two measures judge them: the score (share of the model seen with a matching
+// gradient) and the support (how many of the model's subpixel points lie on image edges,
+// least_squares_refinement.hpp).
+
+namespace facet::shape_detail {
+
+struct RefinementOutcome {
+  double startScore = 0.0;
+  double refinedScore = 0.0;
+  double startSupport = 0.0;
+  double refinedSupport = 0.0;
+  // The refinement fitted everything the part may change: its scale too, within the tolerance.
+  // Otherwise (fixed scale, or a scale beyond the tolerance) it fits nowhere exactly.
+  bool fittedFully = false;
+};
+
+// The most score a refinement that fits the part may give up: what a displaced feature (a hole
+// out of place, a slightly different pad) holds of the model, a few hundredths. A refinement
+// that loses more has locked onto something that is not the part (texture, specular spots, a
+// neighbour's edges), however many points it lays on edges there.
+inline constexpr double kMaxRefinementScoreLoss = 0.1;
+
+// True when the refined pose is kept. Where the refinement fitted the part fully, the support
+// decides within kMaxRefinementScoreLoss: a pose tilted towards a displaced feature may score a
+// little higher than the one that fits the rest of the part. Elsewhere the score decides. A
+// refinement never turns a part found (start score >= minScore) into one missed.
+bool keepsRefinedPose(const RefinementOutcome& outcome, double minScore);
+
+}  // namespace facet::shape_detail
