@@ -1,6 +1,8 @@
 #include "algorithms/shape/shape_similarity.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "algorithms/shape/image_gradients.hpp"
 
@@ -27,17 +29,29 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
   const double invN = 1.0 / n;
   const double safe = minScore - 1.0, greedy = minScore;
   double sum = 0.0;
-  const int w = field.cols, h = field.rows;
-  for (int j = 0; j < n; ++j) {
-    const int x = at.x + posed.offsets[j].x, y = at.y + posed.offsets[j].y;
-    if (x >= 0 && y >= 0 && x < w && y < h) {
-      const Direction g = field.ptr<Direction>(y)[x];
-      const double dot =
-          (g[0] * posed.directions[j].x + g[1] * posed.directions[j].y) * (1.0 / 127);
-      sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
+  const auto w = static_cast<unsigned>(field.cols), h = static_cast<unsigned>(field.rows);
+  // Plain pointers and blocks of eight points between the checks: the loop is most of the
+  // tracking down the pyramid, and its loads of the field's and the points' headers are not.
+  const uchar* data = field.data;
+  const std::size_t rowStep = field.step[0];
+  const cv::Point* offsets = posed.offsets.data();
+  const cv::Point2f* directions = posed.directions.data();
+  const bool local = polarity == Polarity::IgnoreLocal;
+  const bool check = minScore > 0.0;
+  for (int j0 = 0; j0 < n; j0 += 8) {
+    const int j1 = std::min(j0 + 8, n);
+    for (int j = j0; j < j1; ++j) {
+      // Unsigned: a negative coordinate is out of range as well.
+      const auto x = static_cast<unsigned>(at.x + offsets[j].x);
+      const auto y = static_cast<unsigned>(at.y + offsets[j].y);
+      if (x < w && y < h) {
+        const Direction g = reinterpret_cast<const Direction*>(data + y * rowStep)[x];
+        const double dot = (g[0] * directions[j].x + g[1] * directions[j].y) * (1.0 / 127);
+        sum += local ? std::abs(dot) : dot;
+      }
     }
-    if ((j & 7) == 7 && minScore > 0.0) {
-      const double f = (j + 1) * invN;
+    if (j1 - j0 == 8 && check) {
+      const double f = j1 * invN;
       const double bound = (1.0 - greediness) * (safe + f) + greediness * greedy * f;
       const double partial = (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
       if (partial < bound) return -1.0;
