@@ -11,14 +11,16 @@ namespace facet::shape_detail {
 PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, double scale) {
   const double c = std::cos(angle), s = std::sin(angle);
   PosedPoints out;
-  out.offsets.reserve(points.size());
-  out.directions.reserve(points.size());
-  for (const auto& p : points) {
-    const double x = p.position.x, y = p.position.y;
-    out.offsets.emplace_back(cvRound(scale * (c * x + s * y)), cvRound(scale * (-s * x + c * y)));
-    const double dx = p.direction.x, dy = p.direction.y;
-    out.directions.emplace_back(static_cast<float>(c * dx + s * dy),
-                                static_cast<float>(-s * dx + c * dy));
+  // Sized once and written in place: the tracking down the pyramid poses hundreds of times.
+  out.offsets.resize(points.size());
+  out.directions.resize(points.size());
+  cv::Point* offsets = out.offsets.data();
+  cv::Point2f* directions = out.directions.data();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double x = points[i].position.x, y = points[i].position.y;
+    offsets[i] = {cvRound(scale * (c * x + s * y)), cvRound(scale * (-s * x + c * y))};
+    const double dx = points[i].direction.x, dy = points[i].direction.y;
+    directions[i] = {static_cast<float>(c * dx + s * dy), static_cast<float>(-s * dx + c * dy)};
   }
   return out;
 }
