@@ -21,7 +21,7 @@ class DirectionField {
  public:
   // `grey`: CV_8U (raw grey levels) or CV_32F (8-bit scale).
   DirectionField(cv::Mat grey, double minContrast);
-  // Hands its buffers to the thread's next field of the same size (direction_field_buffers).
+  // Hands its buffers to the thread's next field of the same size (see image_gradients.cpp).
   ~DirectionField();
   DirectionField(const DirectionField&) = default;
   DirectionField(DirectionField&&) = default;
