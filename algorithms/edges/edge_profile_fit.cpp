@@ -68,59 +68,74 @@ bool solveSpd(std::array<std::array<double, N>, N>& a, std::array<double, N>& y)
   return true;
 }
 
-// The integer range of dx for which lo <= dx * k + c <= hi, given invK = 1 / k (all dx when k ~ 0
-// and c fits).
-void restrict(double k, double invK, double c, double lo, double hi, int& first, int& last) {
-  if (std::abs(k) < 1e-12) {
-    if (c < lo || c > hi) last = first - 1;
-    return;
+// The integer range of dx for which lo <= dx * k + c <= hi on each row dy of a window, with
+// c = dy * slope and invK = 1 / k (all dx when k ~ 0 and c fits). What does not depend on the row
+// is settled once per window: the order of the two ends follows the sign of invK alone (lo < hi).
+struct RowRange {
+  double slope, lo, hi, invK;
+  bool flat, reversed;
+  RowRange(double k, double inverse, double rowSlope, double low, double high)
+      : slope(rowSlope),
+        lo(low),
+        hi(high),
+        invK(inverse),
+        flat(std::abs(k) < 1e-12),
+        reversed(inverse < 0) {}
+
+  void restrict(int dy, int& first, int& last) const {
+    const double c = dy * slope;
+    if (flat) {
+      if (c < lo || c > hi) last = first - 1;
+      return;
+    }
+    const double a = (lo - c) * invK, b = (hi - c) * invK;
+    const double x0 = reversed ? b : a, x1 = reversed ? a : b;
+    first = std::max(first, static_cast<int>(std::ceil(x0 - 1e-9)));
+    last = std::min(last, static_cast<int>(std::floor(x1 + 1e-9)));
   }
-  double x0 = (lo - c) * invK, x1 = (hi - c) * invK;
-  if (x0 > x1) std::swap(x0, x1);
-  first = std::max(first, static_cast<int>(std::ceil(x0 - 1e-9)));
-  last = std::min(last, static_cast<int>(std::floor(x1 + 1e-9)));
-}
+};
 
 template <typename T>
 void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
             const EdgeProfileParams& params, float scale, Samples& out) {
   const int reach = edgeProfileReach(params);
-  out.count = 0;
+  int count = 0;
   float sum = 0;
   const auto nx = static_cast<float>(n.x), ny = static_cast<float>(n.y);
   const double invX = std::abs(n.x) < 1e-12 ? 0.0 : 1.0 / n.x;
   const double invY = std::abs(n.y) < 1e-12 ? 0.0 : -1.0 / n.y;
+  // s = dx nx + dy ny within offset +- halfAcross; t = -dx ny + dy nx within +- halfAlong.
+  const RowRange across(n.x, invX, n.y, offset - params.halfAcross, offset + params.halfAcross);
+  const RowRange along(-n.y, invY, n.x, -params.halfAlong, params.halfAlong);
+  float* const s = out.s.data();
+  float* const t = out.t.data();
+  float* const v = out.v.data();
+  float* const weight = out.weight.data();
   for (int dy = -reach; dy <= reach; ++dy) {
     int first = -reach, last = reach;
-    // s = dx nx + dy ny within offset +- halfAcross; t = -dx ny + dy nx within +- halfAlong.
-    restrict(n.x, invX, dy * n.y, offset - params.halfAcross, offset + params.halfAcross, first,
-             last);
-    restrict(-n.y, invY, dy * n.x, -params.halfAlong, params.halfAlong, first, last);
-    last = std::min(last, first + (kCapacity - 4 - out.count) - 1);
+    across.restrict(dy, first, last);
+    along.restrict(dy, first, last);
+    last = std::min(last, first + (kCapacity - 4 - count) - 1);
     const T* row = image.ptr<T>(c.y + dy) + c.x;
     const float sRow = static_cast<float>(dy) * ny, tRow = static_cast<float>(dy) * nx;
-    float* ps = &out.s[out.count];
-    float* pt = &out.t[out.count];
-    float* pv = &out.v[out.count];
-    float* pw = &out.weight[out.count];
-    for (int dx = first; dx <= last; ++dx) {
+    for (int dx = first; dx <= last; ++dx, ++count) {
       const auto fx = static_cast<float>(dx);
-      *ps++ = fx * nx + sRow;
-      *pt++ = tRow - fx * ny;
-      const float v = static_cast<float>(row[dx]) * scale;
-      *pv++ = v;
-      *pw++ = 1.0f;
-      sum += v;
+      s[count] = fx * nx + sRow;
+      t[count] = tRow - fx * ny;
+      const float value = static_cast<float>(row[dx]) * scale;
+      v[count] = value;
+      weight[count] = 1.0f;
+      sum += value;
     }
-    out.count += std::max(0, last - first + 1);
   }
-  const int real = out.filled = out.count;
+  const int real = out.filled = count;
   out.mean = real ? sum / static_cast<float>(real) : 0.0f;
-  for (int i = 0; i < real; ++i) out.v[i] -= out.mean;
-  while (out.count % 4) {
-    const int i = out.count++;
-    out.s[i] = out.t[i] = out.v[i] = out.weight[i] = 0.0f;
+  for (int i = 0; i < real; ++i) v[i] -= out.mean;
+  while (count % 4) {
+    const int i = count++;
+    s[i] = t[i] = v[i] = weight[i] = 0.0f;
   }
+  out.count = count;
 }
 
 // The table intervals of four lanes, one field per vector: each interval is one 16-byte load,

@@ -114,14 +114,60 @@ void sobelRow(const cv::Mat& grey, int y, int x0, int x1, std::vector<int>& s, s
   }
 }
 
+// A search makes a field per pyramid level, and a zeroed 640x480 level 0 is 600 KB, though the
+// search computes only the tiles near its candidates. The thread keeps the fields of its last
+// searches instead; a new field of the same size clears only the tiles its predecessor computed.
+struct FieldBuffers {
+  cv::Mat field, done;
+};
+constexpr std::size_t kKeptBuffers = 6;
+
+std::vector<FieldBuffers>& keptBuffers() {
+  thread_local std::vector<FieldBuffers> kept;
+  return kept;
+}
+
 }  // namespace
 
 DirectionField::DirectionField(cv::Mat grey, double minContrast)
-    : grey_(std::move(grey)),
-      field_(grey_.size(), CV_8SC2, cv::Scalar(0, 0)),
-      done_((grey_.rows + kTile - 1) / kTile, (grey_.cols + kTile - 1) / kTile, CV_8U,
-            cv::Scalar(0)),
-      minContrast_(std::max(minContrast, 1e-3)) {}
+    : grey_(std::move(grey)), minContrast_(std::max(minContrast, 1e-3)) {
+  const cv::Size tiles((grey_.cols + kTile - 1) / kTile, (grey_.rows + kTile - 1) / kTile);
+  std::vector<FieldBuffers>& kept = keptBuffers();
+  for (auto it = kept.begin(); it != kept.end(); ++it) {
+    if (it->field.size() != grey_.size()) continue;
+    field_ = std::move(it->field);
+    done_ = std::move(it->done);
+    kept.erase(it);
+    const cv::Rect image(0, 0, grey_.cols, grey_.rows);
+    for (int ty = 0; ty < tiles.height; ++ty) {
+      const uchar* row = done_.ptr<uchar>(ty);
+      for (int tx = 0; tx < tiles.width;) {
+        if (!row[tx]) {
+          ++tx;
+          continue;
+        }
+        int end = tx;
+        while (end < tiles.width && row[end]) ++end;
+        field_(cv::Rect(tx * kTile, ty * kTile, (end - tx) * kTile, kTile) & image)
+            .setTo(cv::Scalar::all(0));
+        tx = end;
+      }
+    }
+    done_.setTo(cv::Scalar::all(0));
+    return;
+  }
+  field_ = cv::Mat(grey_.size(), CV_8SC2, cv::Scalar(0, 0));
+  done_ = cv::Mat(tiles, CV_8U, cv::Scalar(0));
+}
+
+DirectionField::~DirectionField() {
+  // Only buffers that no copy of this field still shares.
+  const auto alone = [](const cv::Mat& m) { return !m.empty() && m.u && m.u->refcount == 1; };
+  if (!alone(field_) || !alone(done_)) return;
+  std::vector<FieldBuffers>& kept = keptBuffers();
+  if (kept.size() >= kKeptBuffers) kept.erase(kept.begin());
+  kept.push_back({std::move(field_), std::move(done_)});
+}
 
 void DirectionField::ensure(cv::Rect region) {
   region &= cv::Rect(0, 0, grey_.cols, grey_.rows);

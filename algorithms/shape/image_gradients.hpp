@@ -21,6 +21,12 @@ class DirectionField {
  public:
   // `grey`: CV_8U (raw grey levels) or CV_32F (8-bit scale).
   DirectionField(cv::Mat grey, double minContrast);
+  // Hands its buffers to the thread's next field of the same size (see image_gradients.cpp).
+  ~DirectionField();
+  DirectionField(const DirectionField&) = default;
+  DirectionField(DirectionField&&) = default;
+  DirectionField& operator=(const DirectionField&) = default;
+  DirectionField& operator=(DirectionField&&) = default;
 
   // Makes sure every pixel of `region` (clipped to the image) is computed.
   void ensure(cv::Rect region);

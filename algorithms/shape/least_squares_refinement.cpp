@@ -127,7 +127,10 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
         const double t = 1.0 - (a / cutoff) * (a / cutoff);
         w = t * t;
       }
-      H += w * pr.J * pr.J.transpose();
+      // The lower triangle only: the LDLT solve below reads no other part of H.
+      const Eigen::Vector4d wJ = w * pr.J;
+      for (int j = 0; j < 4; ++j)
+        for (int i = j; i < 4; ++i) H(i, j) += pr.J[j] * wJ[i];
       g += w * pr.r * pr.J;
       sumSq += w * pr.r * pr.r;
       weightSum += w;

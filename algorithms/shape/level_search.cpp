@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "algorithms/shape/shape_similarity.hpp"
 
@@ -17,6 +19,15 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
   const double sStep = s.scaleMax > s.scaleMin ? s.level->scaleStep : 0.0;
   Candidate best = c;
   best.score = -1.0;
+  // A climb looks again at the angles and scales next to its new centre, most of which the last
+  // one posed already: keep each pose's points for the call.
+  std::vector<std::pair<cv::Vec2d, PosedPoints>> posedAt;
+  const auto pose = [&](double a, double sc) -> const PosedPoints& {
+    for (const auto& [key, posed] : posedAt)
+      if (key[0] == a && key[1] == sc) return posed;
+    posedAt.emplace_back(cv::Vec2d(a, sc), posePoints(s.level->points, a, sc));
+    return posedAt.back().second;
+  };
   for (int climb = 0; climb < 6; ++climb) {
     Candidate centre = climb == 0 ? c : best;
     bool onBorder = false;
@@ -25,7 +36,7 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
       const double a = clampAngle(s.angles, centre.angle + k * aStep);
       for (int m = -ns; m <= ns; ++m) {
         const double sc = std::clamp(centre.scale + m * sStep, s.scaleMin, s.scaleMax);
-        const PosedPoints posed = posePoints(s.level->points, a, sc);
+        const PosedPoints& posed = pose(a, sc);
         for (int dy = -radius; dy <= radius; ++dy)
           for (int dx = -radius; dx <= radius; ++dx) {
             const cv::Point at(cvRound(centre.x) + dx, cvRound(centre.y) + dy);
@@ -47,10 +58,14 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
 }
 
 Candidate interpolate(const LevelSearch& s, Candidate c) {
+  // The five scores at the candidate's own angle and scale share its posed points.
+  const PosedPoints centre = posePoints(s.level->points, c.angle + 0.0, c.scale + 0.0);
   auto at = [&](double dx, double dy, double da, double ds) {
-    const PosedPoints posed = posePoints(s.level->points, c.angle + da, c.scale + ds);
-    return scorePose(*s.field, posed, cv::Point(cvRound(c.x + dx), cvRound(c.y + dy)), s.polarity,
-                     0.0, 0.0);
+    const bool turned = da != 0.0 || ds != 0.0;
+    const PosedPoints posed =
+        turned ? posePoints(s.level->points, c.angle + da, c.scale + ds) : PosedPoints{};
+    return scorePose(*s.field, turned ? posed : centre,
+                     cv::Point(cvRound(c.x + dx), cvRound(c.y + dy)), s.polarity, 0.0, 0.0);
   };
   auto vertex = [](double m, double z, double p) {
     const double d = m - 2.0 * z + p;

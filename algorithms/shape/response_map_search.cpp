@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <functional>
 #include <numbers>
 
@@ -27,6 +28,64 @@ struct TopTemplate {
   double scale = 1.0;
   std::vector<std::ptrdiff_t> sources;  // map plane of the point's bin + its offset in the plane
 };
+
+// One template's points as the sums read them: quantised direction bin and offset (pixels).
+struct TemplateShape {
+  std::vector<int> bins;
+  std::vector<cv::Point> offsets;
+};
+
+// The templates of one model level at all angles and scales. A line searches one model in image
+// after image, and posing its points with an atan2 each costs a twentieth of a 640x480 search:
+// the thread keeps the sets of its last searches, found again by their exact inputs.
+struct TemplateSet {
+  std::vector<ShapePoint> points;
+  std::vector<double> angles, scales;
+  std::vector<TemplateShape> shapes;  // scale-major, as the search loops
+  int sharing = 1;                    // the most points of one template on the same pixel
+};
+
+template <typename T>
+bool sameBits(const std::vector<T>& a, const std::vector<T>& b) {
+  return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+}
+
+const TemplateSet& templateSet(const std::vector<ShapePoint>& points,
+                               const std::vector<double>& angles,
+                               const std::vector<double>& scales) {
+  static_assert(sizeof(ShapePoint) == 4 * sizeof(float));
+  thread_local std::vector<TemplateSet> kept;
+  for (const TemplateSet& set : kept)
+    if (sameBits(set.points, points) && sameBits(set.angles, angles) &&
+        sameBits(set.scales, scales))
+      return set;
+  TemplateSet set{points, angles, scales, {}, 1};
+  for (double s : scales) {
+    for (double a : angles) {
+      TemplateShape shape;
+      const PosedPoints posed = posePoints(points, a, s);
+      std::vector<cv::Point> pixels = posed.offsets;
+      std::sort(pixels.begin(), pixels.end(), [](const cv::Point& p, const cv::Point& q) {
+        return p.y != q.y ? p.y < q.y : p.x < q.x;
+      });
+      for (std::size_t i = 0, j = 0; i < pixels.size(); i = j) {
+        while (j < pixels.size() && pixels[j] == pixels[i]) ++j;
+        set.sharing = std::max(set.sharing, static_cast<int>(j - i));
+      }
+      for (std::size_t i = 0; i < points.size(); ++i) {
+        const double theta = std::atan2(posed.directions[i].y, posed.directions[i].x);
+        shape.bins.push_back(
+            ((static_cast<int>(std::lround(theta / kTwoPi * kBins)) % kBins) + kBins) % kBins);
+      }
+      shape.offsets = posed.offsets;
+      set.shapes.push_back(std::move(shape));
+    }
+  }
+  constexpr std::size_t kKeptSets = 4;
+  if (kept.size() >= kKeptSets) kept.erase(kept.begin());
+  kept.push_back(std::move(set));
+  return kept.back();
+}
 
 }  // namespace
 
@@ -93,25 +152,20 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
     }
   });
 
+  // Offsets lie within the border, less than half a row's stride either side: a pixel's offset
+  // y * stride + x is unique, so the set's sharing (counted per (x, y)) is the same.
+  const TemplateSet& set = templateSet(points, angles, scales);
+  const int sharing = set.sharing;
   std::vector<TopTemplate> templates;
-  int sharing = 1;  // the most points of one template that land on the same pixel
+  std::size_t shapeIndex = 0;
   for (double s : scales) {
     for (double a : angles) {
       TopTemplate t{a, s, {}};
-      const PosedPoints posed = posePoints(points, a, s);
-      std::vector<std::ptrdiff_t> pixels;
-      for (const cv::Point& o : posed.offsets) pixels.push_back(o.y * stride + o.x);
-      std::sort(pixels.begin(), pixels.end());
-      for (std::size_t i = 0, j = 0; i < pixels.size(); i = j) {
-        while (j < pixels.size() && pixels[j] == pixels[i]) ++j;
-        sharing = std::max(sharing, static_cast<int>(j - i));
-      }
-      for (std::size_t i = 0; i < points.size(); ++i) {
-        const double theta = std::atan2(posed.directions[i].y, posed.directions[i].x);
-        const int bin =
-            ((static_cast<int>(std::lround(theta / kTwoPi * kBins)) % kBins) + kBins) % kBins;
-        t.sources.push_back(bin * plane + posed.offsets[i].y * stride + posed.offsets[i].x);
-      }
+      const TemplateShape& shape = set.shapes[shapeIndex++];
+      t.sources.reserve(shape.bins.size());
+      for (std::size_t i = 0; i < shape.bins.size(); ++i)
+        t.sources.push_back(shape.bins[i] * plane + shape.offsets[i].y * stride +
+                            shape.offsets[i].x);
       templates.push_back(std::move(t));
     }
   }

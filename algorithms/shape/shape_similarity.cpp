@@ -1,6 +1,8 @@
 #include "algorithms/shape/shape_similarity.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstddef>
 
 #include "algorithms/shape/image_gradients.hpp"
 
@@ -9,14 +11,16 @@ namespace facet::shape_detail {
 PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, double scale) {
   const double c = std::cos(angle), s = std::sin(angle);
   PosedPoints out;
-  out.offsets.reserve(points.size());
-  out.directions.reserve(points.size());
-  for (const auto& p : points) {
-    const double x = p.position.x, y = p.position.y;
-    out.offsets.emplace_back(cvRound(scale * (c * x + s * y)), cvRound(scale * (-s * x + c * y)));
-    const double dx = p.direction.x, dy = p.direction.y;
-    out.directions.emplace_back(static_cast<float>(c * dx + s * dy),
-                                static_cast<float>(-s * dx + c * dy));
+  // Sized once and written in place: the tracking down the pyramid poses hundreds of times.
+  out.offsets.resize(points.size());
+  out.directions.resize(points.size());
+  cv::Point* offsets = out.offsets.data();
+  cv::Point2f* directions = out.directions.data();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const double x = points[i].position.x, y = points[i].position.y;
+    offsets[i] = {cvRound(scale * (c * x + s * y)), cvRound(scale * (-s * x + c * y))};
+    const double dx = points[i].direction.x, dy = points[i].direction.y;
+    directions[i] = {static_cast<float>(c * dx + s * dy), static_cast<float>(-s * dx + c * dy)};
   }
   return out;
 }
@@ -27,17 +31,29 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
   const double invN = 1.0 / n;
   const double safe = minScore - 1.0, greedy = minScore;
   double sum = 0.0;
-  const int w = field.cols, h = field.rows;
-  for (int j = 0; j < n; ++j) {
-    const int x = at.x + posed.offsets[j].x, y = at.y + posed.offsets[j].y;
-    if (x >= 0 && y >= 0 && x < w && y < h) {
-      const Direction g = field.ptr<Direction>(y)[x];
-      const double dot =
-          (g[0] * posed.directions[j].x + g[1] * posed.directions[j].y) * (1.0 / 127);
-      sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
+  const auto w = static_cast<unsigned>(field.cols), h = static_cast<unsigned>(field.rows);
+  // Plain pointers and blocks of eight points between the checks: the loop is most of the
+  // tracking down the pyramid, and its loads of the field's and the points' headers are not.
+  const uchar* data = field.data;
+  const std::size_t rowStep = field.step[0];
+  const cv::Point* offsets = posed.offsets.data();
+  const cv::Point2f* directions = posed.directions.data();
+  const bool local = polarity == Polarity::IgnoreLocal;
+  const bool check = minScore > 0.0;
+  for (int j0 = 0; j0 < n; j0 += 8) {
+    const int j1 = std::min(j0 + 8, n);
+    for (int j = j0; j < j1; ++j) {
+      // Unsigned: a negative coordinate is out of range as well.
+      const auto x = static_cast<unsigned>(at.x + offsets[j].x);
+      const auto y = static_cast<unsigned>(at.y + offsets[j].y);
+      if (x < w && y < h) {
+        const Direction g = reinterpret_cast<const Direction*>(data + y * rowStep)[x];
+        const double dot = (g[0] * directions[j].x + g[1] * directions[j].y) * (1.0 / 127);
+        sum += local ? std::abs(dot) : dot;
+      }
     }
-    if ((j & 7) == 7 && minScore > 0.0) {
-      const double f = (j + 1) * invN;
+    if (j1 - j0 == 8 && check) {
+      const double f = j1 * invN;
       const double bound = (1.0 - greediness) * (safe + f) + greediness * greedy * f;
       const double partial = (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
       if (partial < bound) return -1.0;

@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -296,7 +298,9 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--speed-only")) speedOnly = true;
   }
   const cv::Mat templ = testing::bracketTemplate();
-  const auto modelFile = std::filesystem::temp_directory_path() / "bench_shape_real.model";
+  // One file per process: two runs at once must not remove each other's model.
+  const auto modelFile = std::filesystem::temp_directory_path() /
+                         ("bench_shape_real." + std::to_string(getpid()) + ".model");
   {
     const ShapeModel model = createShapeModel(templ);
     saveShapeModel(model, modelFile);
@@ -313,6 +317,7 @@ int main(int argc, char** argv) {
   }
   if (photosOnly) {
     photoTable(data, smoke, photoParams);
+    std::filesystem::remove(modelFile);
     return 0;
   }
   const int scenes = smoke ? 2 : 20;
