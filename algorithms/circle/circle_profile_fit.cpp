@@ -12,6 +12,7 @@
 
 #include "algorithms/circle/rim_band.hpp"
 #include "algorithms/circle/step_profile.hpp"
+#include "algorithms/circle/weighted_normal_equations.hpp"
 #include "algorithms/edges/row_runs.hpp"
 #include "algorithms/geometry/levenberg_marquardt.hpp"
 
@@ -290,7 +291,6 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   std::size_t m = samples.size();
   Eigen::VectorXd px, py, grey, r, rTry, weight;
   Columns jac, jacTry;
-  Eigen::VectorXd weighted;  // one column of W J
   auto loadBand = [&] {
     const auto n = static_cast<Eigen::Index>(m);
     px.resize(n);
@@ -324,20 +324,28 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   Vector8 jtr;
   // J^T W J and J^T W r over the free parameters only; a fixed parameter's row and column are
   // the identity's, so that the step leaves it alone (the ramp is fixed in the first solve, and
-  // its products were a quarter of the work). Each entry is one dot product of two contiguous
-  // columns, which vectorises; the matrix products with a row of weighted columns did not.
+  // its products were a quarter of the work). The free columns go through one pass per pair of
+  // them (weighted_normal_equations.hpp).
   using Free = std::array<bool, 8>;
   constexpr Free kAll{true, true, true, true, true, true, true, true};
-  // `gradient`: the entries of J^T W r wanted (the ramp's score test below needs two).
-  auto normalEquations = [&](const Free& free, const Free& gradient) {
+  auto normalEquations = [&](const Free& free) {
+    std::array<int, 8> index{};
+    std::array<const double*, 8> columns{};
+    int k = 0;
+    for (int a = 0; a < 8; ++a)
+      if (free[a]) {
+        index[k] = a;
+        columns[k++] = jac.col(a).data();
+      }
+    std::array<double, 64> h{};
+    std::array<double, 8> g{};
+    weightedNormalEquations({columns.data(), static_cast<std::size_t>(k)}, weight.data(), r.data(),
+                            static_cast<std::ptrdiff_t>(m), h.data(), g.data());
     jtj.setIdentity();
     jtr.setZero();
-    for (int a = 0; a < 8; ++a) {
-      if (!free[a]) continue;
-      weighted = jac.col(a).cwiseProduct(weight);
-      if (gradient[a]) jtr(a) = weighted.dot(r);
-      for (int b = a; b < 8; ++b)
-        if (free[b]) jtj(b, a) = jtj(a, b) = weighted.dot(jac.col(b));
+    for (int u = 0; u < k; ++u) {
+      jtr(index[u]) = g[u];
+      for (int v = 0; v < k; ++v) jtj(index[u], index[v]) = h[u * k + v];
     }
   };
   auto tukeyWeights = [&] {
@@ -366,7 +374,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
             sigma = tukeyWeights();
             current = cost(r);
           }
-          normalEquations(free, free);
+          normalEquations(free);
           h = jtj;
           g = -jtr;  // the residuals here are grey - model
         },
@@ -379,7 +387,11 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
           std::swap(r, rTry);
           std::swap(jac, jacTry);
         },
-        [](int it, const Vector8& step) { return it >= 2 && step.head<4>().norm() < 1e-3; }};
+        // Done once a step under the final weights (the last reweighting is at it = 1) moves
+        // the rim by less than 1e-3 px: the next would move it by far less (1e-4 px and below).
+        // A solve that starts at a converged fit (the ramp's, the refit without contaminated
+        // sectors) stops after two steps instead of three.
+        [](int it, const Vector8& step) { return it >= 1 && step.head<4>().norm() < 1e-3; }};
     const LevenbergMarquardtSettings settings{.maxIterations = maxIterations,
                                               .maxTries = 6,
                                               .initialDamping = 1e-4,
@@ -394,7 +406,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // has a ramp worth fitting.
   bool withRamp = false;
   if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
-  normalEquations(kAll, {false, false, false, false, false, true, true, false});
+  normalEquations(kAll);
   {
     constexpr int kRamp[2] = {5, 6};
     constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};

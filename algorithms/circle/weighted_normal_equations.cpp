@@ -1,0 +1,104 @@
+#include "algorithms/circle/weighted_normal_equations.hpp"
+
+#include <cstring>
+
+namespace facet {
+namespace {
+
+// Two doubles in one SSE2 register: the sums run in two lanes (even and odd rows) and are added
+// at the end. The compiler does not vectorise a floating-point sum on its own (it may not reorder
+// the additions), so the lanes are written out.
+using Lanes = double __attribute__((vector_size(16)));
+
+Lanes load(const double* p) {
+  Lanes v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
+// Rows a (and a + 1 when `pair`) of J^T W J and J^T W r, for the B columns a .. a + B - 1 handed
+// in `cols`: 2 B + 1 sums, which fit the 16 registers but for a few at B = 8. B is a template
+// argument so that the sums are registers, not an array in memory.
+template <int B, bool pair>
+void rowBlock(const double* const* cols, const double* __restrict weight,
+              const double* __restrict residual, std::ptrdiff_t n, double* first, double* second,
+              double& firstR, double& secondR) {
+  Lanes a[B] = {}, b[B] = {}, ra = {}, rb = {};
+  std::ptrdiff_t i = 0;
+  for (; i + 2 <= n; i += 2) {
+    const Lanes w = load(weight + i), r = load(residual + i);
+    Lanes c[B];
+    for (int j = 0; j < B; ++j) c[j] = load(cols[j] + i);
+    const Lanes wa = w * c[0];
+    for (int j = 0; j < B; ++j) a[j] += wa * c[j];
+    ra += wa * r;
+    if constexpr (pair) {
+      const Lanes wb = w * c[1];
+      for (int j = 1; j < B; ++j) b[j] += wb * c[j];
+      rb += wb * r;
+    }
+  }
+  for (int j = 0; j < B; ++j) first[j] = a[j][0] + a[j][1];
+  firstR = ra[0] + ra[1];
+  if constexpr (pair) {
+    for (int j = 1; j < B; ++j) second[j] = b[j][0] + b[j][1];
+    secondR = rb[0] + rb[1];
+  }
+  for (; i < n; ++i) {  // an odd last row
+    const double wa = weight[i] * cols[0][i];
+    for (int j = 0; j < B; ++j) first[j] += wa * cols[j][i];
+    firstR += wa * residual[i];
+    if constexpr (pair) {
+      const double wb = weight[i] * cols[1][i];
+      for (int j = 1; j < B; ++j) second[j] += wb * cols[j][i];
+      secondR += wb * residual[i];
+    }
+  }
+}
+
+template <bool pair>
+void rowBlockOf(int columns, const double* const* cols, const double* weight,
+                const double* residual, std::ptrdiff_t n, double* first, double* second,
+                double& firstR, double& secondR) {
+  switch (columns) {
+#define FACET_ROW_BLOCK(B)                                                        \
+  case B:                                                                         \
+    rowBlock<B, pair>(cols, weight, residual, n, first, second, firstR, secondR); \
+    break;
+    FACET_ROW_BLOCK(1)
+    FACET_ROW_BLOCK(2)
+    FACET_ROW_BLOCK(3)
+    FACET_ROW_BLOCK(4)
+    FACET_ROW_BLOCK(5)
+    FACET_ROW_BLOCK(6)
+    FACET_ROW_BLOCK(7)
+    FACET_ROW_BLOCK(8)
+#undef FACET_ROW_BLOCK
+    default:
+      break;
+  }
+}
+
+}  // namespace
+
+void weightedNormalEquations(std::span<const double* const> columns, const double* weight,
+                             const double* residual, std::ptrdiff_t n, double* jtj, double* jtr) {
+  const int k = static_cast<int>(columns.size());
+  double first[8] = {}, second[8] = {};
+  for (int a = 0; a < k; a += 2) {
+    const int b = k - a;  // columns a .. k - 1
+    double firstR = 0.0, secondR = 0.0;
+    if (b >= 2)
+      rowBlockOf<true>(b, columns.data() + a, weight, residual, n, first, second, firstR, secondR);
+    else
+      rowBlockOf<false>(b, columns.data() + a, weight, residual, n, first, second, firstR, secondR);
+    for (int j = 0; j < b; ++j) jtj[a * k + a + j] = jtj[(a + j) * k + a] = first[j];
+    jtr[a] = firstR;
+    if (b >= 2) {
+      for (int j = 1; j < b; ++j) jtj[(a + 1) * k + a + j] = jtj[(a + j) * k + a + 1] = second[j];
+      jtr[a + 1] = secondR;
+    }
+  }
+}
+
+}  // namespace facet
