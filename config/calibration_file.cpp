@@ -246,8 +246,9 @@ bool wellFormedOpenCvYaml(const std::filesystem::path& file, Diagnostics& out) {
         if (const auto r = readInteger(m["rows"])) rows = *r;
         if (const auto c = readInteger(m["cols"])) cols = *c;
         const YAML::Node data = m["data"];
-        small = rows >= 0 && cols >= 0 && rows * cols <= 64 && data && data.IsSequence() &&
-                static_cast<long long>(data.size()) == rows * cols;
+        // Each side bounded first: the product of two large counts would overflow.
+        small = rows >= 0 && cols >= 0 && rows <= 64 && cols <= 64 && rows * cols <= 64 && data &&
+                data.IsSequence() && static_cast<long long>(data.size()) == rows * cols;
       }
     } catch (const YAML::Exception&) {
       small = false;

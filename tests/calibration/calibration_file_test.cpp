@@ -96,6 +96,14 @@ TEST_F(CalibrationFileTest, OpenCvMatrixOfAHugeOrNonNumericSizeIsRefused) {
   EXPECT_FALSE(readCalibrationFile(big, bigOut));
   EXPECT_NE(bigOut.text().find("'camera_matrix' is not a small matrix"), std::string::npos)
       << bigOut.text();
+  // rows * cols beyond a 64-bit integer (found by the fuzzer: the product overflowed).
+  const auto overflow = write("overflow.yaml",
+                              "%YAML:1.0\n---\ncamera_matrix: !!opencv-matrix\n   rows: 2\n"
+                              "   cols: 7791680384683591452\n   dt: d\n   data: [ 1. ]\n");
+  Diagnostics overflowOut;
+  EXPECT_FALSE(readCalibrationFile(overflow, overflowOut));
+  EXPECT_NE(overflowOut.text().find("'camera_matrix' is not a small matrix"), std::string::npos)
+      << overflowOut.text();
 }
 
 TEST_F(CalibrationFileTest, TruncatedFileIsReportedAtItsLine) {
