@@ -107,6 +107,7 @@ constexpr float kApertureRange = 7.5f;  // pixels either side of the edge
 constexpr int kAperturePerPixel = 16;
 constexpr int kApertureSize = static_cast<int>(2 * kApertureRange * kAperturePerPixel) + 2;
 constexpr int kApertureAngles = 46;
+static_assert(kApertureSize == 2 * (kApertureSize / 2 - 1) + 2, "u = 0 is a sample");
 
 }  // namespace
 
@@ -129,13 +130,23 @@ class ApertureProfiles {
       const double c = std::cos(angle), sn = std::sin(angle);
       const GridTaps taps = gridBlur ? gridTaps(c, sn) : GridTaps();
       TapWindow window;
-      for (int i = 0; i < kApertureSize; ++i) {
+      const auto compute = [&](int i) {
         const double u = -kApertureRange + static_cast<double>(i) / kAperturePerPixel;
         if (gridBlur)
           gridProfile(taps, window, u, c, sn, value[i], slope[i]);
         else
           profile(u, c, sn, value[i], slope[i]);
+      };
+      // Both blurs and the pixel square are point-symmetric, so P(-u) = 1 - P(u) and
+      // P'(-u) = P'(u): the samples up to u = 0 give those after it (the last one, past +range,
+      // has no mirror).
+      constexpr int kCentre = kApertureSize / 2 - 1;  // u = 0
+      for (int i = 0; i <= kCentre; ++i) compute(i);
+      for (int i = kCentre + 1; i < 2 * kCentre + 1; ++i) {
+        value[i] = 1 - value[2 * kCentre - i];
+        slope[i] = slope[2 * kCentre - i];
       }
+      compute(kApertureSize - 1);
       NormalTable::Interval* row = &rows[static_cast<size_t>(k) * kApertureSize];
       for (int i = 0; i < kApertureSize; ++i) {
         const int j = std::min(i + 1, kApertureSize - 1);
