@@ -63,6 +63,9 @@ class AntiderivativeTable {
   }
 
   Antiderivatives at(double x) const {
+    // NaN (a failed width estimate upstream) stays NaN, as erfc would have kept it: a profile
+    // of NaN never wins a comparison, where one of numbers might.
+    if (std::isnan(x)) return {x, x, x};
     if (x <= -kOuter) return {0, 0, 0};
     if (x >= kOuter) return {1, x, 0.5 * (x * x + 1)};
     const double position = (x + kOuter) * kPerUnit;

@@ -127,6 +127,15 @@ TEST_P(ApertureProfileTable, GridRowMatchesTheSharpStepThroughTheSampledKernel) 
   }
 }
 
+// A width that an upstream estimate failed to give (NaN) yields a profile of NaN, which no fit
+// prefers, never one of numbers.
+TEST(ApertureProfileTableOfNoWidth, IsNotANumber) {
+  const auto profiles = apertureProfiles(std::nan(""), false);
+  const ProfileView view = apertureView(*profiles, {0.8, 0.6});
+  ASSERT_NE(view.data, nullptr);
+  for (int i = 0; i < view.size; i += 13) EXPECT_TRUE(std::isnan(view.data[i].cdf)) << i;
+}
+
 INSTANTIATE_TEST_SUITE_P(SigmasAndAngles, ApertureProfileTable,
                          ::testing::Values(Case{0.3, 0}, Case{0.3, 1}, Case{0.3, 45}, Case{0.8, 7},
                                            Case{0.8, 30}, Case{1.7, 0}, Case{1.7, 19},
