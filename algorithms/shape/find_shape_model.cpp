@@ -171,7 +171,8 @@ struct Finisher {
     const Finished refined{r.pose, scoreAt(r.pose), r.residual};
     const shape_detail::RefinementOutcome outcome{interpolated.score, refined.score, r.startSupport,
                                                   r.support, fitScale && !scaleMisfit};
-    return shape_detail::keepsRefinedPose(outcome, params.minScore) ? refined : interpolated;
+    if (!shape_detail::keepsRefinedPose(outcome)) return interpolated;
+    return Finished{refined.pose, shape_detail::keptRefinementScore(outcome), refined.residual};
   }
 };
 

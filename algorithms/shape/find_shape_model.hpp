@@ -74,8 +74,10 @@ struct ShapeMatch {
   double y = 0.0;
   double angle = 0.0;  // radians, counter-clockwise on screen (wrapped to (-pi, pi])
   double scale = 1.0;  // unitless
-  // 0..1, see above. With subpixel refinement: the similarity of the model's subpixel points at
-  // the refined pose (image directions interpolated bilinearly); without: on the level-0 grid.
+  // 0..1, see above. With subpixel refinement: the similarity of the model's subpixel points
+  // (image directions interpolated bilinearly) at the refined pose, or at the search's
+  // interpolated pose where that is higher (the refinement may give up a little of it to fit the
+  // whole part, refinement_choice.hpp); without: on the level-0 grid.
   double score = 0.0;
   // The model's subpixel edge points placed into the image at this pose, for overlays.
   std::vector<cv::Point2d> contour;

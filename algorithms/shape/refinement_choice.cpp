@@ -1,12 +1,17 @@
 #include "algorithms/shape/refinement_choice.hpp"
 
+#include <algorithm>
+
 namespace facet::shape_detail {
 
-bool keepsRefinedPose(const RefinementOutcome& o, double minScore) {
+bool keepsRefinedPose(const RefinementOutcome& o) {
   if (!o.fittedFully) return o.refinedScore >= o.startScore;
-  if (o.refinedScore < minScore && o.startScore >= minScore) return false;
   if (o.refinedScore < o.startScore - kMaxRefinementScoreLoss) return false;
   return o.refinedSupport >= o.startSupport;
+}
+
+double keptRefinementScore(const RefinementOutcome& o) {
+  return std::max(o.startScore, o.refinedScore);
 }
 
 }  // namespace facet::shape_detail
