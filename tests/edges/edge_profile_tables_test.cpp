@@ -3,6 +3,7 @@
 // grid profile the pixel-averaged sharp step summed over the sampled Gaussian kernel. The tables
 // use closed forms and interpolation; this checks both to float precision.
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <ostream>
 #include <vector>
@@ -96,14 +97,25 @@ void PrintTo(const Case& c, std::ostream* out) {
   *out << "sigma " << c.sigma << ", normal at " << c.degrees << " deg";
 }
 
-class ApertureProfileTable : public ::testing::TestWithParam<Case> {};
+class ApertureProfileTable : public ::testing::TestWithParam<Case> {
+ protected:
+  // The table's row for the case's width and normal, with the normal it was asked for.
+  struct Row {
+    double c, s;
+    std::shared_ptr<ApertureProfiles> profiles;  // holds the row the view points into
+    ProfileView view;
+  };
+  Row row(bool gridBlur) const {
+    const double angle = GetParam().degrees * std::numbers::pi / 180;
+    Row r{std::cos(angle), std::sin(angle), apertureProfiles(GetParam().sigma, gridBlur), {}};
+    r.view = apertureView(*r.profiles, {r.c, r.s});
+    return r;
+  }
+};
 
 TEST_P(ApertureProfileTable, LensRowMatchesTheBlurredStepOverThePixel) {
-  const auto [sigma, degrees] = GetParam();
-  const double angle = degrees * std::numbers::pi / 180;
-  const double c = std::cos(angle), s = std::sin(angle);
-  const auto profiles = apertureProfiles(sigma, false);
-  const ProfileView view = apertureView(*profiles, {c, s});
+  const double sigma = GetParam().sigma;
+  const auto [c, s, profiles, view] = row(false);
   ASSERT_NE(view.data, nullptr);
   for (int i = 0; i < view.size; i += 7) {
     const double u = i / view.perUnit - view.range;
@@ -115,11 +127,8 @@ TEST_P(ApertureProfileTable, LensRowMatchesTheBlurredStepOverThePixel) {
 }
 
 TEST_P(ApertureProfileTable, GridRowMatchesTheSharpStepThroughTheSampledKernel) {
-  const auto [sigma, degrees] = GetParam();
-  const double angle = degrees * std::numbers::pi / 180;
-  const double c = std::cos(angle), s = std::sin(angle);
-  const auto profiles = apertureProfiles(sigma, true);
-  const ProfileView view = apertureView(*profiles, {c, s});
+  const double sigma = GetParam().sigma;
+  const auto [c, s, profiles, view] = row(true);
   ASSERT_NE(view.data, nullptr);
   for (int i = 0; i < view.size; i += 11) {
     const double u = i / view.perUnit - view.range;
