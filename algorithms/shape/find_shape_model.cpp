@@ -229,6 +229,31 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
       scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params.polarity,
       kTopFactor * params.minScore, params.threads, maxCandidates);
 
+  // The top level sees the part coarsest: where the model is nearly symmetric there, the turned
+  // pose may be the one it keeps and the right one absent. Each candidate's near-symmetric turns
+  // are tracked down the pyramid beside it (the levels below tell them apart); turns outside the
+  // searched angles are not.
+  if (!model.symmetries.empty()) {
+    const double f = std::ldexp(1.0, -top);
+    const std::size_t found = candidates.size();
+    for (std::size_t i = 0; i < found; ++i) {
+      const Candidate c = candidates[i];
+      for (ModelSymmetry sym : model.symmetries) {
+        sym.centre *= f;
+        const Pose2D turned = turnedBy({c.x, c.y, c.angle, c.scale}, sym);
+        double a = turned.angle;
+        if (!angles->full) {
+          a = angles->start +
+              std::fmod(a - angles->start + 4.0 * std::numbers::pi, 2.0 * std::numbers::pi);
+          if (a > angles->start + angles->extent) continue;
+        } else {
+          a = wrapAngle(a);
+        }
+        candidates.push_back({std::round(turned.x), std::round(turned.y), a, c.scale, c.score});
+      }
+    }
+  }
+
   LevelSearch search;
   search.angles = *angles;
   search.scaleMin = scaleMin;

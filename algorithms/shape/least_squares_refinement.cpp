@@ -20,6 +20,7 @@ Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Re
   edgeParams.roi = roi;
   edgeParams.low = model.minContrast;
   edgeParams.high = std::max(2.0 * model.minContrast, 0.5 * model.contrastHigh);
+  edgeParams.fitProfile = model.edgeEstimator == EdgeEstimator::ProfileFit;
   const EdgeContours edges = detectSubpixelEdges(image, edgeParams);
   if (edges.points.size() < 6) return result;
 

@@ -36,9 +36,10 @@ PointRaster rasterise(const std::vector<ShapePoint>& points, cv::Point2d centre,
 }
 
 // Mean over every `stride`-th point of the best direction agreement within one pixel of the
-// turned point.
+// point turned by `angle` about `centre` and moved by `shift`.
 double selfSimilarity(const std::vector<ShapePoint>& points, const PointRaster& raster,
-                      cv::Point2d centre, double angle, std::size_t stride = 1) {
+                      cv::Point2d centre, double angle, std::size_t stride = 1,
+                      cv::Point2d shift = {}) {
   const double c = std::cos(angle), s = std::sin(angle);
   const cv::Rect inside(1, 1, raster.directions.cols - 2, raster.directions.rows - 2);
   double sum = 0.0;
@@ -46,7 +47,7 @@ double selfSimilarity(const std::vector<ShapePoint>& points, const PointRaster& 
   for (std::size_t i = 0; i < points.size(); i += stride, ++used) {
     const ShapePoint& p = points[i];
     const double x = p.position.x - centre.x, y = p.position.y - centre.y;
-    const cv::Point2d q = centre + cv::Point2d(c * x + s * y, -s * x + c * y);
+    const cv::Point2d q = centre + shift + cv::Point2d(c * x + s * y, -s * x + c * y);
     const cv::Point at(cvRound(q.x - raster.origin.x), cvRound(q.y - raster.origin.y));
     if (!inside.contains(at)) continue;
     const double dx = c * p.direction.x + s * p.direction.y;
@@ -102,6 +103,89 @@ std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& po
   std::sort(out.begin(), out.end(),
             [](const ModelSymmetry& a, const ModelSymmetry& b) { return a.score > b.score; });
   if (static_cast<int>(out.size()) > maxCount) out.resize(static_cast<std::size_t>(maxCount));
+  return out;
+}
+
+namespace {
+
+// The turn of `points` near `angle` (within `angleReach`, in steps of `angleStep`) and the shift
+// within `shiftReach` pixels (in whole pixels) about `centre` that maps them best onto themselves.
+struct Turn {
+  double angle;
+  cv::Point2d shift;
+  double score;
+};
+Turn bestTurnNear(const std::vector<ShapePoint>& points, const PointRaster& raster,
+                  cv::Point2d centre, Turn start, double angleReach, double angleStep,
+                  int shiftReach, std::size_t stride) {
+  Turn best{start.angle, start.shift, -1.0};
+  const int steps = static_cast<int>(std::ceil(angleReach / angleStep));
+  for (int k = -steps; k <= steps; ++k)
+    for (int dy = -shiftReach; dy <= shiftReach; ++dy)
+      for (int dx = -shiftReach; dx <= shiftReach; ++dx) {
+        const double a = start.angle + k * angleStep;
+        const cv::Point2d shift = start.shift + cv::Point2d(dx, dy);
+        const double v = selfSimilarity(points, raster, centre, a, stride, shift);
+        if (v > best.score) best = {a, shift, v};
+      }
+  return best;
+}
+
+struct Cloud {
+  cv::Point2d centre;
+  PointRaster raster;
+};
+Cloud cloudOf(const std::vector<ShapePoint>& points) {
+  cv::Point2d centre(0, 0);
+  for (const auto& p : points) centre += cv::Point2d(p.position.x, p.position.y);
+  centre *= 1.0 / static_cast<double>(points.size());
+  double reach = 0.0;
+  for (const auto& p : points)
+    reach = std::max(reach, std::hypot(p.position.x - centre.x, p.position.y - centre.y));
+  return {centre, rasterise(points, centre, reach)};
+}
+
+}  // namespace
+
+std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& levels) {
+  if (levels.empty()) return {};
+  const ShapeLevel& base = levels.front();
+  std::vector<ModelSymmetry> out = findModelSymmetries(base.points, base.angleStep);
+  const ShapeLevel& top = levels.back();
+  if (levels.size() < 2 || base.points.size() < 8 || top.points.size() < 8) return out;
+  const double f = std::ldexp(1.0, static_cast<int>(levels.size()) - 1);
+  const Cloud topCloud = cloudOf(top.points), baseCloud = cloudOf(base.points);
+  const double topReach = (topCloud.raster.directions.cols - 5) / 2.0;
+  for (const ModelSymmetry& coarse : findModelSymmetries(top.points, top.angleStep)) {
+    const bool known = std::any_of(out.begin(), out.end(), [&](const ModelSymmetry& s) {
+      return std::abs(wrapAngle(s.angle - coarse.angle)) <= top.angleStep;
+    });
+    if (known) continue;
+    // The centroid of the points is not the centre of the part's symmetry where a feature breaks
+    // it (a lens ring off the centre of a rectangular housing): find the turn's shift too, on the
+    // top level (coarse, cheap), then on level 0 around it (a sample of the points, then all).
+    const int topShift = std::max(2, static_cast<int>(std::ceil(topReach / 3.0)));
+    Turn t = bestTurnNear(top.points, topCloud.raster, topCloud.centre, {coarse.angle, {}, 0.0},
+                          top.angleStep, 0.5 * top.angleStep, topShift, 1);
+    // The same turn and shift about level 0's centroid (model coordinates are level 0's times
+    // 1/f on the top level).
+    const double c = std::cos(t.angle), s = std::sin(t.angle);
+    const cv::Point2d m = baseCloud.centre, mt = topCloud.centre * f;
+    const cv::Point2d d = mt - m;
+    const cv::Point2d shift0 = t.shift * f + d - cv::Point2d(c * d.x + s * d.y, -s * d.x + c * d.y);
+    const std::size_t stride = std::max<std::size_t>(1, base.points.size() / kSampledPoints);
+    Turn fine = bestTurnNear(base.points, baseCloud.raster, m,
+                             {t.angle, {std::round(shift0.x), std::round(shift0.y)}, 0.0},
+                             0.5 * top.angleStep, base.angleStep, static_cast<int>(f / 2), stride);
+    fine =
+        bestTurnNear(base.points, baseCloud.raster, m, fine, base.angleStep, base.angleStep, 1, 1);
+    // q = m + shift + R (p - m) = centre + R (p - centre)  <=>  (I - R) centre = (I - R) m + shift.
+    const double ca = std::cos(fine.angle), sa = std::sin(fine.angle);
+    const cv::Matx22d iMinusR(1.0 - ca, -sa, sa, 1.0 - ca);
+    const cv::Vec2d rhs = iMinusR * cv::Vec2d(m.x, m.y) + cv::Vec2d(fine.shift.x, fine.shift.y);
+    const cv::Vec2d centre = iMinusR.inv() * rhs;
+    out.push_back({wrapAngle(fine.angle), {centre[0], centre[1]}, fine.score});
+  }
   return out;
 }
 

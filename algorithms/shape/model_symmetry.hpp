@@ -13,6 +13,7 @@
 namespace facet {
 
 struct ShapePoint;
+struct ShapeLevel;
 
 struct ModelSymmetry {
   double angle = 0.0;  // radians, the rotation that maps the model (almost) onto itself
@@ -25,6 +26,13 @@ struct ModelSymmetry {
 std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& points,
                                                double angleStep, double minScore = 0.6,
                                                int maxCount = 3);
+
+// The near-symmetries a search must try for a model with these pyramid levels (level 0 first):
+// those of level 0, and those of the top level, where the search starts and sees the part
+// coarsest. A rectangular part with an off-centre feature is no symmetry on level 0 (its turn
+// scores 0.7) but may be one on the top level, which then keeps the turned pose and loses the
+// right one; such turns are located on level 0's points (the best turn within a top-level step).
+std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& levels);
 
 // The pose that shows the model turned by `symmetry` where `pose` shows it: pose o S with
 // S(p) = c + R(a) (p - c).

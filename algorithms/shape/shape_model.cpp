@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/edges/subpixel_edges.hpp"
+#include "algorithms/shape/edge_estimator_choice.hpp"
 #include "algorithms/shape/image_gradients.hpp"
 
 namespace facet {
@@ -154,6 +155,41 @@ double extentOf(const std::vector<ShapePoint>& points, cv::Size2d& box) {
   return radius;
 }
 
+// Subpixel edges of the template for the least-squares refinement: the points of `estimator` on
+// the model's own edge pixels (`modelEdges`, in the region's pixels). The edge detector's
+// thresholds are kept loose (its gradient estimate differs from Sobel's); the model's edge pixels
+// decide which points belong.
+std::vector<ShapePoint> finePointsOf(const cv::Mat& templateImage, cv::Rect region,
+                                     const cv::Mat& mask, const ShapeModel& model,
+                                     const cv::Mat& modelEdges, int maxPoints,
+                                     EdgeEstimator estimator) {
+  EdgeParams edgeParams;
+  edgeParams.low = 0.5 * model.contrastLow;
+  edgeParams.high = 0.5 * model.contrastHigh;
+  edgeParams.roi = region;
+  edgeParams.fitProfile = estimator == EdgeEstimator::ProfileFit;
+  if (!mask.empty()) {
+    edgeParams.mask = cv::Mat(templateImage.size(), CV_8U, cv::Scalar(0));
+    cv::Mat regionMask = mask.size() == region.size() ? mask : mask(region);
+    regionMask.copyTo(edgeParams.mask(region));
+  }
+  const cv::Point2d origin = model.referencePoint + cv::Point2d(region.tl());
+  std::vector<ShapePoint> points;
+  for (const EdgePoint& e : detectSubpixelEdges(templateImage, edgeParams).points) {
+    const cv::Point pixel(cvRound(e.position.x) - region.x, cvRound(e.position.y) - region.y);
+    if (!cv::Rect(0, 0, region.width, region.height).contains(pixel) ||
+        !modelEdges.at<uchar>(pixel))
+      continue;
+    const cv::Point2d p = e.position - origin;
+    points.push_back({cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)),
+                      cv::Point2f(static_cast<float>(e.normal.x), static_cast<float>(e.normal.y))});
+  }
+  thin(points, maxPoints > 0 ? 2 * maxPoints : 0);
+  if (static_cast<int>(points.size()) < kMinModelPoints)
+    throw ShapeModelError("shape model: the template has too few subpixel edge points");
+  return points;
+}
+
 void checkParams(const cv::Mat& image, const ShapeModelParams& p) {
   if (image.empty()) throw ShapeModelError("shape model: the template image is empty");
   if (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U))
@@ -202,6 +238,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   model.scaleMin = params.scaleMin;
   model.scaleMax = params.scaleMax;
   model.minContrast = params.minContrast;
+  model.edgeEstimator = params.edgeEstimator.value_or(EdgeEstimator::ProfileFit);
 
   cv::Mat grey = toGreyFloat(templateImage(region));
   const int wanted = params.numLevels > 0 ? params.numLevels : kMaxAutoLevels;
@@ -252,34 +289,22 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     model.levels.push_back(std::move(shapeLevel));
   }
 
-  // Subpixel edges of the template for the least-squares refinement: the Facet-model points on
-  // the model's own edge pixels. The edge detector's thresholds are kept loose (its gradient
-  // estimate differs from Sobel's); the model's edge pixels decide which points belong.
-  EdgeParams edgeParams;
-  edgeParams.low = 0.5 * model.contrastLow;
-  edgeParams.high = 0.5 * model.contrastHigh;
-  edgeParams.roi = region;
-  if (!mask.empty()) {
-    edgeParams.mask = cv::Mat(templateImage.size(), CV_8U, cv::Scalar(0));
-    cv::Mat regionMask = params.mask.size() == region.size() ? params.mask : params.mask(region);
-    regionMask.copyTo(edgeParams.mask(region));
+  model.finePoints = finePointsOf(templateImage, region, mask.empty() ? cv::Mat() : params.mask,
+                                  model, modelEdges, params.maxPoints, model.edgeEstimator);
+  model.symmetries = findSearchSymmetries(model.levels);
+  if (!params.edgeEstimator) {
+    // Chosen by the test of edge_estimator_choice.hpp; the other candidate differs only in its
+    // subpixel points.
+    ShapeModel zeroCrossing = model;
+    zeroCrossing.edgeEstimator = EdgeEstimator::FacetZeroCrossing;
+    zeroCrossing.finePoints =
+        finePointsOf(templateImage, region, mask.empty() ? cv::Mat() : params.mask, model,
+                     modelEdges, params.maxPoints, EdgeEstimator::FacetZeroCrossing);
+    const EdgeEstimatorChoice choice =
+        chooseEdgeEstimator(templateImage(region), {&model, &zeroCrossing});
+    if (choice.chosen == EdgeEstimator::FacetZeroCrossing) model = std::move(zeroCrossing);
+    model.edgeEstimatorTrials = choice.trials;
   }
-  const cv::Point2d origin = model.referencePoint + cv::Point2d(region.tl());
-  for (const EdgePoint& e : detectSubpixelEdges(templateImage, edgeParams).points) {
-    const cv::Point pixel(cvRound(e.position.x) - region.x, cvRound(e.position.y) - region.y);
-    if (!cv::Rect(0, 0, region.width, region.height).contains(pixel) ||
-        !modelEdges.at<uchar>(pixel))
-      continue;
-    const cv::Point2d p = e.position - origin;
-    model.finePoints.push_back(
-        {cv::Point2f(static_cast<float>(p.x), static_cast<float>(p.y)),
-         cv::Point2f(static_cast<float>(e.normal.x), static_cast<float>(e.normal.y))});
-  }
-  thin(model.finePoints, params.maxPoints > 0 ? 2 * params.maxPoints : 0);
-  if (static_cast<int>(model.finePoints.size()) < kMinModelPoints)
-    throw ShapeModelError("shape model: the template has too few subpixel edge points");
-  model.symmetries =
-      findModelSymmetries(model.levels.front().points, model.levels.front().angleStep);
   return model;
 }
 

@@ -18,6 +18,25 @@
 
 namespace facet {
 
+// How the least-squares refinement locates subpixel edges, in the template and in searched images.
+enum class EdgeEstimator {
+  // The facet zero crossing refined by a blurred-step profile fit (edge_profile_fit.hpp): the
+  // most precise where the part's edges are blurred straight steps (machined and printed parts).
+  ProfileFit,
+  // The cubic facet model's zero crossing alone: steadier where edges are not steps (shiny,
+  // textured parts whose contours lie a few pixels apart), where a profile fit takes in the
+  // neighbouring contours.
+  FacetZeroCrossing,
+};
+
+// One estimator's result in the training test that chooses it (edge_estimator_choice.hpp).
+struct EdgeEstimatorTrial {
+  EdgeEstimator estimator = EdgeEstimator::ProfileFit;
+  // RMS, over the template's turned copies, of how far the found pose puts the model's subpixel
+  // points from where the true pose puts them, pixels; +infinity when a copy was not found.
+  double poseError = 0.0;
+};
+
 struct ShapeModelParams {
   // Region of the template image that holds the part, image pixels; empty = the whole image.
   cv::Rect roi;
@@ -59,6 +78,10 @@ struct ShapeModelParams {
   // Most points kept per pyramid level; larger models are thinned evenly along their edges.
   // Default 800 (level 0), 0 = no thinning. Upper levels keep at most 250 (top-level SIMD sums).
   int maxPoints = 800;
+  // Edge estimator of the least-squares refinement. Unset (default): chosen at training as the
+  // one that finds the template's own pose again on copies of it turned by known angles
+  // (edge_estimator_choice.hpp).
+  std::optional<EdgeEstimator> edgeEstimator;
 };
 
 // One model point: position relative to the reference point (pixels of its pyramid level) and the
@@ -80,6 +103,10 @@ struct ShapeModel {
   // Subpixel (Facet-model) edge points of the template on level 0, relative to the reference
   // point; the least-squares refinement matches these against the image's subpixel edges.
   std::vector<ShapePoint> finePoints;
+  // How finePoints were found, and how the refinement finds the image's edges.
+  EdgeEstimator edgeEstimator = EdgeEstimator::ProfileFit;
+  // The training test that chose it (empty when it was given, or the model was loaded).
+  std::vector<EdgeEstimatorTrial> edgeEstimatorTrials;
 
   cv::Size templateSize;                  // size of the trained region, pixels
   cv::Point2d referencePoint;             // in the trained region's pixels
@@ -90,7 +117,8 @@ struct ShapeModel {
   double minContrast = 5.0;  // grey levels per pixel
   double contrastLow = 0.0;  // thresholds actually used for the template, grey levels per pixel
   double contrastHigh = 0.0;
-  // Rotations that map the model almost onto itself (derived from the level-0 points when the
+  // Rotations that map the model almost onto itself, on level 0 or on the top level
+  // (findSearchSymmetries, model_symmetry.hpp; derived from the points when the
   // model is created or loaded; not stored in model files).
   std::vector<ModelSymmetry> symmetries;
 

@@ -149,6 +149,7 @@ void saveShapeModel(const ShapeModel& model, const std::filesystem::path& path) 
     w.putPoints(level.points);
   }
   w.putPoints(model.finePoints);
+  w.put(static_cast<std::uint8_t>(model.edgeEstimator == EdgeEstimator::ProfileFit ? 0 : 1));
 
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw ShapeModelFileError(path.string() + ": cannot open for writing");
@@ -177,10 +178,10 @@ ShapeModel loadShapeModel(const std::filesystem::path& path) {
   std::uint64_t size = 0;
   std::memcpy(&version, file.data() + kMagic.size(), sizeof(version));
   std::memcpy(&size, file.data() + kMagic.size() + sizeof(version), sizeof(size));
-  if (version != kShapeModelFileVersion)
+  if (version != kShapeModelFileVersion && version != 1)
     throw ShapeModelFileError(name + ": unsupported shape model file version " +
                               std::to_string(version) + " (this build reads version " +
-                              std::to_string(kShapeModelFileVersion) + ")");
+                              std::to_string(kShapeModelFileVersion) + " and 1)");
   if (file.size() - kHeaderSize < sizeof(std::uint64_t) ||
       size > file.size() - kHeaderSize - sizeof(std::uint64_t))
     throw ShapeModelFileError(name + ": truncated shape model file (" +
@@ -212,13 +213,19 @@ ShapeModel loadShapeModel(const std::filesystem::path& path) {
     model.levels.push_back(std::move(level));
   }
   model.finePoints = r.getPoints();
+  // Version 1 has no estimator: its models were searched with the profile fit.
+  if (version >= 2) {
+    const auto estimator = r.get<std::uint8_t>();
+    if (estimator > 1) r.fail("corrupt edge estimator");
+    model.edgeEstimator =
+        estimator == 0 ? EdgeEstimator::ProfileFit : EdgeEstimator::FacetZeroCrossing;
+  }
   if (!r.atEnd()) r.fail("corrupt shape model file (unexpected data after the model)");
   if (model.levels.front().points.empty() || model.finePoints.empty())
     r.fail("corrupt shape model file (invalid values)");
   if (const std::string why = implausibility(model); !why.empty())
     r.fail("corrupt shape model file (invalid values: " + why + ")");
-  model.symmetries =
-      findModelSymmetries(model.levels.front().points, model.levels.front().angleStep);
+  model.symmetries = findSearchSymmetries(model.levels);
   return model;
 }
 

@@ -13,7 +13,9 @@
 
 namespace facet {
 
-inline constexpr std::uint32_t kShapeModelFileVersion = 1;
+// Version 2 adds the model's edge estimator (one byte after the subpixel points); version 1 files
+// still load, as models of the profile fit.
+inline constexpr std::uint32_t kShapeModelFileVersion = 2;
 
 struct ShapeModelFileError : std::runtime_error {
   using std::runtime_error::runtime_error;

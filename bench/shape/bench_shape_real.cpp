@@ -238,8 +238,10 @@ void photoTable(const std::filesystem::path& data, bool smoke, const FindParams&
       "\n| photograph | refs | method | facet found/missed/false | facet worst pos px, "
       "angle deg | facet lowest score found | facet ms | NCC found/missed/false | NCC worst pos "
       "px, angle deg | NCC "
-      "ms |\n|---|---|---|---|---|---|---|---|---|---|\n");
-  Tally sum, nccSum;
+      "ms | edges chosen (training test px: profile / zero crossing) | profile fit only: "
+      "found/missed/false, worst pos px, angle deg "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  Tally sum, nccSum, profileSum;
   for (const auto& c : cases) {
     const cv::Mat templ = cv::imread((data / c.templ).string(), cv::IMREAD_GRAYSCALE);
     const cv::Mat scene = cv::imread((data / c.scene).string(), cv::IMREAD_GRAYSCALE);
@@ -248,6 +250,10 @@ void photoTable(const std::filesystem::path& data, bool smoke, const FindParams&
       continue;
     }
     const ShapeModel model = createShapeModel(templ);
+    // The earlier default, every model on the profile fit, in the same run.
+    ShapeModelParams profileParams;
+    profileParams.edgeEstimator = EdgeEstimator::ProfileFit;
+    const ShapeModel profileModel = createShapeModel(templ, profileParams);
     const auto refCount = static_cast<int>(
         std::count_if(c.refs.begin(), c.refs.end(), [](const Pose2D& r) { return r.scale > 0.0; }));
     FindParams p = base;
@@ -258,6 +264,12 @@ void photoTable(const std::filesystem::path& data, bool smoke, const FindParams&
     const Tally t = tally(
         c, ours, [](auto& m) { return m.x; }, [](auto& m) { return m.y; },
         [](auto& m) { return m.angle; });
+    const Tally pf = tally(
+        c, findShapeModel(scene, profileModel, p), [](auto& m) { return m.x; },
+        [](auto& m) { return m.y; }, [](auto& m) { return m.angle; });
+    double trial[2] = {NAN, NAN};
+    for (const EdgeEstimatorTrial& e : model.edgeEstimatorTrials)
+      trial[e.estimator == EdgeEstimator::ProfileFit ? 0 : 1] = e.poseError;
     Tally n;
     double nccMs = NAN;
     if (!smoke) {
@@ -271,15 +283,19 @@ void photoTable(const std::filesystem::path& data, bool smoke, const FindParams&
     std::printf(
         "| %s (%d levels) | %d | %s | %d/%d/%d | %.2f, %.2f | %.3f | %.1f | %d/%d/%d | %.2f, %.2f "
         "| "
-        "%.1f |\n",
+        "%.1f | %s (%.3f / %.3f) | %d/%d/%d, %.2f, %.2f |\n",
         c.name.c_str(), model.numLevels(), refCount, c.method.c_str(), t.found, t.missed, t.falses,
         t.worstPos, t.worstAngle, t.lowestScore, ms, n.found, n.missed, n.falses, n.worstPos,
-        n.worstAngle, nccMs);
+        n.worstAngle, nccMs,
+        model.edgeEstimator == EdgeEstimator::ProfileFit ? "profile" : "zero crossing", trial[0],
+        trial[1], pf.found, pf.missed, pf.falses, pf.worstPos, pf.worstAngle);
+    profileSum.found += pf.found, profileSum.missed += pf.missed, profileSum.falses += pf.falses;
     sum.found += t.found, sum.missed += t.missed, sum.falses += t.falses;
     nccSum.found += n.found, nccSum.missed += n.missed, nccSum.falses += n.falses;
   }
-  std::printf("| all | | | %d/%d/%d | | | | %d/%d/%d | | |\n", sum.found, sum.missed, sum.falses,
-              nccSum.found, nccSum.missed, nccSum.falses);
+  std::printf("| all | | | %d/%d/%d | | | | %d/%d/%d | | | | %d/%d/%d |\n", sum.found, sum.missed,
+              sum.falses, nccSum.found, nccSum.missed, nccSum.falses, profileSum.found,
+              profileSum.missed, profileSum.falses);
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // facet model create: trains a shape model from a template image and writes it to a model file.
+#include <cmath>
 #include <iostream>
 #include <sstream>
 #include <vector>
@@ -18,9 +19,14 @@ struct ModelOptions {
   std::string scaleRange;
   int levels = 0;
   double minContrast = ShapeModelParams{}.minContrast;
+  std::string edgeEstimator = "auto";
   std::string out;
   bool json = false;
 };
+
+const char* nameOf(EdgeEstimator e) {
+  return e == EdgeEstimator::ProfileFit ? "profile" : "zero-crossing";
+}
 
 // "a,b,c" -> numbers; exactly `count` of them or an InputError naming the option.
 std::vector<double> parseList(const std::string& text, std::size_t count,
@@ -64,6 +70,10 @@ void run(const ModelOptions& o) {
   }
   p.numLevels = o.levels;
   p.minContrast = o.minContrast;
+  if (o.edgeEstimator == "profile")
+    p.edgeEstimator = EdgeEstimator::ProfileFit;
+  else if (o.edgeEstimator == "zero-crossing")
+    p.edgeEstimator = EdgeEstimator::FacetZeroCrossing;
 
   ShapeModel model;
   try {
@@ -84,23 +94,33 @@ void run(const ModelOptions& o) {
     nlohmann::json symmetries = nlohmann::json::array();
     for (const auto& s : model.symmetries)
       symmetries.push_back({{"angle", degrees(s.angle)}, {"score", s.score}});
-    printJson({{"model", o.out},
-               {"levels", model.numLevels()},
-               {"levels_chosen", o.levels == 0 ? "automatic" : "--levels"},
-               {"pyramid", levels},
-               {"points", model.levels.front().points.size()},
-               {"subpixel_points", model.finePoints.size()},
-               {"reference", {model.referencePoint.x, model.referencePoint.y}},
-               {"angle_step", degrees(model.levels.front().angleStep)},
-               {"contrast_low", model.contrastLow},
-               {"contrast_high", model.contrastHigh},
-               {"min_contrast", model.minContrast},
-               {"near_symmetries", symmetries}});
+    // The training test's pose errors (null for a copy not found: JSON has no infinity).
+    nlohmann::json trials = nlohmann::json::object();
+    for (const auto& t : model.edgeEstimatorTrials)
+      trials[nameOf(t.estimator)] =
+          std::isfinite(t.poseError) ? nlohmann::json(t.poseError) : nlohmann::json();
+    printJson(
+        {{"model", o.out},
+         {"levels", model.numLevels()},
+         {"levels_chosen", o.levels == 0 ? "automatic" : "--levels"},
+         {"pyramid", levels},
+         {"points", model.levels.front().points.size()},
+         {"subpixel_points", model.finePoints.size()},
+         {"reference", {model.referencePoint.x, model.referencePoint.y}},
+         {"angle_step", degrees(model.levels.front().angleStep)},
+         {"contrast_low", model.contrastLow},
+         {"contrast_high", model.contrastHigh},
+         {"min_contrast", model.minContrast},
+         {"near_symmetries", symmetries},
+         {"edge_estimator", nameOf(model.edgeEstimator)},
+         {"edge_estimator_chosen", o.edgeEstimator == "auto" ? "automatic" : "--edge-estimator"},
+         {"edge_estimator_trials", trials}});
   } else {
     std::cout << "wrote " << o.out << ": " << model.numLevels() << " levels, "
               << model.levels.front().points.size() << " points on level 0, "
               << model.finePoints.size() << " subpixel points, angle step "
-              << degrees(model.levels.front().angleStep) << " deg\n";
+              << degrees(model.levels.front().angleStep) << " deg, edges by "
+              << nameOf(model.edgeEstimator) << "\n";
   }
 }
 
@@ -120,6 +140,12 @@ void addModelCommand(CLI::App& app) {
   create->add_option("--levels", o->levels, "Pyramid levels (default 0 = automatic)");
   create->add_option("--min-contrast", o->minContrast,
                      "Weakest gradient used, grey levels per pixel (default 5)");
+  create
+      ->add_option("--edge-estimator", o->edgeEstimator,
+                   "Subpixel edges of the refinement: profile (blurred-step fit), zero-crossing "
+                   "(facet model alone) or auto (default: the one that finds the template's own "
+                   "pose again on turned copies of it)")
+      ->check(CLI::IsMember({"auto", "profile", "zero-crossing"}));
   create->add_option("--out", o->out, "Model file to write")->required();
   create->add_flag("--json", o->json, "Print JSON");
   create->callback([o] { run(*o); });

@@ -7,6 +7,7 @@
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "tests/shape/bracket_scenes.hpp"
+#include "tests/shape/nested_part_scenes.hpp"
 
 namespace facet {
 namespace {
@@ -315,6 +316,25 @@ TEST(FindShapeModel, EmptyImageAndBadParameters) {
                std::invalid_argument);
   // An image smaller than the part: searched, nothing found, no crash.
   EXPECT_TRUE(findShapeModel(cv::Mat(20, 30, CV_8U, cv::Scalar(9)), bracketModel()).empty());
+}
+
+// A rectangular housing with a lens ring off its centre: on the top level (40 points) the half
+// turn looks like the part, and the search used to keep only it there, returning the part turned
+// by 180 deg at 0.73 or nothing at all at the default minimum, over most of the circle.
+TEST(FindShapeModel, APartNearlySymmetricOnTheTopLevelIsFoundAtEveryAngle) {
+  const ShapeModel model =
+      createShapeModel(testing::nestedPartScene({140, 100}, {69.5, 49.5, 0.0, 1.0}, 5, false));
+  ASSERT_GE(model.numLevels(), 4);
+  for (int i = 0; i < 12; ++i) {
+    const Pose2D truth{160.3 + 0.37 * i, 121.6 - 0.29 * i, radians(-165.0 + 30.0 * i), 1.0};
+    const cv::Mat image = testing::nestedPartScene({320, 240}, truth, 200 + i, false);
+    const auto matches = findShapeModel(image, model);
+    ASSERT_EQ(matches.size(), 1u) << "angle " << degrees(truth.angle);
+    EXPECT_NEAR(matches[0].x, truth.x, 0.05) << "angle " << degrees(truth.angle);
+    EXPECT_NEAR(matches[0].y, truth.y, 0.05) << "angle " << degrees(truth.angle);
+    EXPECT_NEAR(wrapAngle(matches[0].angle - truth.angle), 0.0, radians(0.05));
+    EXPECT_GT(matches[0].score, 0.95);
+  }
 }
 
 }  // namespace

@@ -62,6 +62,11 @@ TEST(ShapeCli, CreateThenMatchPrintsThePoseAsJson) {
   const auto created = nlohmann::json::parse(create.out);
   EXPECT_GE(created.at("levels").get<int>(), 3);
   EXPECT_DOUBLE_EQ(created.at("reference")[0].get<double>(), 79.5);
+  // The automatic edge estimator and the training test behind it: a part of blurred steps.
+  EXPECT_EQ(created.at("edge_estimator"), "profile");
+  EXPECT_EQ(created.at("edge_estimator_chosen"), "automatic");
+  EXPECT_LT(created.at("edge_estimator_trials").at("profile").get<double>(),
+            created.at("edge_estimator_trials").at("zero-crossing").get<double>());
 
   const CliRun match = run(cli + " match --model " + (dir / "part.model").string() + " --image " +
                                (dir / "scene.png").string() +

@@ -1,6 +1,7 @@
 // Shape model files: round trip, and every way a file can be bad.
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iterator>
 #include <limits>
 #include <string>
@@ -92,6 +93,49 @@ TEST_F(ShapeModelFile, RoundTripKeepsEverything) {
   EXPECT_EQ(a[0].x, b[0].x);
   EXPECT_EQ(a[0].angle, b[0].angle);
   EXPECT_EQ(a[0].scale, b[0].scale);
+}
+
+// The same payload under another header: `version`, and the payload changed by `edit`, with a
+// size and checksum that fit it (what an older facet or a careful hand would have written).
+std::vector<char> rewritten(const std::vector<char>& file, std::uint32_t version,
+                            const std::function<void(std::vector<char>&)>& edit) {
+  constexpr std::size_t kHeader = 8 + 4 + 8;
+  std::vector<char> payload(file.begin() + kHeader, file.end() - 8);
+  edit(payload);
+  std::vector<char> out(file.begin(), file.begin() + 8);
+  const auto append = [&out](const auto& v) {
+    const auto* p = reinterpret_cast<const char*>(&v);
+    out.insert(out.end(), p, p + sizeof(v));
+  };
+  append(version);
+  append(static_cast<std::uint64_t>(payload.size()));
+  out.insert(out.end(), payload.begin(), payload.end());
+  std::uint64_t h = 14695981039346656037ull;  // FNV-1a, as the format says
+  for (const char c : payload) h = (h ^ static_cast<unsigned char>(c)) * 1099511628211ull;
+  append(h);
+  return out;
+}
+
+TEST_F(ShapeModelFile, TheEdgeEstimatorIsKeptAndVersionOneFilesLoadAsTheProfileFit) {
+  ShapeModelParams params;
+  params.edgeEstimator = EdgeEstimator::FacetZeroCrossing;
+  const ShapeModel model = createShapeModel(testing::bracketTemplate(), params);
+  const fs::path file = dir_ / "zero_crossing.model";
+  saveShapeModel(model, file);
+  EXPECT_EQ(loadShapeModel(file).edgeEstimator, EdgeEstimator::FacetZeroCrossing);
+
+  // Version 1 had no estimator byte after the subpixel points: its models used the profile fit.
+  const fs::path old = dir_ / "version1.model";
+  write(old, rewritten(bytesOf(file), 1, [](std::vector<char>& p) { p.pop_back(); }));
+  const ShapeModel loaded = loadShapeModel(old);
+  EXPECT_EQ(loaded.edgeEstimator, EdgeEstimator::ProfileFit);
+  EXPECT_EQ(loaded.finePoints.size(), model.finePoints.size());
+
+  const fs::path unknown = dir_ / "estimator7.model";
+  write(unknown, rewritten(bytesOf(file), kShapeModelFileVersion,
+                           [](std::vector<char>& p) { p.back() = 7; }));
+  const std::string e = loadError(unknown);
+  EXPECT_NE(e.find("edge estimator"), std::string::npos) << e;
 }
 
 TEST_F(ShapeModelFile, BadFilesAreRefusedNamingTheFile) {

@@ -1,0 +1,114 @@
+#include "algorithms/shape/edge_estimator_choice.hpp"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/shape/find_shape_model.hpp"
+
+namespace facet {
+namespace {
+
+// Known poses of the turned copies: angles in degrees and shifts in pixels, small enough that
+// the turned template still holds almost all of the part, uneven so that no copy samples the
+// edges as the template does.
+struct Turn {
+  double degrees;
+  double dx;
+  double dy;
+};
+constexpr Turn kTurns[] = {{-5.5, 0.31, -0.17}, {-4.0, -0.12, 0.27}, {-2.5, 0.46, 0.38},
+                           {-1.0, -0.23, 0.41}, {1.0, 0.44, 0.12},   {2.5, -0.41, -0.06},
+                           {4.0, -0.37, -0.29}, {5.5, 0.08, -0.44}};
+constexpr double kSearchHalfRange = 2.0 * std::numbers::pi / 180.0;  // around the known angle
+
+// The zero crossing replaces the profile fit only when the copies show it better beyond their
+// own scatter: its mean error lower by more than twice the standard error of the paired
+// differences (a one-sided test at about 2.5%, whatever the part).
+constexpr double kSignificance = 2.0;
+
+double poseError(const ShapeModel& model, const Pose2D& found, const Pose2D& truth) {
+  const Pose2D::Map f = found.map(), t = truth.map();
+  double sum = 0.0;
+  for (const ShapePoint& p : model.finePoints) {
+    const cv::Point2d d = f(cv::Point2d(p.position)) - t(cv::Point2d(p.position));
+    sum += d.dot(d);
+  }
+  return std::sqrt(sum / static_cast<double>(model.finePoints.size()));
+}
+
+// True when `better`'s errors are lower than `than`'s, copy by copy, beyond their scatter. A copy
+// that one of them did not find counts for the other.
+bool clearlyBetter(const std::vector<double>& better, const std::vector<double>& than) {
+  std::vector<double> gain;
+  for (std::size_t i = 0; i < better.size(); ++i) {
+    if (std::isinf(better[i]) && std::isinf(than[i])) continue;
+    if (std::isinf(better[i])) return false;
+    if (std::isinf(than[i])) return true;
+    gain.push_back(than[i] - better[i]);
+  }
+  if (gain.size() < 2) return false;
+  const double n = static_cast<double>(gain.size());
+  double mean = 0.0, var = 0.0;
+  for (const double g : gain) mean += g;
+  mean /= n;
+  for (const double g : gain) var += (g - mean) * (g - mean);
+  const double standardError = std::sqrt(var / (n - 1.0) / n);
+  return mean > kSignificance * standardError;
+}
+
+}  // namespace
+
+EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
+                                        const std::vector<const ShapeModel*>& candidates) {
+  EdgeEstimatorChoice choice;
+  if (candidates.empty()) return choice;
+  // The copies lie on a canvas a quarter larger, the template's border repeated, so that turned
+  // corners of the part stay in view.
+  const int margin = std::max(templateImage.cols, templateImage.rows) / 8 + 4;
+  cv::Mat canvas;
+  cv::copyMakeBorder(templateImage, canvas, margin, margin, margin, margin, cv::BORDER_REPLICATE);
+
+  std::vector<std::vector<double>> errors;  // per candidate, per turned copy
+  for (const ShapeModel* model : candidates) {
+    const cv::Point2d centre = model->referencePoint + cv::Point2d(margin, margin);
+    std::vector<double>& e = errors.emplace_back();
+    double sum = 0.0;
+    for (const Turn& turn : kTurns) {
+      cv::Mat warp = cv::getRotationMatrix2D(centre, turn.degrees, 1.0);
+      warp.at<double>(0, 2) += turn.dx;
+      warp.at<double>(1, 2) += turn.dy;
+      cv::Mat copy;
+      cv::warpAffine(canvas, copy, warp, canvas.size(), cv::INTER_LANCZOS4, cv::BORDER_REPLICATE);
+      const double angle = turn.degrees * std::numbers::pi / 180.0;
+      const Pose2D truth{centre.x + turn.dx, centre.y + turn.dy, angle, 1.0};
+
+      FindParams find;
+      find.minScore = 0.3;
+      find.angleStart = angle - kSearchHalfRange;
+      find.angleExtent = 2.0 * kSearchHalfRange;
+      find.threads = 1;
+      const std::vector<ShapeMatch> matches = findShapeModel(copy, *model, find);
+      e.push_back(matches.empty() ? std::numeric_limits<double>::infinity()
+                                  : poseError(*model, matches.front().pose(), truth));
+      sum += e.back() * e.back();
+    }
+    choice.trials.push_back(
+        {model->edgeEstimator, std::sqrt(sum / static_cast<double>(std::size(kTurns)))});
+  }
+
+  int profile = -1, zeroCrossing = -1;
+  for (int i = 0; i < static_cast<int>(choice.trials.size()); ++i)
+    (choice.trials[i].estimator == EdgeEstimator::ProfileFit ? profile : zeroCrossing) = i;
+  if (profile < 0) {
+    choice.chosen = EdgeEstimator::FacetZeroCrossing;
+  } else if (zeroCrossing >= 0 && clearlyBetter(errors[zeroCrossing], errors[profile])) {
+    choice.chosen = EdgeEstimator::FacetZeroCrossing;
+  }
+  return choice;
+}
+
+}  // namespace facet
