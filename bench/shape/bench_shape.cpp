@@ -138,6 +138,9 @@ TestScene crowdScene(std::uint64_t seed) {
 struct Errors {
   std::vector<double> position, angleDeg, scaleRel, ms, cpu;
   int found = 0, scenes = 0, wrong = 0;
+  // Misses whose true pose itself scores below the minimum: the occluder hid more than that share
+  // of the model's edges, and a score that means "share of the model seen" must not find them.
+  int hiddenBeyondMinimum = 0;
 };
 
 // The match nearest to the truth counts as found when within 2 px and 1 degree.
@@ -315,7 +318,7 @@ int main(int argc, char** argv) {
   FindParams find;  // full circle, least squares, min score 0.7, one match
   find.numMatches = 1;
 
-  Errors vga, sxga, scale, occluded, clutter, crowd;
+  Errors vga, sxga, scale, occluded, occludedHeldOut, clutter, crowd;
   std::vector<TestScene> vgaScenes;
   for (int i = 0; i < scenes; ++i) {
     auto run = [&](const TestScene& sc, const ShapeModel& m, const FindParams& p, Errors& e) {
@@ -327,6 +330,15 @@ int main(int argc, char** argv) {
       ++e.scenes;
       if (!score(sc.truth.front(), matches, e)) {
         ++e.wrong;
+        // The score at the true pose: a search in its neighbourhood without a minimum.
+        FindParams near = p;
+        near.minScore = 0.05;
+        near.angleStart = sc.truth.front().angle - radians(1.0);
+        near.angleExtent = radians(2.0);
+        for (const auto& m : findShapeModel(sc.image, m, near))
+          if (std::hypot(m.x - sc.truth.front().x, m.y - sc.truth.front().y) < 1.0 &&
+              m.score < p.minScore)
+            ++e.hiddenBeyondMinimum;
         if (verbose) {
           const Pose2D& t = sc.truth.front();
           std::printf("missed: truth %.2f %.2f %.2f deg scale %.3f;", t.x, t.y, degrees(t.angle),
@@ -345,6 +357,9 @@ int main(int argc, char** argv) {
     FindParams low = find;
     low.minScore = 0.5;
     run(randomScene({640, 480}, 4000 + i, 1.0, 1.0, 0.4), model, low, occluded);
+    // The same kind of scene from seeds no change was ever tried on: the row above has been
+    // looked at miss by miss, this one only counted.
+    run(randomScene({640, 480}, 7000 + i, 1.0, 1.0, 0.4), model, low, occludedHeldOut);
   }
   for (int i = 0; i < clutterScenes; ++i) {
     const TestScene sc = randomScene({640, 480}, 5000 + i, 1, 1, 0, false);
@@ -408,8 +423,13 @@ int main(int argc, char** argv) {
   printRow("1280x1024, 360 deg", sxga, "<= 25 ms, same accuracy");
   printRow("640x480, scale 0.8-1.2", scale, "<= 4x fixed-scale time, scale RMS <= 5e-4");
   printRow("640x480, 40% occluded, s>=0.5", occluded, "found >= 98%");
+  printRow("same, held-out seeds 7000+", occludedHeldOut, "found >= 98%");
   printRow("clutter only, s>=0.7 (found=none)", clutter, "100% with no match");
   printRow("20 instances 1280x1024 (all once)", crowd, "all found, none twice");
+  std::printf(
+      "\noccluded rows: of the parts missed, %d and %d (held-out) score below the minimum at "
+      "their true pose (more than half of the model hidden)\n",
+      occluded.hiddenBeyondMinimum, occludedHeldOut.hiddenBeyondMinimum);
   std::printf("\nscale-range time / fixed-scale time: %.2f wall, %.2f CPU (target <= 4)\n",
               median(scale.ms) / median(vga.ms), median(scale.cpu) / median(vga.cpu));
   std::printf(
