@@ -63,18 +63,53 @@ double selfSimilarity(const std::vector<ShapePoint>& points, const PointRaster& 
   return used == 0 ? 0.0 : sum / static_cast<double>(used);
 }
 
-}  // namespace
+// The turn of `points` near `angle` (within `angleReach`, in steps of `angleStep`) and the shift
+// within `shiftReach` pixels (in whole pixels) about `centre` that maps them best onto themselves.
+struct Turn {
+  double angle;
+  cv::Point2d shift;
+  double score;
+};
+Turn bestTurnNear(const std::vector<ShapePoint>& points, const PointRaster& raster,
+                  cv::Point2d centre, Turn start, double angleReach, double angleStep,
+                  int shiftReach, std::size_t stride) {
+  Turn best{start.angle, start.shift, -1.0};
+  const int steps = static_cast<int>(std::ceil(angleReach / angleStep));
+  for (int k = -steps; k <= steps; ++k)
+    for (int dy = -shiftReach; dy <= shiftReach; ++dy)
+      for (int dx = -shiftReach; dx <= shiftReach; ++dx) {
+        const double a = start.angle + k * angleStep;
+        const cv::Point2d shift = start.shift + cv::Point2d(dx, dy);
+        const double v = selfSimilarity(points, raster, centre, a, stride, shift);
+        if (v > best.score) best = {a, shift, v};
+      }
+  return best;
+}
 
-std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& points,
-                                               double angleStep, double minScore, int maxCount) {
-  if (points.size() < 8 || !(angleStep > 0.0)) return {};
+// Model points about their centroid, rasterised.
+struct Cloud {
+  cv::Point2d centre;
+  double reach = 0.0;  // farthest point from the centre, pixels
+  PointRaster raster;
+};
+Cloud cloudOf(const std::vector<ShapePoint>& points) {
   cv::Point2d centre(0, 0);
   for (const auto& p : points) centre += cv::Point2d(p.position.x, p.position.y);
   centre *= 1.0 / static_cast<double>(points.size());
   double reach = 0.0;
   for (const auto& p : points)
     reach = std::max(reach, std::hypot(p.position.x - centre.x, p.position.y - centre.y));
-  const PointRaster raster = rasterise(points, centre, reach);
+  return {centre, reach, rasterise(points, centre, reach)};
+}
+
+}  // namespace
+
+std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& points,
+                                               double angleStep, double minScore, int maxCount) {
+  if (points.size() < 8 || !(angleStep > 0.0)) return {};
+  const Cloud cloud = cloudOf(points);
+  const cv::Point2d centre = cloud.centre;
+  const PointRaster& raster = cloud.raster;
 
   const int n = std::max(8, static_cast<int>(std::ceil(kTwoPi / angleStep)));
   // Every angle is scored with a sample of the points first (a model has hundreds and the turn
@@ -106,47 +141,6 @@ std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& po
   return out;
 }
 
-namespace {
-
-// The turn of `points` near `angle` (within `angleReach`, in steps of `angleStep`) and the shift
-// within `shiftReach` pixels (in whole pixels) about `centre` that maps them best onto themselves.
-struct Turn {
-  double angle;
-  cv::Point2d shift;
-  double score;
-};
-Turn bestTurnNear(const std::vector<ShapePoint>& points, const PointRaster& raster,
-                  cv::Point2d centre, Turn start, double angleReach, double angleStep,
-                  int shiftReach, std::size_t stride) {
-  Turn best{start.angle, start.shift, -1.0};
-  const int steps = static_cast<int>(std::ceil(angleReach / angleStep));
-  for (int k = -steps; k <= steps; ++k)
-    for (int dy = -shiftReach; dy <= shiftReach; ++dy)
-      for (int dx = -shiftReach; dx <= shiftReach; ++dx) {
-        const double a = start.angle + k * angleStep;
-        const cv::Point2d shift = start.shift + cv::Point2d(dx, dy);
-        const double v = selfSimilarity(points, raster, centre, a, stride, shift);
-        if (v > best.score) best = {a, shift, v};
-      }
-  return best;
-}
-
-struct Cloud {
-  cv::Point2d centre;
-  PointRaster raster;
-};
-Cloud cloudOf(const std::vector<ShapePoint>& points) {
-  cv::Point2d centre(0, 0);
-  for (const auto& p : points) centre += cv::Point2d(p.position.x, p.position.y);
-  centre *= 1.0 / static_cast<double>(points.size());
-  double reach = 0.0;
-  for (const auto& p : points)
-    reach = std::max(reach, std::hypot(p.position.x - centre.x, p.position.y - centre.y));
-  return {centre, rasterise(points, centre, reach)};
-}
-
-}  // namespace
-
 std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& levels) {
   if (levels.empty()) return {};
   const ShapeLevel& base = levels.front();
@@ -155,7 +149,6 @@ std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& l
   if (levels.size() < 2 || base.points.size() < 8 || top.points.size() < 8) return out;
   const double f = std::ldexp(1.0, static_cast<int>(levels.size()) - 1);
   const Cloud topCloud = cloudOf(top.points), baseCloud = cloudOf(base.points);
-  const double topReach = (topCloud.raster.directions.cols - 5) / 2.0;
   for (const ModelSymmetry& coarse : findModelSymmetries(top.points, top.angleStep)) {
     const bool known = std::any_of(out.begin(), out.end(), [&](const ModelSymmetry& s) {
       return std::abs(wrapAngle(s.angle - coarse.angle)) <= top.angleStep;
@@ -164,7 +157,7 @@ std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& l
     // The centroid of the points is not the centre of the part's symmetry where a feature breaks
     // it (a lens ring off the centre of a rectangular housing): find the turn's shift too, on the
     // top level (coarse, cheap), then on level 0 around it (a sample of the points, then all).
-    const int topShift = std::max(2, static_cast<int>(std::ceil(topReach / 3.0)));
+    const int topShift = std::max(2, static_cast<int>(std::ceil(topCloud.reach / 3.0)));
     Turn t = bestTurnNear(top.points, topCloud.raster, topCloud.centre, {coarse.angle, {}, 0.0},
                           top.angleStep, 0.5 * top.angleStep, topShift, 1);
     // The same turn and shift about level 0's centroid (model coordinates are level 0's times

@@ -325,6 +325,14 @@ TEST(FindShapeModel, APartNearlySymmetricOnTheTopLevelIsFoundAtEveryAngle) {
   const ShapeModel model =
       createShapeModel(testing::nestedPartScene({140, 100}, {69.5, 49.5, 0.0, 1.0}, 5, false));
   ASSERT_GE(model.numLevels(), 4);
+  // The half turn is a near-symmetry of the search, about the housing's centre (0.25, 0.15), not
+  // about the centroid of the points, which the lens ring pulls aside.
+  const auto halfTurn = std::find_if(
+      model.symmetries.begin(), model.symmetries.end(),
+      [](const ModelSymmetry& s) { return std::abs(std::abs(degrees(s.angle)) - 180.0) < 2.0; });
+  ASSERT_NE(halfTurn, model.symmetries.end());
+  EXPECT_NEAR(halfTurn->centre.x, 0.25, 1.0);
+  EXPECT_NEAR(halfTurn->centre.y, 0.15, 1.0);
   for (int i = 0; i < 12; ++i) {
     const Pose2D truth{160.3 + 0.37 * i, 121.6 - 0.29 * i, radians(-165.0 + 30.0 * i), 1.0};
     const cv::Mat image = testing::nestedPartScene({320, 240}, truth, 200 + i, false);
