@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "camera/bmp_file.hpp"
 #include "camera/decoded_frame.hpp"
 #include "camera/exif_orientation.hpp"
 #include "camera/image_codec_table.hpp"
@@ -133,6 +134,17 @@ std::optional<cv::Mat> imreadOfPlainTiff(const fs::path& file, int flags) {
   return readPlainTiff(file, kImreadMaxPixels, stored);
 }
 
+// cv::imread's result for a plain BMP: the stored pixels, read as stored or, for a grey file, as
+// grey. A colour file read as grey is converted by OpenCV's own rules: the module.
+std::optional<cv::Mat> imreadOfPlainBmp(const fs::path& file, int flags) {
+  const PlainRead read = plainReadOf(flags);
+  if (read == PlainRead::Other) return std::nullopt;
+  const auto stored = [&](int type) {
+    return read == PlainRead::Unchanged || CV_MAT_CN(type) == 1;
+  };
+  return readPlainBmp(file, kImreadMaxPixels, stored);
+}
+
 // readImageFile's result for a plain PNG: what the module's decoder makes of it.
 std::optional<ImageFileContent> frameOfPlainPng(const fs::path& file, std::uint64_t max_pixels) {
   auto png = readPlainPng(file, max_pixels);
@@ -156,6 +168,14 @@ std::optional<ImageFileContent> frameOfPlainTiff(const fs::path& file, std::uint
   return frameOfDecodedPixels(std::move(*tiff));
 }
 
+// readImageFile's result for a plain BMP: OpenImageIO in the module reads a grey palette as one
+// grey channel and 24 bits as RGB, which the frame rule takes as the colour it is.
+std::optional<ImageFileContent> frameOfPlainBmp(const fs::path& file, std::uint64_t max_pixels) {
+  auto bmp = readPlainBmp(file, max_pixels);
+  if (!bmp) return std::nullopt;
+  return frameOfDecodedPixels(std::move(*bmp));
+}
+
 }  // namespace
 
 const std::string& imageCodecsProblem() {
@@ -166,6 +186,7 @@ cv::Mat readImage(const fs::path& file, int flags) {
   if (auto png = imreadOfPlainPng(file, flags)) return *png;
   if (auto jpeg = imreadOfPlainJpeg(file, flags)) return *jpeg;
   if (auto tiff = imreadOfPlainTiff(file, flags)) return *tiff;
+  if (auto bmp = imreadOfPlainBmp(file, flags)) return *bmp;
   const ImageCodecTable* table = loaded().table;
   return table ? table->read(file.string(), flags) : cv::Mat();
 }
@@ -190,6 +211,7 @@ ImageFileContent readImageFile(const fs::path& file, std::uint64_t max_pixels) {
   if (auto png = frameOfPlainPng(file, max_pixels)) return std::move(*png);
   if (auto jpeg = frameOfPlainJpeg(file, max_pixels)) return std::move(*jpeg);
   if (auto tiff = frameOfPlainTiff(file, max_pixels)) return std::move(*tiff);
+  if (auto bmp = frameOfPlainBmp(file, max_pixels)) return std::move(*bmp);
   const LoadedCodecs& codecs = loaded();
   if (codecs.table) return codecs.table->readFile(file, max_pixels);
   ImageFileContent content;

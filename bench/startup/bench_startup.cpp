@@ -75,11 +75,13 @@ int main(int argc, char** argv) {
     }
     return copy;
   };
-  const std::string tiff = copyAs(".tif"), pgm = copyAs(".pgm");
+  const std::string tiff = copyAs(".tif"), bmp = copyAs(".bmp"), pgm = copyAs(".pgm");
   const std::vector<std::string> match = {"match", "--model", "recipes/models/bracket.shape",
                                           "--image", png};
   const std::vector<std::string> matchTiff = {"match", "--model", "recipes/models/bracket.shape",
                                               "--image", tiff};
+  const std::vector<std::string> matchBmp = {"match", "--model", "recipes/models/bracket.shape",
+                                             "--image", bmp};
   const std::vector<std::string> matchPgm = {"match", "--model", "recipes/models/bracket.shape",
                                              "--image", pgm};
   std::printf("bench_startup%s: median wall time of %d runs (warm page cache)\n",
@@ -88,7 +90,8 @@ int main(int argc, char** argv) {
   int failed = 0;
   for (const auto& [name, args] :
        {std::pair{"version", version}, std::pair{"match png", match},
-        std::pair{"match tiff", matchTiff}, std::pair{"match pgm (module)", matchPgm}}) {
+        std::pair{"match tiff", matchTiff}, std::pair{"match bmp", matchBmp},
+        std::pair{"match pgm (module)", matchPgm}}) {
     std::vector<std::string> now = {FACET_TOOL}, old = {FACET_LINKED_CODECS_TOOL};
     now.insert(now.end(), args.begin(), args.end());
     old.insert(old.end(), args.begin(), args.end());
@@ -101,6 +104,7 @@ int main(int argc, char** argv) {
     std::printf("%-18s %12.1f %22.1f %7.2fx\n", name, t, baseline, baseline / t);
   }
   std::filesystem::remove(tiff);
+  std::filesystem::remove(bmp);
   std::filesystem::remove(pgm);
   return failed == 0 ? 0 : 1;
 }
