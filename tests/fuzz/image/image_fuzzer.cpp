@@ -1,11 +1,11 @@
 // libFuzzer target: the replay backend's image decoders: the one inside the image-codec module
 // (camera/image_file_decoder.hpp: OpenImageIO and, for 16-bit PNM, OpenCV) and the plain-PNG
-// plain-JPEG and plain-TIFF readers that run in the process before it (camera/png_file.hpp,
-// camera/jpeg_file.hpp, camera/tiff_file.hpp). The first byte picks the file
-// extension the replay folder accepts, the rest is the file. Expected outcome for bad input: an
-// error naming the file (module) or no image (plain readers: the module then decides). An image
-// that reads must have the size its header announced and a frame format; where both read a file,
-// they agree on its size.
+// plain-JPEG, plain-TIFF and plain-BMP readers that run in the process before it
+// (camera/png_file.hpp, camera/jpeg_file.hpp, camera/tiff_file.hpp, camera/bmp_file.hpp). The first
+// byte picks the file extension the replay folder accepts, the rest is the file. Expected outcome
+// for bad input: an error naming the file (module) or no image (plain readers: the module then
+// decides). An image that reads must have the size its header announced and a frame format; where
+// both read a file, they agree on its size.
 //
 // The pixel limit is lower than the camera's default (2^28) so that runs stay within the
 // fuzzer's memory limit; the header check in front of any allocation is the same code.
@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "camera/bmp_file.hpp"
 #include "camera/image_file_decoder.hpp"
 #include "camera/jpeg_file.hpp"
 #include "camera/png_file.hpp"
@@ -58,6 +59,14 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (p.empty() || p.total() > kMaxPixels || (p.depth() != CV_8U && p.depth() != CV_16U) ||
         (p.channels() != 1 && p.channels() != 3))
       std::abort();
+    if (content.ok() && content.image.size() != p.size()) std::abort();
+  }
+  if (const auto plain = facet::readPlainBmp(file, kMaxPixels)) {
+    const cv::Mat& p = *plain;
+    if (p.empty() || p.total() > kMaxPixels || p.depth() != CV_8U ||
+        (p.channels() != 1 && p.channels() != 3))
+      std::abort();
+    // Where the module reads it too, to the same size.
     if (content.ok() && content.image.size() != p.size()) std::abort();
   }
   return 0;
