@@ -162,15 +162,24 @@ struct Finisher {
         shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, fitScale);
     const bool scaleMisfit =
         !scaleRange && r.status.ok() && std::abs(r.pose.scale / start.scale - 1.0) > tolerance;
-    if (scaleMisfit)
+    // A refit at the start's scale that lays at least as many points on edges as the scale the
+    // free fit wanted shows that scale was not the part's (an occluder's or a neighbour's edges
+    // pulled it): the refit fits the part fully. A part truly beyond the tolerance fits better
+    // at its own scale, and the refit then fits nowhere exactly.
+    double misfitSupport = 0.0;
+    if (scaleMisfit) {
+      misfitSupport = r.support;
       r = shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, false);
+    }
+    const bool refitFits = scaleMisfit && r.status.ok() && r.support >= misfitSupport;
     // A refinement that wanders off by more than the search's own uncertainty has locked onto
     // something else.
     if (!r.status.ok() || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0)
       return interpolated;
     const Finished refined{r.pose, scoreAt(r.pose), r.residual};
     const shape_detail::RefinementOutcome outcome{interpolated.score, refined.score, r.startSupport,
-                                                  r.support, fitScale && !scaleMisfit};
+                                                  r.support,
+                                                  fitScale && (!scaleMisfit || refitFits)};
     if (!shape_detail::keepsRefinedPose(outcome)) return interpolated;
     return Finished{refined.pose, shape_detail::keptRefinementScore(outcome), refined.residual};
   }

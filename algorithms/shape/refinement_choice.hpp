@@ -11,8 +11,10 @@ struct RefinementOutcome {
   double refinedScore = 0.0;
   double startSupport = 0.0;
   double refinedSupport = 0.0;
-  // The refinement fitted everything the part may change: its scale too, within the tolerance.
-  // Otherwise (fixed scale, or a scale beyond the tolerance) it fits nowhere exactly.
+  // The refinement fitted everything the part may change: its scale too, within the tolerance,
+  // or, where the free scale went beyond it, a refit at the start's scale that lays at least as
+  // many points on edges (the scale was pulled by something else). Otherwise (fixed scale, or a
+  // part truly beyond the tolerance) it fits nowhere exactly.
   bool fittedFully = false;
 };
 
