@@ -250,13 +250,13 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
       for (ModelSymmetry sym : model.symmetries) {
         sym.centre *= f;
         const Pose2D turned = turnedBy({c.x, c.y, c.angle, c.scale}, sym);
-        double a = turned.angle;
+        double a = wrapAngle(turned.angle);
         if (!angles->full) {
-          a = angles->start +
-              std::fmod(a - angles->start + 4.0 * std::numbers::pi, 2.0 * std::numbers::pi);
-          if (a > angles->start + angles->extent) continue;
-        } else {
-          a = wrapAngle(a);
+          // The turn's angle taken to the first one at or after the range's start.
+          double past = std::fmod(a - angles->start, kTwoPi);
+          if (past < 0.0) past += kTwoPi;
+          if (past > angles->extent) continue;
+          a = angles->start + past;
         }
         candidates.push_back({std::round(turned.x), std::round(turned.y), a, c.scale, c.score});
       }

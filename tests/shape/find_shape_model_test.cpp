@@ -344,6 +344,16 @@ TEST(FindShapeModel, APartNearlySymmetricOnTheTopLevelIsFoundAtEveryAngle) {
     EXPECT_NEAR(wrapAngle(matches[0].angle - truth.angle), 0.0, radians(0.05));
     EXPECT_GT(matches[0].score, 0.95);
   }
+  // A range across +-180 deg given from 150 deg: the part at 165 deg is found, its half turn
+  // lies outside the range.
+  const Pose2D truth{161.1, 118.9, radians(165.0), 1.0};
+  FindParams around;
+  around.angleStart = radians(150.0);
+  around.angleExtent = radians(50.0);
+  const auto matches =
+      findShapeModel(testing::nestedPartScene({320, 240}, truth, 300, false), model, around);
+  ASSERT_EQ(matches.size(), 1u);
+  EXPECT_NEAR(wrapAngle(matches[0].angle - truth.angle), 0.0, radians(0.05));
 }
 
 // The bracket 40% hidden behind a strip of grey 110, clutter around, at a pose drawn from `seed`.
