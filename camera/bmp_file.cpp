@@ -26,12 +26,12 @@ std::uint16_t u16(const std::vector<unsigned char>& b, std::size_t at) {
 
 std::optional<cv::Mat> readPlainBmp(const std::filesystem::path& file, std::uint64_t maxPixels,
                                     const StoredLayoutFilter& wanted) {
+  // The headers first: a file that is no plain BMP is not read further (the module reads it).
   std::ifstream in(file, std::ios::binary);
-  char magic[2] = {};
-  if (!in.read(magic, 2) || magic[0] != 'B' || magic[1] != 'M') return std::nullopt;
-  in.seekg(0);
-  const std::vector<unsigned char> b{std::istreambuf_iterator<char>(in), {}};
-  if (b.size() < kFileHeader + kInfoHeader) return std::nullopt;
+  std::vector<unsigned char> b(kFileHeader + kInfoHeader);
+  if (!in.read(reinterpret_cast<char*>(b.data()), static_cast<std::streamsize>(b.size())) ||
+      b[0] != 'B' || b[1] != 'M')
+    return std::nullopt;
 
   const std::uint32_t pixelsAt = u32(b, 10);
   const std::uint32_t infoSize = u32(b, 14);
@@ -47,6 +47,7 @@ std::optional<cv::Mat> readPlainBmp(const std::filesystem::path& file, std::uint
     return std::nullopt;
   const int type = bits == 8 ? CV_8UC1 : CV_8UC3;
   if (wanted && !wanted(type)) return std::nullopt;
+  b.insert(b.end(), std::istreambuf_iterator<char>(in), {});
 
   // Rows are padded to 4 bytes; the pixel data must be whole.
   const std::size_t stride = (static_cast<std::size_t>(width) * bits / 8 + 3) & ~std::size_t{3};
