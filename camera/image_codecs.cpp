@@ -121,17 +121,24 @@ std::optional<cv::Mat> imreadOfPlainJpeg(const fs::path& file, int flags) {
   return std::move(jpeg->pixels);
 }
 
+// The layouts that cv::imread gives as stored for files whose colour it takes as it is (TIFF,
+// BMP): every layout read unchanged; grey ones read as grey, 8 bits or any depth when asked. A
+// colour file read as grey, or a 16-bit one read as 8 bits, follows OpenCV's own rules: the
+// module.
+StoredLayoutFilter storedAsRead(PlainRead read, int flags) {
+  return [read, flags](int type) {
+    return read == PlainRead::Unchanged ||
+           (CV_MAT_CN(type) == 1 && (CV_MAT_DEPTH(type) == CV_8U || (flags & cv::IMREAD_ANYDEPTH)));
+  };
+}
+
 // cv::imread's result for a plain TIFF: the stored samples, read as stored or, for a grey file,
 // as grey (8 bits, or 16 when any depth is asked). A colour file read as grey, or a 16-bit one
 // read as 8 bits, is converted by OpenCV's own rules: the module.
 std::optional<cv::Mat> imreadOfPlainTiff(const fs::path& file, int flags) {
   const PlainRead read = plainReadOf(flags);
   if (read == PlainRead::Other) return std::nullopt;
-  const auto stored = [&](int type) {
-    return read == PlainRead::Unchanged ||
-           (CV_MAT_CN(type) == 1 && (CV_MAT_DEPTH(type) == CV_8U || (flags & cv::IMREAD_ANYDEPTH)));
-  };
-  return readPlainTiff(file, kImreadMaxPixels, stored);
+  return readPlainTiff(file, kImreadMaxPixels, storedAsRead(read, flags));
 }
 
 // cv::imread's result for a plain BMP: the stored pixels, read as stored or, for a grey file, as
@@ -139,10 +146,7 @@ std::optional<cv::Mat> imreadOfPlainTiff(const fs::path& file, int flags) {
 std::optional<cv::Mat> imreadOfPlainBmp(const fs::path& file, int flags) {
   const PlainRead read = plainReadOf(flags);
   if (read == PlainRead::Other) return std::nullopt;
-  const auto stored = [&](int type) {
-    return read == PlainRead::Unchanged || CV_MAT_CN(type) == 1;
-  };
-  return readPlainBmp(file, kImreadMaxPixels, stored);
+  return readPlainBmp(file, kImreadMaxPixels, storedAsRead(read, flags));
 }
 
 // readImageFile's result for a plain PNG: what the module's decoder makes of it.

@@ -76,7 +76,6 @@ EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
   for (const ShapeModel* model : candidates) {
     const cv::Point2d centre = model->referencePoint + cv::Point2d(margin, margin);
     std::vector<double>& e = errors.emplace_back();
-    double sum = 0.0;
     for (const Turn& turn : kTurns) {
       cv::Mat warp = cv::getRotationMatrix2D(centre, turn.degrees, 1.0);
       warp.at<double>(0, 2) += turn.dx;
@@ -94,10 +93,10 @@ EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
       const std::vector<ShapeMatch> matches = findShapeModel(copy, *model, find);
       e.push_back(matches.empty() ? std::numeric_limits<double>::infinity()
                                   : poseError(*model, matches.front().pose(), truth));
-      sum += e.back() * e.back();
     }
-    choice.trials.push_back(
-        {model->edgeEstimator, std::sqrt(sum / static_cast<double>(std::size(kTurns)))});
+    double sum = 0.0;
+    for (const double v : e) sum += v * v;
+    choice.trials.push_back({model->edgeEstimator, std::sqrt(sum / static_cast<double>(e.size()))});
   }
 
   int profile = -1, zeroCrossing = -1;

@@ -207,6 +207,10 @@ void checkParams(const cv::Mat& image, const ShapeModelParams& p) {
 
 }  // namespace
 
+const char* edgeEstimatorName(EdgeEstimator estimator) {
+  return estimator == EdgeEstimator::ProfileFit ? "profile" : "zero-crossing";
+}
+
 double ShapeModel::radius() const {
   cv::Size2d box;
   return levels.empty() ? 0.0 : extentOf(levels.front().points, box);
@@ -289,17 +293,19 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     model.levels.push_back(std::move(shapeLevel));
   }
 
-  model.finePoints = finePointsOf(templateImage, region, mask.empty() ? cv::Mat() : params.mask,
-                                  model, modelEdges, params.maxPoints, model.edgeEstimator);
+  // `mask` now has the top level's size; the fine points take the caller's.
+  const auto finePoints = [&](EdgeEstimator estimator) {
+    return finePointsOf(templateImage, region, mask.empty() ? cv::Mat() : params.mask, model,
+                        modelEdges, params.maxPoints, estimator);
+  };
+  model.finePoints = finePoints(model.edgeEstimator);
   model.symmetries = findSearchSymmetries(model.levels);
   if (!params.edgeEstimator) {
     // Chosen by the test of edge_estimator_choice.hpp; the other candidate differs only in its
     // subpixel points.
     ShapeModel zeroCrossing = model;
     zeroCrossing.edgeEstimator = EdgeEstimator::FacetZeroCrossing;
-    zeroCrossing.finePoints =
-        finePointsOf(templateImage, region, mask.empty() ? cv::Mat() : params.mask, model,
-                     modelEdges, params.maxPoints, EdgeEstimator::FacetZeroCrossing);
+    zeroCrossing.finePoints = finePoints(EdgeEstimator::FacetZeroCrossing);
     const EdgeEstimatorChoice choice =
         chooseEdgeEstimator(templateImage(region), {&model, &zeroCrossing});
     if (choice.chosen == EdgeEstimator::FacetZeroCrossing) model = std::move(zeroCrossing);

@@ -29,6 +29,9 @@ enum class EdgeEstimator {
   FacetZeroCrossing,
 };
 
+// The estimator's name in commands, JSON and benchmark tables: "profile" or "zero-crossing".
+const char* edgeEstimatorName(EdgeEstimator estimator);
+
 // One estimator's result in the training test that chooses it (edge_estimator_choice.hpp).
 struct EdgeEstimatorTrial {
   EdgeEstimator estimator = EdgeEstimator::ProfileFit;

@@ -308,12 +308,10 @@ int main(int argc, char** argv) {
       "bench_shape%s: scenes blurred by the %s model; model %zu points on level 0, %d levels, "
       "%zu subpixel points, edges by %s\n",
       smoke ? " --smoke" : "", scene::blurModelName(gBlurModel), model.levels[0].points.size(),
-      model.numLevels(), model.finePoints.size(),
-      model.edgeEstimator == EdgeEstimator::ProfileFit ? "profile fit" : "zero crossing");
+      model.numLevels(), model.finePoints.size(), edgeEstimatorName(model.edgeEstimator));
   for (const EdgeEstimatorTrial& t : model.edgeEstimatorTrials)
     std::printf("  training test, %s: turned copies found %.4f px from their poses\n",
-                t.estimator == EdgeEstimator::ProfileFit ? "profile fit" : "zero crossing",
-                t.poseError);
+                edgeEstimatorName(t.estimator), t.poseError);
 
   FindParams find;  // full circle, least squares, min score 0.7, one match
   find.numMatches = 1;

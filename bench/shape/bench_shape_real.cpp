@@ -286,9 +286,8 @@ void photoTable(const std::filesystem::path& data, bool smoke, const FindParams&
         "%.1f | %s (%.3f / %.3f) | %d/%d/%d, %.2f, %.2f |\n",
         c.name.c_str(), model.numLevels(), refCount, c.method.c_str(), t.found, t.missed, t.falses,
         t.worstPos, t.worstAngle, t.lowestScore, ms, n.found, n.missed, n.falses, n.worstPos,
-        n.worstAngle, nccMs,
-        model.edgeEstimator == EdgeEstimator::ProfileFit ? "profile" : "zero crossing", trial[0],
-        trial[1], pf.found, pf.missed, pf.falses, pf.worstPos, pf.worstAngle);
+        n.worstAngle, nccMs, edgeEstimatorName(model.edgeEstimator), trial[0], trial[1], pf.found,
+        pf.missed, pf.falses, pf.worstPos, pf.worstAngle);
     profileSum.found += pf.found, profileSum.missed += pf.missed, profileSum.falses += pf.falses;
     sum.found += t.found, sum.missed += t.missed, sum.falses += t.falses;
     nccSum.found += n.found, nccSum.missed += n.missed, nccSum.falses += n.falses;

@@ -24,10 +24,6 @@ struct ModelOptions {
   bool json = false;
 };
 
-const char* nameOf(EdgeEstimator e) {
-  return e == EdgeEstimator::ProfileFit ? "profile" : "zero-crossing";
-}
-
 // "a,b,c" -> numbers; exactly `count` of them or an InputError naming the option.
 std::vector<double> parseList(const std::string& text, std::size_t count,
                               const std::string& option) {
@@ -97,7 +93,7 @@ void run(const ModelOptions& o) {
     // The training test's pose errors (null for a copy not found: JSON has no infinity).
     nlohmann::json trials = nlohmann::json::object();
     for (const auto& t : model.edgeEstimatorTrials)
-      trials[nameOf(t.estimator)] =
+      trials[edgeEstimatorName(t.estimator)] =
           std::isfinite(t.poseError) ? nlohmann::json(t.poseError) : nlohmann::json();
     printJson(
         {{"model", o.out},
@@ -112,7 +108,7 @@ void run(const ModelOptions& o) {
          {"contrast_high", model.contrastHigh},
          {"min_contrast", model.minContrast},
          {"near_symmetries", symmetries},
-         {"edge_estimator", nameOf(model.edgeEstimator)},
+         {"edge_estimator", edgeEstimatorName(model.edgeEstimator)},
          {"edge_estimator_chosen", o.edgeEstimator == "auto" ? "automatic" : "--edge-estimator"},
          {"edge_estimator_trials", trials}});
   } else {
@@ -120,7 +116,7 @@ void run(const ModelOptions& o) {
               << model.levels.front().points.size() << " points on level 0, "
               << model.finePoints.size() << " subpixel points, angle step "
               << degrees(model.levels.front().angleStep) << " deg, edges by "
-              << nameOf(model.edgeEstimator) << "\n";
+              << edgeEstimatorName(model.edgeEstimator) << "\n";
   }
 }
 
