@@ -135,6 +135,43 @@ struct Finisher {
     return shape_detail::refinedScore(field.directions(), model, pose, params.polarity);
   }
 
+  struct Refinement {
+    shape_detail::Refined fit;
+    bool fittedFully;  // see shape_detail::RefinementOutcome
+  };
+
+  // The least-squares refinement from `start`. A model with a scale range fits its scale. A
+  // fixed-scale model may still meet a part a percent larger or smaller (lens, distance): it is
+  // refined both with the scale free and at the model's scale, and the fit that lays more of the
+  // model's points on edges within the tolerance the closer of the two reached (its own final
+  // cut-off) is the part's. The other one has let something else stand in for part of the part:
+  // an occluder's border parallel to a hidden edge pulls a free scale 1-2% and the pose a pixel
+  // or more with it, at ten times the residual of the fit at the model's scale; at the model's
+  // scale, a part truly a percent larger fits at neither end. A free scale that wins but goes
+  // beyond the tolerance is not followed: the part is held at the model's scale and is judged
+  // as not fitted fully.
+  Refinement refineFrom(const shape_detail::LeastSquaresRefinement& refinement,
+                        const Pose2D& start) const {
+    const double tolerance = params.refineScaleTolerance;
+    if (scaleRange) return {refinement.refine(start, true), true};
+    if (tolerance <= 0.0) return {refinement.refine(start, false), false};
+    const shape_detail::Refined freeScale = refinement.refine(start, true);
+    const double scaleChange = std::abs(freeScale.pose.scale / start.scale - 1.0);
+    // An exact free fit at a scale within two standard errors of the model's leaves nothing for
+    // the fit at the model's scale to find.
+    if (freeScale.exact() && scaleChange <= 2.0 * freeScale.scaleSigma && scaleChange <= tolerance)
+      return {freeScale, true};
+    const shape_detail::Refined modelScale = refinement.refine(start, false);
+    if (!freeScale.status.ok()) return {modelScale, false};
+    const bool freeWithin = scaleChange <= tolerance;
+    if (!modelScale.status.ok()) return {freeWithin ? freeScale : modelScale, freeWithin};
+    const double cutoff = std::min(freeScale.cutoff, modelScale.cutoff);
+    const bool freeFits =
+        refinement.support(freeScale, cutoff) > refinement.support(modelScale, cutoff);
+    if (!freeFits) return {modelScale, true};
+    return {freeWithin ? freeScale : modelScale, freeWithin};
+  }
+
   std::optional<Finished> finish(Candidate c) const {
     field.ensure(placedBox(box, {c.x, c.y, c.angle, c.scale}).boundingRect() + cv::Size(8, 8) -
                  cv::Point(4, 4));
@@ -152,34 +189,16 @@ struct Finisher {
     if (params.subpixel != SubpixelMode::LeastSquares ||
         interpolated.score < params.minScore - kSkipRefinement)
       return interpolated;
-    // A fixed-scale model may still meet a part a percent larger or smaller (lens, distance):
-    // the refinement follows it within the tolerance, or keeps the scale when it would go
-    // farther.
-    const double tolerance = params.refineScaleTolerance;
     const cv::Rect roi = placedBox(box, start).boundingRect() + cv::Size(8, 8) - cv::Point(4, 4);
-    const bool fitScale = scaleRange || tolerance > 0.0;
-    shape_detail::Refined r =
-        shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, fitScale);
-    const bool scaleMisfit =
-        !scaleRange && r.status.ok() && std::abs(r.pose.scale / start.scale - 1.0) > tolerance;
-    // A refit at the start's scale that lays at least as many points on edges as the scale the
-    // free fit wanted shows that scale was not the part's (an occluder's or a neighbour's edges
-    // pulled it): the refit fits the part fully. A part truly beyond the tolerance fits better
-    // at its own scale, and the refit then fits nowhere exactly.
-    double misfitSupport = 0.0;
-    if (scaleMisfit) {
-      misfitSupport = r.support;
-      r = shape_detail::refineLeastSquares(image, model, roi, start, params.polarity, false);
-    }
-    const bool refitFits = scaleMisfit && r.status.ok() && r.support >= misfitSupport;
+    const shape_detail::LeastSquaresRefinement refinement(image, model, roi, params.polarity);
+    const auto [r, fittedFully] = refineFrom(refinement, start);
     // A refinement that wanders off by more than the search's own uncertainty has locked onto
     // something else.
     if (!r.status.ok() || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0)
       return interpolated;
     const Finished refined{r.pose, scoreAt(r.pose), r.residual};
     const shape_detail::RefinementOutcome outcome{interpolated.score, refined.score, r.startSupport,
-                                                  r.support,
-                                                  fitScale && (!scaleMisfit || refitFits)};
+                                                  r.support,          fittedFully,   r.exact()};
     if (!shape_detail::keepsRefinedPose(outcome)) return interpolated;
     return Finished{refined.pose, shape_detail::keptRefinementScore(outcome), refined.residual};
   }

@@ -3,8 +3,12 @@
 // points against the image's Facet-model subpixel edges, minimising point-to-line distances
 // along the image edge normals in position, angle and optionally scale.
 
+#include <vector>
+
+#include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/geometry/pose2d.hpp"
 #include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model.hpp"
@@ -18,6 +22,16 @@ enum class RefinementFailure {
   TooFewCorrespondences,  // too few model points met image edges; the pose is the start pose
 };
 
+// The Tukey cut-off of the refinement's last steps is 4.685 robust sigmas of the pairs' distances,
+// clamped to [kMinCutoff, kMaxCutoff] pixels.
+inline constexpr double kMinCutoff = 0.15;
+inline constexpr double kMaxCutoff = 1.5;
+// A fit whose cut-off ends at or below this lays the model's points on edges within a median of
+// 0.03 px: what subpixel edges reach on a sharp image, and what a fit onto a part's own contour
+// reaches there. Fits locked onto texture or a neighbour's edges end at 1.2-1.5 px (a photograph
+// of LEDs); on rendered scenes, fits of the part end at the floor, 0.15 px.
+inline constexpr double kExactFitCutoff = 0.2;
+
 struct Refined {
   Pose2D pose;
   double residual = 0.0;  // weighted RMS point-to-line distance, pixels
@@ -27,10 +41,47 @@ struct Refined {
   // that lowers it has made the pose worse.
   double support = 0.0;
   double startSupport = 0.0;
+  // The distance across an edge beyond which a point no longer counted in the last step, pixels:
+  // it follows the fit's own residuals, so it tells how closely the fit lays the model on edges.
+  double cutoff = 0.0;
+  // With the scale free: the standard error of the relative scale, from the last step's normal
+  // equations and residual (0 otherwise).
+  double scaleSigma = 0.0;
+  // Polarity IgnoreGlobal: the sign of the part's contrast the first pass found (1 or -1).
+  double contrastSign = 1.0;
+  [[nodiscard]] bool exact() const { return status.ok() && cutoff <= kExactFitCutoff; }
 };
 
-// Refines `pose` using the image's edges inside `roi` (image pixels, clipped to the image).
-Refined refineLeastSquares(const cv::Mat& image, const ShapeModel& model, cv::Rect roi, Pose2D pose,
-                           Polarity polarity, bool withScale);
+// The image's subpixel edges inside one match's region, detected once for the refinements tried
+// from there (with the scale free and at the model's scale).
+class LeastSquaresRefinement {
+ public:
+  // `roi`: image pixels, clipped to the image.
+  LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model, cv::Rect roi,
+                         Polarity polarity);
+
+  Refined refine(Pose2D start, bool withScale) const;
+
+  // How well the model's points lie on edges at the fit's pose, each counted by Tukey's biweight
+  // of its distance across the edge: 1 on it, 0 from `cutoff` pixels away.
+  double support(const Refined& fit, double cutoff) const;
+
+ private:
+  struct Pair {
+    Eigen::Vector4d J;
+    double r;
+  };
+  // Each model point placed at `at` paired with the nearest direction-agreeing edge point within
+  // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
+  double correspond(const Pose2D& at, int radius, bool anySign, double sign,
+                    std::vector<Pair>& pairs) const;
+  double support(const Pose2D& at, double sign, double cutoff) const;
+
+  const ShapeModel& model_;
+  Polarity polarity_;
+  cv::Rect roi_;
+  EdgeContours edges_;
+  cv::Mat cell_;  // index of the strongest edge point in each pixel of the region, -1 for none
+};
 
 }  // namespace facet::shape_detail

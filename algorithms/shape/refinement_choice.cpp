@@ -6,7 +6,7 @@ namespace facet::shape_detail {
 
 bool keepsRefinedPose(const RefinementOutcome& o) {
   if (!o.fittedFully) return o.refinedScore >= o.startScore;
-  if (o.refinedScore < o.startScore - kMaxRefinementScoreLoss) return false;
+  if (!o.exactFit && o.refinedScore < o.startScore - kMaxRefinementScoreLoss) return false;
   return o.refinedSupport >= o.startSupport;
 }
 

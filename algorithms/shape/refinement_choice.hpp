@@ -16,6 +16,9 @@ struct RefinementOutcome {
   // many points on edges (the scale was pulled by something else). Otherwise (fixed scale, or a
   // part truly beyond the tolerance) it fits nowhere exactly.
   bool fittedFully = false;
+  // The refinement lays the model's points on edges as closely as subpixel edges are located on a
+  // sharp image (least_squares_refinement.hpp, kExactFitCutoff).
+  bool exactFit = false;
 };
 
 // The most score a refinement that fits the part may give up: what a displaced feature (a hole
@@ -26,8 +29,12 @@ inline constexpr double kMaxRefinementScoreLoss = 0.1;
 
 // True when the refined pose is kept. Where the refinement fitted the part fully, the support
 // decides within kMaxRefinementScoreLoss: a pose tilted towards a displaced feature may score a
-// little higher than the one that fits the rest of the part. Elsewhere the score decides. The
-// minimum score plays no part: it filters matches, it does not choose their poses.
+// little higher than the one that fits the rest of the part. An exact fit may lose more: the
+// score tolerates a pixel or two, and next to an occluder a pose 1-2 px off collects the
+// occluder's border and outscores the true one by 0.1-0.14, while the refinement from there lays
+// the visible part's points on its edges within a few hundredths of a pixel (a fit locked onto
+// texture or a neighbour's edges lays them tenths of a pixel off). Elsewhere the score decides.
+// The minimum score plays no part: it filters matches, it does not choose their poses.
 bool keepsRefinedPose(const RefinementOutcome& outcome);
 
 // The score a match reports when its refined pose is kept: the better of the two. The refinement
