@@ -154,7 +154,12 @@ struct Finisher {
                         const Pose2D& start) const {
     const double tolerance = params.refineScaleTolerance;
     if (scaleRange) return {refinement.refine(start, true), true};
-    if (tolerance <= 0.0) return {refinement.refine(start, false), false};
+    if (tolerance <= 0.0) {
+      // The scale is held: the fit judges whether the part has it. An exact fit does (a part a
+      // percent off fits at neither end, its points tenths of a pixel off edges).
+      const shape_detail::Refined modelScale = refinement.refine(start, false);
+      return {modelScale, modelScale.exact()};
+    }
     const shape_detail::Refined freeScale = refinement.refine(start, true);
     const double scaleChange = std::abs(freeScale.pose.scale / start.scale - 1.0);
     // An exact free fit at a scale within two standard errors of the model's leaves nothing for

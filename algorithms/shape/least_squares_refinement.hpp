@@ -27,10 +27,11 @@ enum class RefinementFailure {
 inline constexpr double kMinCutoff = 0.15;
 inline constexpr double kMaxCutoff = 1.5;
 // A fit whose cut-off ends at or below this lays the model's points on edges within a median of
-// 0.03 px: what subpixel edges reach on a sharp image, and what a fit onto a part's own contour
-// reaches there. Fits locked onto texture or a neighbour's edges end at 1.2-1.5 px (a photograph
-// of LEDs); on rendered scenes, fits of the part end at the floor, 0.15 px.
-inline constexpr double kExactFitCutoff = 0.2;
+// 0.04 px: what a fit onto a part's own contour reaches on a sharp image (0.15-0.24 px on rendered
+// scenes, occluded or not). Fits locked onto texture or a neighbour's edges end at 1.2-1.5 px (a
+// photograph of LEDs); so do correct fits on photographs (0.5-1.5 px), which are therefore never
+// judged exact.
+inline constexpr double kExactFitCutoff = 0.3;
 
 struct Refined {
   Pose2D pose;
