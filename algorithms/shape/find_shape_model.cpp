@@ -167,7 +167,7 @@ struct Finisher {
     if (freeScale.exact() && scaleChange <= 2.0 * freeScale.scaleSigma && scaleChange <= tolerance)
       return {freeScale, true};
     const shape_detail::Refined modelScale = refinement.refine(start, false);
-    if (!freeScale.status.ok()) return {modelScale, false};
+    if (!freeScale.status.ok()) return {modelScale, modelScale.exact()};
     const bool freeWithin = scaleChange <= tolerance;
     if (!modelScale.status.ok()) return {freeWithin ? freeScale : modelScale, freeWithin};
     const double cutoff = std::min(freeScale.cutoff, modelScale.cutoff);
@@ -202,8 +202,12 @@ struct Finisher {
     if (!r.status.ok() || std::hypot(r.pose.x - start.x, r.pose.y - start.y) >= 3.0)
       return interpolated;
     const Finished refined{r.pose, scoreAt(r.pose), r.residual};
-    const shape_detail::RefinementOutcome outcome{interpolated.score, refined.score, r.startSupport,
-                                                  r.support,          fittedFully,   r.exact()};
+    const shape_detail::RefinementOutcome outcome{.startScore = interpolated.score,
+                                                  .refinedScore = refined.score,
+                                                  .startSupport = r.startSupport,
+                                                  .refinedSupport = r.support,
+                                                  .fittedFully = fittedFully,
+                                                  .exactFit = r.exact()};
     if (!shape_detail::keepsRefinedPose(outcome)) return interpolated;
     return Finished{refined.pose, shape_detail::keptRefinementScore(outcome), refined.residual};
   }
