@@ -149,7 +149,8 @@ struct Finisher {
   // or more with it, at ten times the residual of the fit at the model's scale; at the model's
   // scale, a part truly a percent larger fits at neither end. A free scale that wins but goes
   // beyond the tolerance is not followed: the part is held at the model's scale and is judged
-  // as not fitted fully.
+  // as not fitted fully. Where neither fit is exact, a third leaves out the points hidden at the
+  // start (below).
   Refinement refineFrom(const shape_detail::LeastSquaresRefinement& refinement,
                         const Pose2D& start) const {
     const double tolerance = params.refineScaleTolerance;
@@ -167,8 +168,27 @@ struct Finisher {
     if (freeScale.exact() && scaleChange <= 2.0 * freeScale.scaleSigma && scaleChange <= tolerance)
       return {freeScale, true};
     const shape_detail::Refined modelScale = refinement.refine(start, false);
-    if (!freeScale.status.ok()) return {modelScale, modelScale.exact()};
     const bool freeWithin = scaleChange <= tolerance;
+    if (!freeScale.exact() && !modelScale.exact()) {
+      // Neither fit is exact (a photograph, or much of the part hidden): the points with no image
+      // gradient near them at the start (hidden) are left out of a third fit, so that an
+      // occluder's border cannot pull it, and it is kept where it lays more points on edges than
+      // the other fits within the tolerance.
+      const shape_detail::Refined visibleOnly = refinement.refine(
+          start, true, shape_detail::pointsNearGradients(field.directions(), model, start));
+      if (visibleOnly.status.ok() &&
+          std::abs(visibleOnly.pose.scale / start.scale - 1.0) <= tolerance) {
+        double cutoff = visibleOnly.cutoff;
+        if (modelScale.status.ok()) cutoff = std::min(cutoff, modelScale.cutoff);
+        if (freeScale.status.ok() && freeWithin) cutoff = std::min(cutoff, freeScale.cutoff);
+        const double support = refinement.support(visibleOnly, cutoff);
+        if ((!modelScale.status.ok() || support > refinement.support(modelScale, cutoff)) &&
+            (!freeScale.status.ok() || !freeWithin ||
+             support > refinement.support(freeScale, cutoff)))
+          return {visibleOnly, true};
+      }
+    }
+    if (!freeScale.status.ok()) return {modelScale, modelScale.exact()};
     if (!modelScale.status.ok()) return {freeWithin ? freeScale : modelScale, freeWithin};
     const double cutoff = std::min(freeScale.cutoff, modelScale.cutoff);
     const bool freeFits =

@@ -59,9 +59,11 @@ struct FindParams {
   // Least squares with a model of fixed scale: the refinement may also adjust the scale by up to
   // this relative amount (real parts and lenses differ from the template by a percent or so; a
   // fixed scale would pull the position towards one side). Where the free scale may have been
-  // pulled (its fit is not exact), the part is also refined at the model's scale and the fit that
-  // lays more of the model on edges is kept (an occluder's border can stand in for a hidden edge
-  // at a scale a percent or two off). The match reports the scale it kept.
+  // pulled (its fit is not exact), the part is also refined at the model's scale, and where that
+  // is not exact either, with the scale free on the points that have image gradients near them
+  // at the start only; the fit that lays more of the model on edges is kept (an occluder's border
+  // can stand in for a hidden edge at a scale a percent or two off). The match reports the scale
+  // it kept.
   // 0 = keep the scale fixed. Default 0.02.
   double refineScaleTolerance = 0.02;
   // Number of pyramid levels used, 0 = all of the model's. Fewer levels = slower, more robust.

@@ -35,12 +35,15 @@ LeastSquaresRefinement::LeastSquaresRefinement(const cv::Mat& image, const Shape
 }
 
 double LeastSquaresRefinement::correspond(const Pose2D& at, int radius, bool anySign, double sign,
-                                          std::vector<Pair>& pairs) const {
+                                          std::vector<Pair>& pairs,
+                                          const std::vector<std::uint8_t>& visible) const {
   const double c = std::cos(at.angle), s = std::sin(at.angle);
   const Pose2D::Map toImage = at.map();
   double polaritySum = 0.0;
   pairs.clear();
-  for (const auto& mp : model_.finePoints) {
+  for (std::size_t i = 0; i < model_.finePoints.size(); ++i) {
+    if (!visible.empty() && !visible[i]) continue;
+    const auto& mp = model_.finePoints[i];
     const double px = mp.position.x, py = mp.position.y;
     const cv::Point2d q = toImage({px, py});
     const double dx = c * mp.direction.x + s * mp.direction.y;
@@ -96,7 +99,8 @@ double LeastSquaresRefinement::support(const Refined& fit, double cutoff) const 
   return support(fit.pose, fit.contrastSign, cutoff);
 }
 
-Refined LeastSquaresRefinement::refine(Pose2D pose, bool withScale) const {
+Refined LeastSquaresRefinement::refine(Pose2D pose, bool withScale,
+                                       const std::vector<std::uint8_t>& visible) const {
   const Pose2D start = pose;
   Refined result{pose, 0.0, {RefinementFailure::TooFewCorrespondences, {}}};
   if (edges_.points.size() < 6) return result;
@@ -108,7 +112,8 @@ Refined LeastSquaresRefinement::refine(Pose2D pose, bool withScale) const {
   std::vector<double> absResiduals;
   for (int iteration = 0; iteration < 15; ++iteration) {
     const int radius = iteration < 2 ? 3 - iteration : 1;
-    const double polaritySum = correspond(pose, radius, iteration == 0 && decideSign, sign, pairs);
+    const double polaritySum =
+        correspond(pose, radius, iteration == 0 && decideSign, sign, pairs, visible);
     if (iteration == 0 && decideSign) sign = polaritySum < 0 ? -1.0 : 1.0;
     if (pairs.size() < 6) break;  // result keeps the last pose that stood on enough pairs
 

@@ -3,6 +3,7 @@
 // points against the image's Facet-model subpixel edges, minimising point-to-line distances
 // along the image edge normals in position, angle and optionally scale.
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -61,7 +62,8 @@ class LeastSquaresRefinement {
   LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model, cv::Rect roi,
                          Polarity polarity);
 
-  Refined refine(Pose2D start, bool withScale) const;
+  // `visible`: one entry per fine point, 0 for a point that takes no part; empty: every point.
+  Refined refine(Pose2D start, bool withScale, const std::vector<std::uint8_t>& visible = {}) const;
 
   // How well the model's points lie on edges at the fit's pose, each counted by Tukey's biweight
   // of its distance across the edge: 1 on it, 0 from `cutoff` pixels away.
@@ -75,7 +77,7 @@ class LeastSquaresRefinement {
   // Each model point placed at `at` paired with the nearest direction-agreeing edge point within
   // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
   double correspond(const Pose2D& at, int radius, bool anySign, double sign,
-                    std::vector<Pair>& pairs) const;
+                    std::vector<Pair>& pairs, const std::vector<std::uint8_t>& visible = {}) const;
   double support(const Pose2D& at, double sign, double cutoff) const;
 
   const ShapeModel& model_;

@@ -89,4 +89,20 @@ double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D&
   return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) / n;
 }
 
+std::vector<std::uint8_t> pointsNearGradients(const cv::Mat& field, const ShapeModel& model,
+                                              const Pose2D& pose) {
+  std::vector<std::uint8_t> near(model.finePoints.size(), 0);
+  const Pose2D::Map toImage = pose.map();
+  for (std::size_t i = 0; i < near.size(); ++i) {
+    const cv::Point2d q = toImage(model.finePoints[i].position);
+    const int x = cvRound(q.x), y = cvRound(q.y);
+    for (int v = std::max(y - 1, 0); v <= std::min(y + 1, field.rows - 1) && !near[i]; ++v) {
+      const Direction* row = field.ptr<Direction>(v);
+      for (int u = std::max(x - 1, 0); u <= std::min(x + 1, field.cols - 1); ++u)
+        if (row[u][0] != 0 || row[u][1] != 0) near[i] = 1;
+    }
+  }
+  return near;
+}
+
 }  // namespace facet::shape_detail

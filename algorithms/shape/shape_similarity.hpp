@@ -2,6 +2,7 @@
 // Steger's similarity measure (internal to facet_shape): the mean normalised dot product of the
 // model's gradient directions, turned into the image, and the image's gradient directions.
 
+#include <cstdint>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -33,5 +34,10 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
 // interpolated bilinearly: the score of a refined match.
 double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
                     Polarity polarity);
+
+// Which of the model's subpixel points have an image gradient (any direction above the field's
+// contrast) within a pixel of where `pose` puts them. One entry per fine point, 1 = near one.
+std::vector<std::uint8_t> pointsNearGradients(const cv::Mat& field, const ShapeModel& model,
+                                              const Pose2D& pose);
 
 }  // namespace facet::shape_detail

@@ -5,6 +5,8 @@
 #include <random>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "tests/shape/bracket_scenes.hpp"
@@ -427,6 +429,48 @@ TEST(FindShapeModel, AHeldScaleKeepsAnExactRefinementBesideAnOccluder) {
     EXPECT_LT(std::hypot(m[0].x - sc.truth.x, m[0].y - sc.truth.y), 0.15) << "seed " << seed;
     EXPECT_EQ(m[0].scale, 1.0) << "seed " << seed;
     EXPECT_GT(m[0].residual, 0.0) << "seed " << seed << ": the refined pose, not the start";
+  }
+}
+
+// A photograph (tests/data/photos, stuff_lighter: the lighter turned by a known pose, scale 1.01)
+// with a third of the part hidden behind a flat plate, from each side in turn. Hidden from the
+// left, the plate's border pulled the free scale to 0.94 and the fit at the model's scale lay
+// 0.45 px off; the pose returned was 0.50 px off. Neither fit is exact on a photograph, so a
+// third one leaves out the points with no image gradient near them at the start (0.17 px). With a
+// plate of grey 128 instead of the photograph's median the same side ends 0.26 px off at scale
+// 1.004: the border still pulls a little.
+TEST(FindShapeModel, AnOccludersBorderOnAPhotographDoesNotPullThePose) {
+  const std::string dir = FACET_TEST_DATA_DIR "/photos/";
+  const cv::Mat templ = cv::imread(dir + "stuff_lighter_template.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat scene = cv::imread(dir + "stuff_lighter_scene.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(templ.empty() || scene.empty()) << "missing " << dir;
+  const Pose2D truth{216.507, 334.066, radians(-52.0), 1.01};  // tests/data/photos/cases.txt
+  const ShapeModel model = createShapeModel(templ);
+  const double hw = templ.cols / 2.0 + 4, hh = templ.rows / 2.0 + 4;
+  const double cx = 2 * hw / 3, cy = 2 * hh / 3;
+  const std::vector<std::vector<cv::Point2d>> plates = {
+      {{-hw, -hh}, {-hw + cx, -hh}, {-hw + cx, hh}, {-hw, hh}},
+      {{hw - cx, -hh}, {hw, -hh}, {hw, hh}, {hw - cx, hh}},
+      {{-hw, -hh}, {hw, -hh}, {hw, -hh + cy}, {-hw, -hh + cy}},
+      {{-hw, hh - cy}, {hw, hh - cy}, {hw, hh}, {-hw, hh}}};
+  // The plate's grey: the photograph's median, as in bench_shape_real.
+  std::vector<uchar> grey(scene.begin<uchar>(), scene.end<uchar>());
+  std::nth_element(grey.begin(), grey.begin() + grey.size() / 2, grey.end());
+  const double plateGrey = grey[grey.size() / 2];
+  FindParams p;
+  p.minScore = 0.5;
+  for (std::size_t k = 0; k < plates.size(); ++k) {
+    cv::Mat hidden = scene.clone();
+    std::vector<cv::Point> poly;
+    for (const cv::Point2d& q : plates[k]) {
+      const cv::Point2d v = truth.apply(q);
+      poly.emplace_back(cvRound(v.x * 16), cvRound(v.y * 16));
+    }
+    cv::fillConvexPoly(hidden, poly, cv::Scalar(plateGrey), cv::LINE_AA, 4);
+    const auto m = findShapeModel(hidden, model, p);
+    ASSERT_EQ(m.size(), 1u) << "side " << k;
+    EXPECT_LT(std::hypot(m[0].x - truth.x, m[0].y - truth.y), 0.25) << "side " << k;
+    EXPECT_NEAR(m[0].scale, truth.scale, 0.005) << "side " << k;
   }
 }
 
