@@ -31,6 +31,7 @@
 #include "algorithms/shape/shape_model_file.hpp"
 #include "bench/shape/pyramid_ncc.hpp"
 #include "tests/shape/bracket_scenes.hpp"
+#include "tests/shape/photo_occlusion.hpp"
 
 namespace {
 
@@ -303,14 +304,21 @@ void photoTable(const std::filesystem::path& data, bool smoke, const FindParams&
 // texture beside an occluder's straight border, which can stand in for a hidden edge of the
 // part. Minimum score 0.5 for both matchers, as in bench_shape's occluded rows.
 void occludedPhotoTable(const std::filesystem::path& data, bool smoke) {
-  constexpr double kHidden = 1.0 / 3.0;
   std::printf(
       "\n| photograph, a third hidden from each side | scenes | facet found | facet pos RMS px | "
       "facet pos max px | NCC found | NCC pos RMS px | NCC pos max px | facet pos px: left, right, "
       "top, bottom hidden |\n"
       "|---|---|---|---|---|---|---|---|---|\n");
+  auto rms = [](const std::vector<double>& v) {
+    double s = 0;
+    for (double e : v) s += e * e;
+    return v.empty() ? NAN : std::sqrt(s / static_cast<double>(v.size()));
+  };
+  auto worst = [](const std::vector<double>& v) {
+    return v.empty() ? NAN : *std::max_element(v.begin(), v.end());
+  };
   std::vector<double> allOurs, allNcc;
-  int scenes = 0, foundOurs = 0, foundNcc = 0;
+  int scenes = 0;
   for (const auto& c : readCases(data / "cases.txt")) {
     if (c.method != "warp" || c.refs.size() != 1) continue;
     const cv::Mat templ = cv::imread((data / c.templ).string(), cv::IMREAD_GRAYSCALE);
@@ -318,70 +326,35 @@ void occludedPhotoTable(const std::filesystem::path& data, bool smoke) {
     if (templ.empty() || scene.empty()) continue;
     const ShapeModel model = createShapeModel(templ);
     const Pose2D& truth = c.refs[0];
-    std::vector<double> med(scene.begin<uchar>(), scene.end<uchar>());
-    std::nth_element(med.begin(), med.begin() + med.size() / 2, med.end());
-    const double grey = med[med.size() / 2];
-    // The template's box about its reference point (its centre), a few pixels wider.
-    const double hw = templ.cols / 2.0 + 4, hh = templ.rows / 2.0 + 4;
-    const double cutX = 2 * hw * kHidden, cutY = 2 * hh * kHidden;
-    const std::vector<std::vector<cv::Point2d>> plates = {
-        {{-hw, -hh}, {-hw + cutX, -hh}, {-hw + cutX, hh}, {-hw, hh}},
-        {{hw - cutX, -hh}, {hw, -hh}, {hw, hh}, {hw - cutX, hh}},
-        {{-hw, -hh}, {hw, -hh}, {hw, -hh + cutY}, {-hw, -hh + cutY}},
-        {{-hw, hh - cutY}, {hw, hh - cutY}, {hw, hh}, {-hw, hh}}};
     std::vector<double> ours, ncc;
     std::string perSide;
     int n = 0;
-    for (const auto& plate : plates) {
+    for (const testing::HiddenSide side : testing::kHiddenSides) {
       if (smoke && n > 0) break;
-      cv::Mat hidden = scene.clone();
-      constexpr int kShift = 4;  // subpixel vertices for the anti-aliased border
-      std::vector<cv::Point> poly;
-      for (const cv::Point2d& q : plate) {
-        const cv::Point2d v = truth.apply(q);
-        poly.emplace_back(cvRound(v.x * (1 << kShift)), cvRound(v.y * (1 << kShift)));
-      }
-      cv::fillConvexPoly(hidden, poly, cv::Scalar(grey), cv::LINE_AA, kShift);
+      const cv::Mat hidden = testing::hideSide(scene, templ.size(), truth, side);
       ++n;
       FindParams p;
       p.minScore = 0.5;
       const auto m = findShapeModel(hidden, model, p);
       const bool hit = !m.empty() && near(m[0].x, m[0].y, m[0].angle, truth);
       if (hit) ours.push_back(std::hypot(m[0].x - truth.x, m[0].y - truth.y));
-      char text[32];
-      std::snprintf(text, sizeof text, "%s%s", n > 1 ? ", " : "",
-                    hit ? cv::format("%.3f", ours.back()).c_str() : "-");
-      perSide += text;
+      perSide += (n > 1 ? ", " : "") + (hit ? cv::format("%.3f", ours.back()) : std::string("-"));
       if (!smoke) {
         const auto t = bench::findByPyramidNcc(hidden, templ, 1, 0.5);
         if (!t.empty() && near(t[0].x, t[0].y, radians(t[0].angleDeg), truth))
           ncc.push_back(std::hypot(t[0].x - truth.x, t[0].y - truth.y));
       }
     }
-    auto rms = [](const std::vector<double>& v) {
-      double s = 0;
-      for (double e : v) s += e * e;
-      return v.empty() ? NAN : std::sqrt(s / static_cast<double>(v.size()));
-    };
-    auto worst = [](const std::vector<double>& v) {
-      return v.empty() ? NAN : *std::max_element(v.begin(), v.end());
-    };
     const std::string nccFound = smoke ? "not run" : std::to_string(ncc.size());
     std::printf("| %s | %d | %zu | %.3f | %.3f | %s | %.3f | %.3f | %s |\n", c.name.c_str(), n,
                 ours.size(), rms(ours), worst(ours), nccFound.c_str(), rms(ncc), worst(ncc),
                 perSide.c_str());
     scenes += n;
-    foundOurs += static_cast<int>(ours.size());
-    foundNcc += static_cast<int>(ncc.size());
     allOurs.insert(allOurs.end(), ours.begin(), ours.end());
     allNcc.insert(allNcc.end(), ncc.begin(), ncc.end());
   }
-  double so = 0, sn = 0;
-  for (double e : allOurs) so += e * e;
-  for (double e : allNcc) sn += e * e;
-  std::printf("| all | %d | %d | %.3f | | %d | %.3f | | |\n", scenes, foundOurs,
-              allOurs.empty() ? NAN : std::sqrt(so / allOurs.size()), foundNcc,
-              allNcc.empty() ? NAN : std::sqrt(sn / allNcc.size()));
+  std::printf("| all | %d | %zu | %.3f | | %zu | %.3f | | |\n", scenes, allOurs.size(),
+              rms(allOurs), allNcc.size(), rms(allNcc));
 }
 
 }  // namespace

@@ -6,11 +6,11 @@
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
-#include <opencv2/imgproc.hpp>
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "tests/shape/bracket_scenes.hpp"
 #include "tests/shape/nested_part_scenes.hpp"
+#include "tests/shape/photo_occlusion.hpp"
 
 namespace facet {
 namespace {
@@ -446,27 +446,10 @@ TEST(FindShapeModel, AnOccludersBorderOnAPhotographDoesNotPullThePose) {
   ASSERT_FALSE(templ.empty() || scene.empty()) << "missing " << dir;
   const Pose2D truth{216.507, 334.066, radians(-52.0), 1.01};  // tests/data/photos/cases.txt
   const ShapeModel model = createShapeModel(templ);
-  const double hw = templ.cols / 2.0 + 4, hh = templ.rows / 2.0 + 4;
-  const double cx = 2 * hw / 3, cy = 2 * hh / 3;
-  const std::vector<std::vector<cv::Point2d>> plates = {
-      {{-hw, -hh}, {-hw + cx, -hh}, {-hw + cx, hh}, {-hw, hh}},
-      {{hw - cx, -hh}, {hw, -hh}, {hw, hh}, {hw - cx, hh}},
-      {{-hw, -hh}, {hw, -hh}, {hw, -hh + cy}, {-hw, -hh + cy}},
-      {{-hw, hh - cy}, {hw, hh - cy}, {hw, hh}, {-hw, hh}}};
-  // The plate's grey: the photograph's median, as in bench_shape_real.
-  std::vector<uchar> grey(scene.begin<uchar>(), scene.end<uchar>());
-  std::nth_element(grey.begin(), grey.begin() + grey.size() / 2, grey.end());
-  const double plateGrey = grey[grey.size() / 2];
   FindParams p;
   p.minScore = 0.5;
-  for (std::size_t k = 0; k < plates.size(); ++k) {
-    cv::Mat hidden = scene.clone();
-    std::vector<cv::Point> poly;
-    for (const cv::Point2d& q : plates[k]) {
-      const cv::Point2d v = truth.apply(q);
-      poly.emplace_back(cvRound(v.x * 16), cvRound(v.y * 16));
-    }
-    cv::fillConvexPoly(hidden, poly, cv::Scalar(plateGrey), cv::LINE_AA, 4);
+  for (std::size_t k = 0; k < std::size(testing::kHiddenSides); ++k) {
+    const cv::Mat hidden = testing::hideSide(scene, templ.size(), truth, testing::kHiddenSides[k]);
     const auto m = findShapeModel(hidden, model, p);
     ASSERT_EQ(m.size(), 1u) << "side " << k;
     EXPECT_LT(std::hypot(m[0].x - truth.x, m[0].y - truth.y), 0.25) << "side " << k;
