@@ -77,50 +77,47 @@ double integrate(const double* y, int n, double x0, double h, double lo, double 
   return 0.5 * ((yl + y[il + 1]) * (il + 1 - fl) + inner + (y[ih] + yh) * (fh - ih)) * h;
 }
 
-// Solves the 4x4 normal equations A d = r (upper triangle of A given) by Cholesky; false when A
-// is not positive definite.
-bool solveCholesky(const double a[10], const double r[4], double d[4]) {
-  // a: (0,0) (0,1) (0,2) (0,3) (1,1) (1,2) (1,3) (2,2) (2,3) (3,3)
-  const double p0 = a[0];
-  if (!(p0 > 0)) return false;
-  const double l00 = std::sqrt(p0);
-  const double l10 = a[1] / l00, l20 = a[2] / l00, l30 = a[3] / l00;
-  const double p1 = a[4] - l10 * l10;
-  if (!(p1 > 0)) return false;
-  const double l11 = std::sqrt(p1);
-  const double l21 = (a[5] - l20 * l10) / l11, l31 = (a[6] - l30 * l10) / l11;
-  const double p2 = a[7] - l20 * l20 - l21 * l21;
-  if (!(p2 > 0)) return false;
-  const double l22 = std::sqrt(p2);
-  const double l32 = (a[8] - l30 * l20 - l31 * l21) / l22;
-  const double p3 = a[9] - l30 * l30 - l31 * l31 - l32 * l32;
-  if (!(p3 > 0)) return false;
-  const double l33 = std::sqrt(p3);
-  // L u = r, then L^T d = u.
-  const double u0 = r[0] / l00;
-  const double u1 = (r[1] - l10 * u0) / l11;
-  const double u2 = (r[2] - l20 * u0 - l21 * u1) / l22;
-  const double u3 = (r[3] - l30 * u0 - l31 * u1 - l32 * u2) / l33;
-  d[3] = u3 / l33;
-  d[2] = (u2 - l32 * d[3]) / l22;
-  d[1] = (u1 - l21 * d[2] - l31 * d[3]) / l11;
-  d[0] = (u0 - l10 * d[1] - l20 * d[2] - l30 * d[3]) / l00;
-  return true;
-}
+// The step fit's unknowns: the level before the edge, the step, the edge, its width, and the
+// background's slope along the profile.
+constexpr int kUnknowns = 5;
+using Normal5 = Eigen::Matrix<double, kUnknowns, kUnknowns>;
+using Vector5 = Eigen::Matrix<double, kUnknowns, 1>;
 
-// A degenerate window (flat, or too few samples on one side): the pivoting LDLT's answer.
-void solveDegenerate(const double a[10], const double r[4], double d[4]) {
-  Eigen::Matrix4d m;
-  m << a[0], a[1], a[2], a[3], a[1], a[4], a[5], a[6], a[2], a[5], a[7], a[8], a[3], a[6], a[8],
-      a[9];
-  const Eigen::Vector4d x = m.ldlt().solve(Eigen::Vector4d(r[0], r[1], r[2], r[3]));
-  for (int k = 0; k < 4; ++k) d[k] = x[k];
+// Solves the normal equations A d = r (upper triangle of A filled) by Cholesky, written out for
+// the fixed size (Eigen's general LLT costs as much as a third of the fit's sums); a degenerate
+// window (flat, or too few samples on one side) gets the pivoting LDLT's answer.
+Vector5 solveNormal(const Normal5& a, const Vector5& r) {
+  double l[kUnknowns][kUnknowns] = {};  // lower factor, l[i][j] for j <= i
+  for (int j = 0; j < kUnknowns; ++j) {
+    double pivot = a(j, j);
+    for (int k = 0; k < j; ++k) pivot -= l[j][k] * l[j][k];
+    if (!(pivot > 0)) return a.selfadjointView<Eigen::Upper>().ldlt().solve(r);
+    l[j][j] = std::sqrt(pivot);
+    for (int i = j + 1; i < kUnknowns; ++i) {
+      double v = a(j, i);
+      for (int k = 0; k < j; ++k) v -= l[i][k] * l[j][k];
+      l[i][j] = v / l[j][j];
+    }
+  }
+  Vector5 u, d;  // L u = r, then L^T d = u
+  for (int i = 0; i < kUnknowns; ++i) {
+    double v = r[i];
+    for (int k = 0; k < i; ++k) v -= l[i][k] * u[k];
+    u[i] = v / l[i][i];
+  }
+  for (int i = kUnknowns - 1; i >= 0; --i) {
+    double v = u[i];
+    for (int k = i + 1; k < kUnknowns; ++k) v -= l[k][i] * d[k];
+    d[i] = v / l[i][i];
+  }
+  return d;
 }
 
 }  // namespace
 
 struct ProfileEdgeFinder::Step {
-  double e = 0, b = 0, w = 1, a = 0;
+  double e = 0, b = 0, w = 1, a = 0;  // a: the background level at e, before the step
+  double g = 0;                       // the background's slope, grey levels per pixel
   bool alive = true;
   bool crowded = false;  // another step reached into its window in the first pass
 };
@@ -204,54 +201,58 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
   const double* y = window_.data() + (i0 - j0);
   const int count = i1 - i0 + 1;
 
-  // Gauss-Newton on (a, b, e, w), started with the linear fit of (a, b) at the current e, w.
-  // The normal equations keep their upper triangle only.
-  double a = st.a, b = st.b, e = st.e, w = std::clamp(st.w, 0.3, 3.0);
+  // Gauss-Newton on (a, b, e, w, g): the model a + b Phi((s - e) / w) + g (s - s0), started with
+  // the linear fit of the levels and slope at the current e, w. The slope is shading: where the
+  // window is cut short on one side, a model with flat levels would read it as a shift of the
+  // edge. It is measured from s0, the edge's start, so that it does not move with e.
+  const double s0 = st.e;
+  // The fit stops once e and w move by less than this; with the symmetric balance after it, the
+  // fit's e is only a start and what the balance needs are the levels, converged long before.
+  const double kConverged = prm.symmetricRefinement ? 1e-3 : 1e-5;
+  double a = st.a, b = st.b, e = st.e, w = std::clamp(st.w, 0.3, 3.0), g = st.g;
   for (int it = 0; it < 8; ++it) {
-    double jtj[10] = {}, jtr[4] = {};
     const bool levelsOnly = it == 0;
     GaussianSweep gauss((p.positionAt(i0) - e) / w, p.step / w, count);
-    if (levelsOnly) {
-      // Jacobian (1, f, 0, 0): the levels alone, the other two unknowns held by unit pivots.
-      for (int j = 0; j < count; ++j) {
-        const auto [z, density] = gauss.next();
-        const double f = normal(z, density).cdf;
-        const double r = y[j] - (a + b * f);
-        jtj[0] += 1.0, jtj[1] += f, jtj[4] += f * f;
-        jtr[0] += r, jtr[1] += f * r;
-      }
-      jtj[7] = jtj[9] = 1.0;
-    } else {
-      const double slope = -b / w;  // the model's derivative in e is slope * phi(z)
-      for (int j = 0; j < count; ++j) {
-        const auto [z, density] = gauss.next();
-        const auto [g, f] = normal(z, density);
-        const double je = slope * g, jw = je * z;
-        const double r = y[j] - (a + b * f);
-        jtj[0] += 1.0, jtj[1] += f, jtj[2] += je, jtj[3] += jw;
-        jtj[4] += f * f, jtj[5] += f * je, jtj[6] += f * jw;
-        jtj[7] += je * je, jtj[8] += je * jw, jtj[9] += jw * jw;
-        jtr[0] += r, jtr[1] += f * r, jtr[2] += je * r, jtr[3] += jw * r;
-      }
+    const double slope = -b / w;  // the model's derivative in e is slope * phi(z)
+    // The normal equations' upper triangle, summed in scalars (the compiler keeps them in
+    // registers): Jacobian (1, f, je, jw, t); the first round fits the levels and slope alone.
+    double s11 = 0, sf = 0, se = 0, sw = 0, s1t = 0, sff = 0, sfe = 0, sfw = 0, sft = 0, see = 0,
+           sew = 0, set = 0, sww = 0, swt = 0, stt = 0;
+    double r1 = 0, rf = 0, re = 0, rw = 0, rt = 0;
+    for (int j = 0; j < count; ++j) {
+      const auto [z, density] = gauss.next();
+      const auto [phi, f] = normal(z, density);
+      const double t = p.positionAt(i0 + j) - s0;
+      const double je = levelsOnly ? 0.0 : slope * phi, jw = je * z;
+      const double r = y[j] - (a + b * f + g * t);
+      s11 += 1.0, sf += f, se += je, sw += jw, s1t += t;
+      sff += f * f, sfe += f * je, sfw += f * jw, sft += f * t;
+      see += je * je, sew += je * jw, set += je * t;
+      sww += jw * jw, swt += jw * t, stt += t * t;
+      r1 += r, rf += f * r, re += je * r, rw += jw * r, rt += t * r;
     }
-    double d[4];
-    if (!solveCholesky(jtj, jtr, d)) solveDegenerate(jtj, jtr, d);
-    if (!(std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2]) && std::isfinite(d[3])))
-      return false;
-    a += d[0], b += d[1];
+    Normal5 jtj;
+    jtj << s11, sf, se, sw, s1t, 0, sff, sfe, sfw, sft, 0, 0, see, sew, set, 0, 0, 0, sww, swt, 0,
+        0, 0, 0, stt;
+    const Vector5 jtr{r1, rf, re, rw, rt};
+    if (levelsOnly) jtj(2, 2) = jtj(3, 3) = 1.0;  // e and w held by unit pivots
+    const Vector5 d = solveNormal(jtj, jtr);
+    if (!d.allFinite()) return false;
+    a += d[0], b += d[1], g += d[4];
     if (!levelsOnly) {
       e += std::clamp(d[2], -1.0, 1.0);
       w = std::clamp(w + d[3], 0.3, 3.0);
     }
     if (e < lo || e > hi) return false;
-    if (!levelsOnly && std::abs(d[2]) < 1e-5 && std::abs(d[3]) < 1e-4) break;
+    if (!levelsOnly && std::abs(d[2]) < kConverged && std::abs(d[3]) < kConverged) break;
   }
-  st.a = a, st.b = b, st.w = w, st.e = e;
+  a += g * (e - s0);  // the level at the edge
+  st.a = a, st.b = b, st.w = w, st.e = e, st.g = g;
   if (!prm.symmetricRefinement) return true;
 
-  // Balance the area about the mid level m over [e - R, e + R] (see the header).
-  const double m = a + 0.5 * b;
-  for (double& v : window_) v -= m;
+  // Balance the area about the mid line m(s) = a + b/2 + g (s - e) over [e - R, e + R] (see the
+  // header).
+  for (int j = j0; j <= j1; ++j) window_[j - j0] -= a + 0.5 * b + g * (p.positionAt(j) - e);
   double gainRadius = -1, gain = 0;
   for (int it = 0; it < 4; ++it) {
     const double r = std::min({prm.areaHalfWidth, e - lo, hi - e});
