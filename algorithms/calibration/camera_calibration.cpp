@@ -49,9 +49,11 @@ constexpr DistortionModel kDistortionModels[] = {
 
 // Solves with every distortion model and keeps the one the criterion prefers; with `only`, with
 // that model alone (the re-centring rounds of circle marks, which move points by hundredths of a
-// pixel and would not change the choice).
+// pixel and would not change the choice). `start`: a solution of these points a moment ago (the
+// same rounds): the solver starts from its camera matrix, not from OpenCV's own guess.
 Solution solve(const BoardSpec& board, cv::Size size,
-               const std::vector<std::vector<cv::Point2d>>& points, const std::string& only = {}) {
+               const std::vector<std::vector<cv::Point2d>>& points, const std::string& only = {},
+               const CameraModel* start = nullptr) {
   // OpenCV wants float points; float keeps 1e-4 px at 2000 px, two orders below the noise.
   std::vector<std::vector<cv::Point3f>> objects(points.size(), plateFloat(board));
   std::vector<std::vector<cv::Point2f>> images;
@@ -64,6 +66,12 @@ Solution solve(const BoardSpec& board, cv::Size size,
   // Each richer model starts from the simpler one's solution (its new terms at zero): near the
   // optimum already, its solver needs fewer rounds than from OpenCV's own start.
   cv::Mat guessK, guessD;
+  if (start) {
+    // The camera matrix only: a distortion term the model holds fixed would be held at the
+    // start's value, not at zero.
+    guessK = cv::Mat(start->cameraMatrix).clone();
+    guessD = cv::Mat::zeros(1, 5, CV_64F);
+  }
   for (const DistortionModel& model : kDistortionModels) {
     if (!only.empty() && only != model.name) continue;
     Solution s;
@@ -170,9 +178,9 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
         points[k] = std::move(centres);
       }
       if (moved < 1e-4 || round + 1 == kRounds) break;
-      s = solve(board, imageSize, points, chosen);
+      s = solve(board, imageSize, points, chosen, &s.camera);
     }
-    s = solve(board, imageSize, points);
+    s = solve(board, imageSize, points, {}, &s.camera);
   }
   out.camera = s.camera;
   out.rmsPx = s.rms;
