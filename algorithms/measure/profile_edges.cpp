@@ -77,6 +77,12 @@ double integrate(const double* y, int n, double x0, double h, double lo, double 
   return 0.5 * ((yl + y[il + 1]) * (il + 1 - fl) + inner + (y[ih] + yh) * (fh - ih)) * h;
 }
 
+// The step fit's window reaches at least this far (pixels, and at most `window`) whatever lies
+// beyond the edge; faint steps stop it beyond (ProfileEdgeFinder::fitStep).
+constexpr double kCoreWindow = 4.0;
+// The faintest step (grey levels, 8-bit scale) that stops a window, however clean the profile.
+constexpr double kFaintStep = 2.0;
+
 // The step fit's unknowns: the level before the edge, the step, the edge, its width, and the
 // background's slope along the profile.
 constexpr int kUnknowns = 5;
@@ -118,8 +124,9 @@ Vector5 solveNormal(const Normal5& a, const Vector5& r) {
 struct ProfileEdgeFinder::Step {
   double e = 0, b = 0, w = 1, a = 0;  // a: the background level at e, before the step
   double g = 0;                       // the background's slope, grey levels per pixel
-  bool alive = true;
-  bool crowded = false;  // another step reached into its window in the first pass
+  bool alive = true;                  // fitted: a neighbour that the other steps' fits subtract
+  bool reported = false;              // and strong enough to be an edge
+  bool crowded = false;               // another step reached into its window in the first pass
 };
 
 ProfileEdgeFinder::ProfileEdgeFinder(const ProfileEdgeParams& params) : params_(params) {}
@@ -184,6 +191,12 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
   Step& st = steps_[self];
   double lo = std::max(p.start, st.e - prm.window);
   double hi = std::min(p.end(), st.e + prm.window);
+  // A faint step stops the window before its blur begins, but not within the core.
+  const double core = std::min(prm.window, kCoreWindow), blurReach = 3.0 * std::max(st.w, 0.5);
+  for (double f : faint_) {
+    if (f > st.e) hi = std::min(hi, std::max(f - blurReach, st.e + core));
+    if (f < st.e) lo = std::max(lo, std::min(f + blurReach, st.e - core));
+  }
   for (std::size_t k : near_) {
     const double mid = 0.5 * (steps_[k].e + st.e);
     if (steps_[k].e < st.e) lo = std::max(lo, mid);
@@ -278,16 +291,27 @@ const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
   // A blurred step of height b peaks in the derivative at b / (sqrt(2 pi) sigma_total).
   const double toStep = std::sqrt(2.0 * M_PI) * std::sqrt(prm.smoothing * prm.smoothing + 1.0);
   const int reach = std::max(1, static_cast<int>(std::lround(prm.smoothing / p.step)));
+  // The noise of the derivative, in step units, from its median magnitude (the profile is
+  // mostly flat between its edges): peaks above 4 sigmas of it (and 2 grey levels) are steps.
+  magnitudes_.resize(n);
+  for (int i = 0; i < n; ++i) magnitudes_[i] = std::abs(d[i]);
+  std::nth_element(magnitudes_.begin(), magnitudes_.begin() + n / 2, magnitudes_.end());
+  const double faintStep = std::max(4.0 * 1.4826 * magnitudes_[n / 2] * toStep, kFaintStep);
   steps_.clear();
+  faint_.clear();
   for (int i = 1; i + 1 < n; ++i) {
     const double v = std::abs(d[i]);
-    if (v * toStep < 0.5 * prm.minAmplitude) continue;
+    if (v * toStep < std::min(faintStep, 0.5 * prm.minAmplitude)) continue;
     bool peak = true;
     for (int k = 1; k <= reach && peak; ++k) {
       if (i - k >= 0 && std::abs(d[i - k]) > v) peak = false;
       if (i + k < n && std::abs(d[i + k]) >= v) peak = false;
     }
     if (!peak || d[i] * d[i - 1] < 0 || d[i] * d[i + 1] < 0) continue;
+    if (v * toStep < 0.5 * prm.minAmplitude) {
+      faint_.push_back(p.positionAt(i));
+      continue;
+    }
     // Parabola through the peak for a subpixel start.
     const double l = std::abs(d[i - 1]), r = std::abs(d[i + 1]);
     const double den = l - 2 * v + r;
@@ -298,8 +322,8 @@ const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
     st.a = p.values[std::max(0, i - static_cast<int>(2.0 / p.step))];
     steps_.push_back(st);
   }
-  // Two passes: the second fits each step with its neighbours' fitted steps removed; steps too
-  // weak or degenerate after the first pass no longer count as neighbours.
+  // Two passes: the second fits each step with its neighbours' fitted steps removed; steps whose
+  // fit degenerated in the first pass no longer count as neighbours.
   for (int pass = 0; pass < 2; ++pass) {
     for (std::size_t i = 0; i < steps_.size(); ++i) {
       if (!steps_[i].alive) continue;
@@ -307,12 +331,19 @@ const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
       if (pass == 0) steps_[i].crowded = !near_.empty();
       // Alone in both passes: the second fit would repeat the first.
       if (pass == 1 && near_.empty() && !steps_[i].crowded) continue;
-      if (!fitStep(p, i) || std::abs(steps_[i].b) < prm.minAmplitude) steps_[i].alive = false;
+      // A step whose fit fails is no neighbour, but still stops the others' windows; one too
+      // weak to be an edge is still subtracted from theirs.
+      if (!fitStep(p, i)) {
+        steps_[i].alive = false;
+        faint_.push_back(steps_[i].e);
+        continue;
+      }
+      steps_[i].reported = std::abs(steps_[i].b) >= prm.minAmplitude;
     }
   }
   found_.clear();
   for (const Step& st : steps_)
-    if (st.alive) found_.push_back({st.e, st.b, st.w});
+    if (st.alive && st.reported) found_.push_back({st.e, st.b, st.w});
   std::sort(found_.begin(), found_.end(),
             [](const ProfileEdge& x, const ProfileEdge& y) { return x.position < y.position; });
   // Two candidates that converged onto one edge: keep the stronger.

@@ -15,7 +15,11 @@
 //     mid level's noise moves the position as much as the samples at the edge do, so the levels
 //     are taken from the whole window (8 px either side: 1.1x the Cramer-Rao bound of the
 //     position where 4 px gave 1.3x); the shading term keeps a window cut short on one side (by
-//     the profile's end or a neighbour) from reading a sloping background as a shift;
+//     the profile's end or a neighbour) from reading a sloping background as a shift. Beyond
+//     4 px the window reaches only over flat profile: a step too faint to be fitted (a
+//     derivative peak above the noise, below half the minimum amplitude) stops it short of its
+//     blur, since a faint step 5 px away inside the window would move the edge by a tenth of a
+//     pixel;
 //  3. e is then moved until the profile's area above and below the mid line m(s) = a + b/2 +
 //     g (s - e) balances over [e - R, e + R] (R = `areaHalfWidth`): for a point-symmetric profile
 //     that balance point is exactly e for any R, whatever the blur's shape, so the model's shape
@@ -67,14 +71,16 @@ class ProfileEdgeFinder {
   bool fitStep(const GreyProfile& profile, std::size_t self);
 
   ProfileEdgeParams params_;
-  double kernelStep_ = 0;          // the profile step the kernel was made for
-  std::vector<double> kernel_;     // derivative taps 1..r (index 0 unused)
-  double kernelNorm_ = 0;          // their response to a unit slope
-  std::vector<double> padded_;     // the profile with its ends repeated r times
-  std::vector<double> slope_;      // the derivative
-  std::vector<Step> steps_;        // candidates, then fitted steps
-  std::vector<std::size_t> near_;  // steps reaching into the current step's window
-  std::vector<double> window_;     // the current step's samples, neighbours removed
+  double kernelStep_ = 0;           // the profile step the kernel was made for
+  std::vector<double> kernel_;      // derivative taps 1..r (index 0 unused)
+  double kernelNorm_ = 0;           // their response to a unit slope
+  std::vector<double> padded_;      // the profile with its ends repeated r times
+  std::vector<double> slope_;       // the derivative
+  std::vector<Step> steps_;         // candidates, then fitted steps
+  std::vector<std::size_t> near_;   // steps reaching into the current step's window
+  std::vector<double> faint_;       // positions of steps too faint to fit (window stops)
+  std::vector<double> magnitudes_;  // |slope|, for the noise level
+  std::vector<double> window_;      // the current step's samples, neighbours removed
   std::vector<ProfileEdge> found_, edges_;
 };
 

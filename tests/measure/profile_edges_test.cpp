@@ -40,6 +40,23 @@ TEST(ProfileEdges, ShadingDoesNotMoveAnEdgeWhoseWindowIsCutShort) {
   EXPECT_LT(worst, 0.002);
 }
 
+TEST(ProfileEdges, AFaintStepBesideAnEdgeDoesNotMoveIt) {
+  // Steps below the minimum amplitude 5-7 px from an edge (a chamfer, a scratch): not edges, but
+  // inside its window they would pull its levels. Fainter than half the minimum they stop the
+  // window; stronger, they are fitted and subtracted like a neighbour.
+  for (double faint : {8.0, 12.0, 16.0, 19.0})
+    for (double away : {-7.0, -5.0, 5.0, 7.0}) {
+      GreyProfile p = shadedStep(0, 40, 0.25, 20.3, 60, 100, 1.0, 0.0);
+      for (std::size_t i = 0; i < p.values.size(); ++i)
+        p.values[i] += faint * 0.5 * std::erfc(-(p.positionAt(i) - 20.3 - away) / std::sqrt(2.0));
+      const std::vector<ProfileEdge> found = findProfileEdges(p);
+      ASSERT_EQ(found.size(), 1u) << faint << " at " << away;
+      // 5 px away its blur still reaches the 4 px either side every fit uses: 0.006 px.
+      EXPECT_NEAR(found[0].position, 20.3, std::abs(away) < 6 ? 0.01 : 0.001)
+          << faint << " at " << away;
+    }
+}
+
 TEST(ProfileEdgesStatistics, PositionNoiseIsNearTheCramerRaoBound) {
   // Pixel-spaced samples with independent noise: the bound for the position alone, the levels
   // and blur known, is noise / (height sqrt(1 / (2 sqrt(pi) blur))). Estimating the levels from
