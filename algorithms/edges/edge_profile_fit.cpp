@@ -13,6 +13,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "algorithms/geometry/spd_solve.hpp"
+
 namespace facet {
 namespace {
 
@@ -39,33 +41,6 @@ struct Samples {
 
 float horizontalSum(Lanes x) {
   return (x[0] + x[1]) + (x[2] + x[3]);
-}
-
-// Solves the symmetric positive definite n x n system A x = y by Cholesky; false if singular.
-template <int N>
-bool solveSpd(std::array<std::array<double, N>, N>& a, std::array<double, N>& y) {
-  for (int j = 0; j < N; ++j) {
-    double d = a[j][j];
-    for (int k = 0; k < j; ++k) d -= a[j][k] * a[j][k];
-    if (d <= 1e-9) return false;
-    a[j][j] = std::sqrt(d);
-    for (int i = j + 1; i < N; ++i) {
-      double v = a[i][j];
-      for (int k = 0; k < j; ++k) v -= a[i][k] * a[j][k];
-      a[i][j] = v / a[j][j];
-    }
-  }
-  for (int i = 0; i < N; ++i) {
-    double v = y[i];
-    for (int k = 0; k < i; ++k) v -= a[i][k] * y[k];
-    y[i] = v / a[i][i];
-  }
-  for (int i = N - 1; i >= 0; --i) {
-    double v = y[i];
-    for (int k = i + 1; k < N; ++k) v -= a[k][i] * y[k];
-    y[i] = v / a[i][i];
-  }
-  return true;
 }
 
 // The integer range of dx for which lo <= dx * k + c <= hi on each row dy of a window, with

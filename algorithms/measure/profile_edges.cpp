@@ -1,10 +1,13 @@
 #include "algorithms/measure/profile_edges.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <utility>
 
 #include <Eigen/Dense>
+
+#include "algorithms/geometry/spd_solve.hpp"
 
 namespace facet {
 namespace {
@@ -89,34 +92,17 @@ constexpr int kUnknowns = 5;
 using Normal5 = Eigen::Matrix<double, kUnknowns, kUnknowns>;
 using Vector5 = Eigen::Matrix<double, kUnknowns, 1>;
 
-// Solves the normal equations A d = r (upper triangle of A filled) by Cholesky, written out for
-// the fixed size (Eigen's general LLT costs as much as a third of the fit's sums); a degenerate
+// Solves the normal equations A d = r (upper triangle of A filled) by Cholesky; a degenerate
 // window (flat, or too few samples on one side) gets the pivoting LDLT's answer.
 Vector5 solveNormal(const Normal5& a, const Vector5& r) {
-  double l[kUnknowns][kUnknowns] = {};  // lower factor, l[i][j] for j <= i
-  for (int j = 0; j < kUnknowns; ++j) {
-    double pivot = a(j, j);
-    for (int k = 0; k < j; ++k) pivot -= l[j][k] * l[j][k];
-    if (!(pivot > 0)) return a.selfadjointView<Eigen::Upper>().ldlt().solve(r);
-    l[j][j] = std::sqrt(pivot);
-    for (int i = j + 1; i < kUnknowns; ++i) {
-      double v = a(j, i);
-      for (int k = 0; k < j; ++k) v -= l[i][k] * l[j][k];
-      l[i][j] = v / l[j][j];
-    }
-  }
-  Vector5 u, d;  // L u = r, then L^T d = u
+  std::array<std::array<double, kUnknowns>, kUnknowns> lower;
+  std::array<double, kUnknowns> d;
   for (int i = 0; i < kUnknowns; ++i) {
-    double v = r[i];
-    for (int k = 0; k < i; ++k) v -= l[i][k] * u[k];
-    u[i] = v / l[i][i];
+    d[i] = r[i];
+    for (int j = 0; j <= i; ++j) lower[i][j] = a(j, i);
   }
-  for (int i = kUnknowns - 1; i >= 0; --i) {
-    double v = u[i];
-    for (int k = i + 1; k < kUnknowns; ++k) v -= l[k][i] * d[k];
-    d[i] = v / l[i][i];
-  }
-  return d;
+  if (solveSpd<kUnknowns>(lower, d)) return Vector5(d.data());
+  return a.selfadjointView<Eigen::Upper>().ldlt().solve(r);
 }
 
 }  // namespace
