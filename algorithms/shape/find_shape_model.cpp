@@ -247,6 +247,8 @@ void checkParams(const ShapeModel& model, const FindParams& p) {
   if (p.scaleMin < 0.0 || p.scaleMax < 0.0 || (p.scaleMax > 0.0 && p.scaleMin > p.scaleMax))
     throw std::invalid_argument("findShapeModel: the scale range must satisfy 0 < min <= max");
   if (p.numLevels < 0) throw std::invalid_argument("findShapeModel: numLevels must be >= 0");
+  if (!(p.refineScaleTolerance >= 0.0 && p.refineScaleTolerance <= kMaxScaleTolerance))
+    throw std::invalid_argument("findShapeModel: refineScaleTolerance must lie in [0, 0.1]");
 }
 
 }  // namespace

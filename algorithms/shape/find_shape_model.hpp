@@ -30,6 +30,8 @@ enum class SubpixelMode {
                   // edges (point-to-line), in position, angle and (with a scale range) scale
 };
 
+inline constexpr double kMaxScaleTolerance = 0.1;
+
 struct FindParams {
   // Lowest score a match may have, in (0, 1]. Default 0.7.
   double minScore = 0.7;
@@ -64,7 +66,8 @@ struct FindParams {
   // at the start only; the fit that lays more of the model on edges is kept (an occluder's border
   // can stand in for a hidden edge at a scale a percent or two off). The match reports the scale
   // it kept.
-  // 0 = keep the scale fixed. Default 0.02.
+  // 0 = keep the scale fixed; at most kMaxScaleTolerance (a part 10% off its template is another
+  // part, or wants a model with a scale range). Default 0.02.
   double refineScaleTolerance = 0.02;
   // Number of pyramid levels used, 0 = all of the model's. Fewer levels = slower, more robust.
   int numLevels = 0;

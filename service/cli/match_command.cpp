@@ -49,6 +49,9 @@ void checkSearchOptions(const FindParams& find) {
     throw InputError("--max-overlap must lie in [0, 1] (got " + number(find.maxOverlap) + ")");
   if (!(find.greediness >= 0.0 && find.greediness <= 1.0))
     throw InputError("--greediness must lie in [0, 1] (got " + number(find.greediness) + ")");
+  if (!(find.refineScaleTolerance >= 0.0 && find.refineScaleTolerance <= kMaxScaleTolerance))
+    throw InputError("--scale-tolerance must lie in [0, " + number(kMaxScaleTolerance) + "] (got " +
+                     number(find.refineScaleTolerance) + ")");
 }
 
 constexpr double kTurn = 2.0 * std::numbers::pi;
@@ -173,6 +176,9 @@ void addMatchCommand(CLI::App& app) {
   cmd->add_option("--angle-range", o->angleRange,
                   "Angles to search: a0,a1 in degrees (default: the model's)");
   cmd->add_option("--scale-range", o->scaleRange, "Scales to search: s0,s1 (default: the model's)");
+  cmd->add_option("--scale-tolerance", o->find.refineScaleTolerance,
+                  "Scale change the subpixel fit may find on a part whose model has one scale, "
+                  "relative, 0..0.1 (default 0.02; 0 = the model's scale)");
   cmd->add_option("--polarity", o->polarity, "use | ignore_global | ignore_local (default use)");
   cmd->add_option("--subpixel", o->subpixel,
                   "none | interpolation | least_squares (default least_squares)");

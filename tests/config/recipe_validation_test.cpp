@@ -112,6 +112,15 @@ TEST_F(RecipeValidation, OutOfRangeValuesGiveTheRange) {
   EXPECT_EQ(r.diagnostics.errorCount(), 4u) << r.diagnostics.text();
 }
 
+TEST_F(RecipeValidation, ShapeScaleToleranceIsLimited) {
+  const auto r = load(
+      "schema_version: 1\nid: 7\nname: x\nsteps:\n  - id: part\n"
+      "    kind: shape\n    template: t.png\n    scale_tolerance: 0.5\n");
+  EXPECT_TRUE(
+      hasDiagnostic(r.diagnostics, 8, 22, "'scale_tolerance' must be between 0 and 0.1 (got 0.5)"))
+      << r.diagnostics.text();
+}
+
 TEST_F(RecipeValidation, MissingRequiredKeyIsReportedAtItsMapping) {
   const auto r = load(kHead + R"(  - id: hole
     kind: circle

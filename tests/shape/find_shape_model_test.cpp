@@ -317,6 +317,10 @@ TEST(FindShapeModel, EmptyImageAndBadParameters) {
                std::invalid_argument);
   EXPECT_THROW(findShapeModel(image, bracketModel(), FindParams{.greediness = -0.1}),
                std::invalid_argument);
+  EXPECT_THROW(findShapeModel(image, bracketModel(), FindParams{.refineScaleTolerance = -0.01}),
+               std::invalid_argument);
+  EXPECT_THROW(findShapeModel(image, bracketModel(), FindParams{.refineScaleTolerance = 0.2}),
+               std::invalid_argument);
   // An image smaller than the part: searched, nothing found, no crash.
   EXPECT_TRUE(findShapeModel(cv::Mat(20, 30, CV_8U, cv::Scalar(9)), bracketModel()).empty());
 }

@@ -154,14 +154,46 @@ TEST(ShapeCli, MatchSaysWhenTheModelCutsTheRequestedRange) {
   ASSERT_EQ(inside.exitCode, 0) << readText(err);
   EXPECT_TRUE(nlohmann::json::parse(inside.out).at("warnings").empty()) << inside.out;
 
-  for (const std::string option : {"--min-score 1.5", "--min-score 0", "--max-overlap 2",
-                                   "--greediness -1", "--num-matches -3"}) {
+  for (const std::string option :
+       {"--min-score 1.5", "--min-score 0", "--max-overlap 2", "--greediness -1",
+        "--num-matches -3", "--scale-tolerance 0.2", "--scale-tolerance -0.01"}) {
     const CliRun bad = run(match + " " + option, err);
     EXPECT_EQ(bad.exitCode, 1) << option;
     const std::string message = readText(err);
     EXPECT_NE(message.find(option.substr(0, option.find(' '))), std::string::npos) << message;
     EXPECT_EQ(message.find("findShapeModel"), std::string::npos) << message;
     EXPECT_EQ(message.find("scene.png"), std::string::npos) << "not the image's fault: " << message;
+  }
+  fs::remove_all(dir);
+}
+
+// A part 1.2% larger than its one-scale model: the subpixel fit finds its scale within the
+// default tolerance, and holds the model's with --scale-tolerance 0.
+TEST(ShapeCli, ScaleToleranceDecidesWhetherTheFitFollowsAPartsScale) {
+  const fs::path dir = fs::temp_directory_path() / "facet_shape_cli_scale_test";
+  fs::create_directories(dir);
+  const std::string cli = FACET_CLI;
+  const fs::path err = dir / "stderr.txt";
+  ASSERT_TRUE(cv::imwrite((dir / "template.png").string(), testing::bracketTemplate()));
+  const Pose2D truth{240.3, 180.6, radians(31.0), 1.012};
+  ASSERT_TRUE(
+      cv::imwrite((dir / "scene.png").string(), testing::bracketScene({480, 360}, {truth}, 5)));
+  const CliRun create = run(cli + " model create --image " + (dir / "template.png").string() +
+                                " --out " + (dir / "part.model").string(),
+                            err);
+  ASSERT_EQ(create.exitCode, 0) << readText(err);
+  const std::string match = cli + " match --model " + (dir / "part.model").string() + " --image " +
+                            (dir / "scene.png").string() + " --json";
+  for (const std::string tolerance : {"", " --scale-tolerance 0"}) {
+    const CliRun r = run(match + tolerance, err);
+    ASSERT_EQ(r.exitCode, 0) << readText(err);
+    const auto j = nlohmann::json::parse(r.out);
+    ASSERT_EQ(j.at("matches").size(), 1u) << r.out;
+    const double scale = j["matches"][0].at("scale").get<double>();
+    if (tolerance.empty())
+      EXPECT_NEAR(scale, truth.scale, 1e-3) << r.out;
+    else
+      EXPECT_EQ(scale, 1.0) << r.out;
   }
   fs::remove_all(dir);
 }

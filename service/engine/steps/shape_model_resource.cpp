@@ -85,8 +85,9 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
 }
 
 FindParams findParamsFor(double minScore, int numMatches, double maxOverlap,
-                         const config::AngleRange& range) {
+                         const config::AngleRange& range, double scaleTolerance) {
   FindParams p;
+  p.refineScaleTolerance = scaleTolerance;
   p.minScore = minScore;
   p.numMatches = numMatches;
   p.maxOverlap = maxOverlap;

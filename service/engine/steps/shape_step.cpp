@@ -33,6 +33,10 @@ ShapeStep::ShapeStep() : TableStep({.point = true, .pose = true, .line = true}) 
                   {.minimum = 1.0, .maximum = 100.0});
   fields_.number("max_overlap", &ShapeParams::maxOverlap, "Largest overlap of two matches, 0..1.",
                  {.minimum = 0.0, .maximum = 1.0});
+  fields_.number("scale_tolerance", &ShapeParams::scaleTolerance,
+                 "Scale change the subpixel fit may find on a part that differs a little from its "
+                 "template (lens, working distance), relative; 0 = the template's scale.",
+                 {.minimum = 0.0, .maximum = kMaxScaleTolerance});
   const std::string xDoc = "Offset of the found position from nominal along x (mm by default).";
   const std::string yDoc = "Offset of the found position from nominal along y (mm by default).";
   checks_ = {"shape checks",
@@ -75,9 +79,9 @@ StepResult ShapeStep::run(const config::Step& step, StepContext& part) const {
   if (search.empty()) return StepResult::failed("search region outside the image");
   part.overlay.polygon(outerCorners(search), true, true);
   const auto& shape = step.resourcesAs<ShapeModelResource>();
-  const auto matches =
-      findShapeModel(part.grey(search), shape.model,
-                     findParamsFor(s.minScore, s.numMatches, s.maxOverlap, angles));
+  const auto matches = findShapeModel(
+      part.grey(search), shape.model,
+      findParamsFor(s.minScore, s.numMatches, s.maxOverlap, angles, s.scaleTolerance));
   StepResult r;
   r.values["count"] = static_cast<double>(matches.size());
   for (const auto& m : matches) drawContour(part.overlay, m.contour, search.tl(), true);

@@ -19,6 +19,7 @@ struct ShapeParams : config::StepParams {
   int numMatches = 1;
   config::AngleRange angleRange;
   double maxOverlap = 0.5;
+  double scaleTolerance = 0.02;  // FindParams::refineScaleTolerance
 };
 
 class ShapeStep : public TableStep<ShapeParams> {
