@@ -207,7 +207,7 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
   const double s0 = st.e;
   // The fit stops once e and w move by less than this; with the symmetric balance after it, the
   // fit's e is only a start and what the balance needs are the levels, converged long before.
-  const double kConverged = prm.symmetricRefinement ? 1e-3 : 1e-5;
+  const double converged = prm.symmetricRefinement ? 1e-3 : 1e-5;
   double a = st.a, b = st.b, e = st.e, w = std::clamp(st.w, 0.3, 3.0), g = st.g;
   for (int it = 0; it < 8; ++it) {
     const bool levelsOnly = it == 0;
@@ -243,7 +243,7 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
       w = std::clamp(w + d[3], 0.3, 3.0);
     }
     if (e < lo || e > hi) return false;
-    if (!levelsOnly && std::abs(d[2]) < kConverged && std::abs(d[3]) < kConverged) break;
+    if (!levelsOnly && std::abs(d[2]) < converged && std::abs(d[3]) < converged) break;
   }
   a += g * (e - s0);  // the level at the edge
   st.a = a, st.b = b, st.w = w, st.e = e, st.g = g;
