@@ -218,17 +218,28 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
     double s11 = 0, sf = 0, se = 0, sw = 0, s1t = 0, sff = 0, sfe = 0, sfw = 0, sft = 0, see = 0,
            sew = 0, set = 0, sww = 0, swt = 0, stt = 0;
     double r1 = 0, rf = 0, re = 0, rw = 0, rt = 0;
-    for (int j = 0; j < count; ++j) {
-      const auto [z, density] = gauss.next();
-      const auto [phi, f] = normal(z, density);
-      const double t = p.positionAt(i0 + j) - s0;
-      const double je = levelsOnly ? 0.0 : slope * phi, jw = je * z;
-      const double r = y[j] - (a + b * f + g * t);
-      s11 += 1.0, sf += f, se += je, sw += jw, s1t += t;
-      sff += f * f, sfe += f * je, sfw += f * jw, sft += f * t;
-      see += je * je, sew += je * jw, set += je * t;
-      sww += jw * jw, swt += jw * t, stt += t * t;
-      r1 += r, rf += f * r, re += je * r, rw += jw * r, rt += t * r;
+    if (levelsOnly) {
+      for (int j = 0; j < count; ++j) {
+        const auto [z, density] = gauss.next();
+        const double f = normal(z, density).cdf;
+        const double t = p.positionAt(i0 + j) - s0;
+        const double r = y[j] - (a + b * f + g * t);
+        s11 += 1.0, sf += f, s1t += t, sff += f * f, sft += f * t, stt += t * t;
+        r1 += r, rf += f * r, rt += t * r;
+      }
+    } else {
+      for (int j = 0; j < count; ++j) {
+        const auto [z, density] = gauss.next();
+        const auto [phi, f] = normal(z, density);
+        const double t = p.positionAt(i0 + j) - s0;
+        const double je = slope * phi, jw = je * z;
+        const double r = y[j] - (a + b * f + g * t);
+        s11 += 1.0, sf += f, se += je, sw += jw, s1t += t;
+        sff += f * f, sfe += f * je, sfw += f * jw, sft += f * t;
+        see += je * je, sew += je * jw, set += je * t;
+        sww += jw * jw, swt += jw * t, stt += t * t;
+        r1 += r, rf += f * r, re += je * r, rw += jw * r, rt += t * r;
+      }
     }
     Normal5 jtj;
     jtj << s11, sf, se, sw, s1t, 0, sff, sfe, sfw, sft, 0, 0, see, sew, set, 0, 0, 0, sww, swt, 0,
@@ -279,10 +290,14 @@ const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
   const int reach = std::max(1, static_cast<int>(std::lround(prm.smoothing / p.step)));
   // The noise of the derivative, in step units, from its median magnitude (the profile is
   // mostly flat between its edges): peaks above 4 sigmas of it (and 2 grey levels) are steps.
-  magnitudes_.resize(n);
-  for (int i = 0; i < n; ++i) magnitudes_[i] = std::abs(d[i]);
-  std::nth_element(magnitudes_.begin(), magnitudes_.begin() + n / 2, magnitudes_.end());
-  const double faintStep = std::max(4.0 * 1.4826 * magnitudes_[n / 2] * toStep, kFaintStep);
+  // A window no wider than the core has nothing for faint steps to stop.
+  double faintStep = 0.5 * prm.minAmplitude;
+  if (prm.window > kCoreWindow) {
+    magnitudes_.resize(n);
+    for (int i = 0; i < n; ++i) magnitudes_[i] = std::abs(d[i]);
+    std::nth_element(magnitudes_.begin(), magnitudes_.begin() + n / 2, magnitudes_.end());
+    faintStep = std::max(4.0 * 1.4826 * magnitudes_[n / 2] * toStep, kFaintStep);
+  }
   steps_.clear();
   faint_.clear();
   for (int i = 1; i + 1 < n; ++i) {
