@@ -63,27 +63,27 @@ int main(int argc, char** argv) {
   const bool smoke = argc > 1 && std::strcmp(argv[1], "--smoke") == 0;
   const int runs = smoke ? 3 : 21;
   const std::vector<std::string> version = {"version"};
-  const std::string png = "recipes/demo/bracket_shape/part_000.png";
+  // The repository's demo part and model, wherever the benchmark is run from.
+  const std::string root = FACET_SOURCE_DIR;
+  const std::string png = root + "/recipes/demo/bracket_shape/part_000.png";
   const auto copyAs = [&](const char* extension) {
     const std::string copy = (std::filesystem::temp_directory_path() /
                               ("bench_startup_" + std::to_string(getpid()) + extension))
                                  .string();
-    if (!cv::imwrite(copy, cv::imread(png, cv::IMREAD_UNCHANGED))) {
-      std::fprintf(stderr, "bench_startup: cannot read %s or write %s (run from the repository)\n",
-                   png.c_str(), copy.c_str());
+    const cv::Mat part = cv::imread(png, cv::IMREAD_UNCHANGED);
+    if (part.empty() || !cv::imwrite(copy, part)) {
+      std::fprintf(stderr, "bench_startup: cannot read %s or write %s\n", png.c_str(),
+                   copy.c_str());
       std::exit(1);
     }
     return copy;
   };
   const std::string tiff = copyAs(".tif"), bmp = copyAs(".bmp"), pgm = copyAs(".pgm");
-  const std::vector<std::string> match = {"match", "--model", "recipes/models/bracket.shape",
-                                          "--image", png};
-  const std::vector<std::string> matchTiff = {"match", "--model", "recipes/models/bracket.shape",
-                                              "--image", tiff};
-  const std::vector<std::string> matchBmp = {"match", "--model", "recipes/models/bracket.shape",
-                                             "--image", bmp};
-  const std::vector<std::string> matchPgm = {"match", "--model", "recipes/models/bracket.shape",
-                                             "--image", pgm};
+  const std::string model = root + "/recipes/models/bracket.shape";
+  const std::vector<std::string> match = {"match", "--model", model, "--image", png};
+  const std::vector<std::string> matchTiff = {"match", "--model", model, "--image", tiff};
+  const std::vector<std::string> matchBmp = {"match", "--model", model, "--image", bmp};
+  const std::vector<std::string> matchPgm = {"match", "--model", model, "--image", pgm};
   std::printf("bench_startup%s: median wall time of %d runs (warm page cache)\n",
               smoke ? " --smoke" : "", runs);
   std::printf("%-18s %12s %22s %8s\n", "command", "facet ms", "linked codecs ms", "ratio");
