@@ -1,5 +1,6 @@
 // `facet model create` and `facet match`: the real binary on generated images.
 #include <array>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -37,6 +38,34 @@ CliRun run(const std::string& command, const fs::path& errFile) {
 std::string readText(const fs::path& p) {
   std::ifstream in(p);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A temporary directory with the bracket's template, a scene of it at `truth` and the model
+// trained from the template with `createOptions`; `match` is `facet match` of that model on the
+// scene. `trained` is false (stderr in `err`) when training failed.
+struct TrainedScene {
+  fs::path dir, err;
+  std::string match;
+  bool trained = false;
+};
+
+TrainedScene trainedScene(const std::string& name, const Pose2D& truth, std::uint64_t seed,
+                          const std::string& createOptions = {}) {
+  TrainedScene t;
+  t.dir = fs::temp_directory_path() / name;
+  fs::create_directories(t.dir);
+  t.err = t.dir / "stderr.txt";
+  const std::string cli = FACET_CLI, model = (t.dir / "part.model").string();
+  if (!cv::imwrite((t.dir / "template.png").string(), testing::bracketTemplate()) ||
+      !cv::imwrite((t.dir / "scene.png").string(),
+                   testing::bracketScene({480, 360}, {truth}, seed)))
+    return t;
+  t.trained = run(cli + " model create --image " + (t.dir / "template.png").string() +
+                      createOptions + " --out " + model,
+                  t.err)
+                  .exitCode == 0;
+  t.match = cli + " match --model " + model + " --image " + (t.dir / "scene.png").string();
+  return t;
 }
 
 TEST(ShapeCli, CreateThenMatchPrintsThePoseAsJson) {
@@ -116,23 +145,11 @@ TEST(ShapeCli, CreateThenMatchPrintsThePoseAsJson) {
 // search asks for: the cut is said on stderr and in the JSON, not left to a silent "0 matches".
 // Search options out of range are argument errors under the user's option names.
 TEST(ShapeCli, MatchSaysWhenTheModelCutsTheRequestedRange) {
-  const fs::path dir = fs::temp_directory_path() / "facet_shape_cli_range_test";
-  fs::create_directories(dir);
-  const std::string cli = FACET_CLI;
-  const fs::path err = dir / "stderr.txt";
-  ASSERT_TRUE(cv::imwrite((dir / "template.png").string(), testing::bracketTemplate()));
-  ASSERT_TRUE(
-      cv::imwrite((dir / "scene.png").string(),
-                  testing::bracketScene({480, 360}, {{240.3, 180.6, radians(30.0), 1.0}}, 4)));
-  const std::string model = (dir / "part.model").string();
-  ASSERT_EQ(run(cli + " model create --image " + (dir / "template.png").string() +
-                    " --angle-range -10,10 --out " + model,
-                err)
-                .exitCode,
-            0)
-      << readText(err);
-  const std::string match =
-      cli + " match --model " + model + " --image " + (dir / "scene.png").string();
+  const TrainedScene scene = trainedScene(
+      "facet_shape_cli_range_test", {240.3, 180.6, radians(30.0), 1.0}, 4, " --angle-range -10,10");
+  ASSERT_TRUE(scene.trained) << readText(scene.err);
+  const std::string& match = scene.match;
+  const fs::path& err = scene.err;
 
   const CliRun wide = run(match + " --angle-range -180,180 --json", err);
   ASSERT_EQ(wide.exitCode, 0) << readText(err);
@@ -164,26 +181,17 @@ TEST(ShapeCli, MatchSaysWhenTheModelCutsTheRequestedRange) {
     EXPECT_EQ(message.find("findShapeModel"), std::string::npos) << message;
     EXPECT_EQ(message.find("scene.png"), std::string::npos) << "not the image's fault: " << message;
   }
-  fs::remove_all(dir);
+  fs::remove_all(scene.dir);
 }
 
 // A part 1.2% larger than its one-scale model: the subpixel fit finds its scale within the
 // default tolerance, and holds the model's with --scale-tolerance 0.
 TEST(ShapeCli, ScaleToleranceDecidesWhetherTheFitFollowsAPartsScale) {
-  const fs::path dir = fs::temp_directory_path() / "facet_shape_cli_scale_test";
-  fs::create_directories(dir);
-  const std::string cli = FACET_CLI;
-  const fs::path err = dir / "stderr.txt";
-  ASSERT_TRUE(cv::imwrite((dir / "template.png").string(), testing::bracketTemplate()));
   const Pose2D truth{240.3, 180.6, radians(31.0), 1.012};
-  ASSERT_TRUE(
-      cv::imwrite((dir / "scene.png").string(), testing::bracketScene({480, 360}, {truth}, 5)));
-  const CliRun create = run(cli + " model create --image " + (dir / "template.png").string() +
-                                " --out " + (dir / "part.model").string(),
-                            err);
-  ASSERT_EQ(create.exitCode, 0) << readText(err);
-  const std::string match = cli + " match --model " + (dir / "part.model").string() + " --image " +
-                            (dir / "scene.png").string() + " --json";
+  const TrainedScene scene = trainedScene("facet_shape_cli_scale_test", truth, 5);
+  ASSERT_TRUE(scene.trained) << readText(scene.err);
+  const std::string match = scene.match + " --json";
+  const fs::path& err = scene.err;
   for (const std::string tolerance : {"", " --scale-tolerance 0"}) {
     const CliRun r = run(match + tolerance, err);
     ASSERT_EQ(r.exitCode, 0) << readText(err);
@@ -195,7 +203,7 @@ TEST(ShapeCli, ScaleToleranceDecidesWhetherTheFitFollowsAPartsScale) {
     else
       EXPECT_EQ(scale, 1.0) << r.out;
   }
-  fs::remove_all(dir);
+  fs::remove_all(scene.dir);
 }
 
 }  // namespace
