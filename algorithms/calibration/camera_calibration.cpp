@@ -7,6 +7,7 @@
 
 #include <opencv2/calib3d.hpp>
 
+#include "algorithms/calibration/charuco_corners.hpp"
 #include "algorithms/calibration/chessboard_corners.hpp"
 #include "algorithms/calibration/circle_marks.hpp"
 #include "algorithms/calibration/field_coverage.hpp"
@@ -14,10 +15,8 @@
 namespace facet {
 namespace {
 
-std::vector<cv::Point3f> plateFloat(const BoardSpec& board) {
-  std::vector<cv::Point3f> out;
-  for (const auto& p : board.platePoints()) out.emplace_back(p);
-  return out;
+std::vector<cv::Point3f> plateFloat(const std::vector<cv::Point3d>& plate) {
+  return {plate.begin(), plate.end()};
 }
 
 std::vector<cv::Point2f> imageFloat(const std::vector<cv::Point2d>& points) {
@@ -51,14 +50,19 @@ constexpr DistortionModel kDistortionModels[] = {
 // that model alone (the re-centring rounds of circle marks, which move points by hundredths of a
 // pixel and would not change the choice). `start`: a solution of these points a moment ago (the
 // same rounds): the solver starts from its camera matrix, not from OpenCV's own guess.
-Solution solve(const BoardSpec& board, cv::Size size,
+// `plate[k]`: the plate points of view k's `points[k]`.
+Solution solve(cv::Size size, const std::vector<std::vector<cv::Point3d>>& plate,
                const std::vector<std::vector<cv::Point2d>>& points, const std::string& only = {},
                const CameraModel* start = nullptr) {
   // OpenCV wants float points; float keeps 1e-4 px at 2000 px, two orders below the noise.
-  std::vector<std::vector<cv::Point3f>> objects(points.size(), plateFloat(board));
+  std::vector<std::vector<cv::Point3f>> objects;
   std::vector<std::vector<cv::Point2f>> images;
   std::size_t count = 0;
-  for (const auto& p : points) images.push_back(imageFloat(p)), count += p.size();
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    objects.push_back(plateFloat(plate[k]));
+    images.push_back(imageFloat(points[k]));
+    count += points[k].size();
+  }
   const double n = 2.0 * static_cast<double>(count);  // residual components
   Solution best;
   std::vector<DistortionCandidate> candidates;
@@ -115,6 +119,8 @@ PlateView detectPlate(const cv::Mat& image, const BoardSpec& board, std::string 
   view.name = std::move(name);
   if (board.kind == BoardSpec::Kind::Chessboard) {
     view.detection = detectChessboard(image, board);
+  } else if (board.kind == BoardSpec::Kind::Charuco) {
+    view.detection = detectCharuco(image, board);
   } else {
     CircleMarks marks = detectCircleMarks(image, board);
     view.detection = std::move(marks.detection);
@@ -133,6 +139,7 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
     fit.name = views[i].name;
     fit.status = views[i].detection.status;
     fit.points = views[i].detection.points;
+    fit.ids = views[i].detection.ids;
     fit.note = views[i].detection.note;
     if (views[i].detection.status.ok()) used.push_back(i);
     out.views.push_back(std::move(fit));
@@ -146,9 +153,12 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
     return out;
   }
   std::vector<std::vector<cv::Point2d>> points, outlines;
+  std::vector<std::vector<cv::Point3d>> plate;
   for (std::size_t i : used) {
-    points.push_back(views[i].detection.points);
-    outlines.push_back(gridOutline(views[i].detection.points, board.cols, board.rows));
+    const PatternDetection& d = views[i].detection;
+    points.push_back(d.points);
+    plate.push_back(d.platePoints(board));
+    outlines.push_back(patternOutline(d.points, d.ids, board.cols, board.rows));
   }
   out.coverage = coveredShare(coveredField(imageSize, outlines));
   if (out.coverage < options.minCoverage) {
@@ -162,7 +172,7 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
     out.warning = "the views cover only " + percent(out.coverage) +
                   " of the image: the lens model is extrapolated outside them";
 
-  Solution s = solve(board, imageSize, points);
+  Solution s = solve(imageSize, plate, points);
   if (board.kind == BoardSpec::Kind::Circles) {
     // Re-centre every mark with the perspective-correct centre of the current solution; the
     // model is chosen again only on the final centres.
@@ -178,15 +188,14 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
         points[k] = std::move(centres);
       }
       if (moved < 1e-4 || round + 1 == kRounds) break;
-      s = solve(board, imageSize, points, chosen, &s.camera);
+      s = solve(imageSize, plate, points, chosen, &s.camera);
     }
-    s = solve(board, imageSize, points, {}, &s.camera);
+    s = solve(imageSize, plate, points, {}, &s.camera);
   }
   out.camera = s.camera;
   out.rmsPx = s.rms;
   out.distortionModel = s.distortionModel;
   out.distortionCandidates = s.candidates;
-  const auto plate = board.platePoints();
   for (std::size_t k = 0; k < used.size(); ++k) {
     ViewFit& fit = out.views[used[k]];
     fit.used = true;
@@ -194,14 +203,14 @@ CameraCalibration calibrateCamera(const BoardSpec& board, cv::Size imageSize,
     fit.rotation = rotationOf(s.rvecs[k]);
     fit.translationMm = cv::Vec3d(s.tvecs[k].ptr<double>());
     double sum = 0;
-    for (std::size_t j = 0; j < plate.size(); ++j) {
-      const cv::Vec3d c =
-          fit.rotation * cv::Vec3d(plate[j].x, plate[j].y, plate[j].z) + fit.translationMm;
+    for (std::size_t j = 0; j < plate[k].size(); ++j) {
+      const cv::Point3d& q = plate[k][j];
+      const cv::Vec3d c = fit.rotation * cv::Vec3d(q.x, q.y, q.z) + fit.translationMm;
       const cv::Point2d r = points[k][j] - s.camera.project(c);
       fit.residuals.push_back(r);
       sum += r.dot(r);
     }
-    fit.rmsPx = std::sqrt(sum / static_cast<double>(plate.size()));
+    fit.rmsPx = std::sqrt(sum / static_cast<double>(plate[k].size()));
   }
   if (out.rmsPx > options.maxRmsPx) {
     out.status = Status<CalibrationFailure>::failed(
@@ -222,7 +231,7 @@ Status<CalibrationFailure> estimatePlanePose(const BoardSpec& board, const Camer
                                               view.name + ": " + view.detection.status.message);
   std::vector<cv::Point2d> points = view.detection.points;
   cv::Mat rvec, tvec;
-  std::vector<cv::Point3d> plate = board.platePoints();
+  std::vector<cv::Point3d> plate = view.detection.platePoints(board);
   const cv::Mat K(camera.cameraMatrix);
   cv::solvePnP(plate, points, K, camera.distortion, rvec, tvec, false, cv::SOLVEPNP_IPPE);
   if (board.kind == BoardSpec::Kind::Circles) {

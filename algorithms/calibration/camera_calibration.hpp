@@ -48,6 +48,7 @@ struct ViewFit {
   std::string note;                           // used, with a reservation (PatternDetection::note)
   double rmsPx = 0;                           // reprojection RMS of this view's points
   std::vector<cv::Point2d> points;            // detected points
+  std::vector<int> ids;                       // their plate point indices (PatternDetection)
   std::vector<cv::Point2d> residuals;         // detected - reprojected, pixels
   cv::Matx33d rotation = cv::Matx33d::eye();  // plate -> camera
   cv::Vec3d translationMm{0, 0, 0};

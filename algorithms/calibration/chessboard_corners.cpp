@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Dense>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "algorithms/calibration/edge_curve.hpp"
 #include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/image/grey8.hpp"
 
@@ -71,65 +71,6 @@ bool squaresBeyondBorder(const cv::Mat& image8, int cols, int rows,
               cols) ||
          side([&](int i) { return at(0, i); }, [&](int i) { return at(1, i); }, rows) ||
          side([&](int i) { return at(cols - 1, i); }, [&](int i) { return at(cols - 2, i); }, rows);
-}
-
-struct EdgeCurve {
-  cv::Point2d origin, along, across;  // local frame: along the line, across it
-  double a = 0, b = 0, q = 0;         // across = a + b t + q t^2
-  [[nodiscard]] cv::Point2d point(double t) const {
-    return origin + t * along + (a + b * t + q * t * t) * across;
-  }
-  [[nodiscard]] cv::Point2d tangent(double t) const { return along + (b + 2 * q * t) * across; }
-};
-
-// Least-squares quadratic through the points of one line; one pass drops points more than
-// 3 RMS (at least 0.2 px) off. False when either side of the corner has fewer than 4 points.
-bool fitCurve(const std::vector<cv::Point2d>& pts, EdgeCurve& curve) {
-  std::vector<double> t, e;
-  for (const auto& p : pts) {
-    t.push_back((p - curve.origin).dot(curve.along));
-    e.push_back((p - curve.origin).dot(curve.across));
-  }
-  std::vector<char> keep(pts.size(), 1);
-  for (int pass = 0; pass < 2; ++pass) {
-    int neg = 0, pos = 0, n = 0;
-    for (std::size_t i = 0; i < t.size(); ++i)
-      if (keep[i]) (t[i] < 0 ? neg : pos)++, ++n;
-    if (neg < 4 || pos < 4) return false;
-    Eigen::MatrixXd A(n, 3);
-    Eigen::VectorXd y(n);
-    for (std::size_t i = 0, k = 0; i < t.size(); ++i) {
-      if (!keep[i]) continue;
-      A.row(static_cast<Eigen::Index>(k)) << 1.0, t[i], t[i] * t[i];
-      y(static_cast<Eigen::Index>(k++)) = e[i];
-    }
-    const Eigen::Vector3d c = A.colPivHouseholderQr().solve(y);
-    curve.a = c(0), curve.b = c(1), curve.q = c(2);
-    if (pass == 1) break;
-    const double rms = std::sqrt((A * c - y).squaredNorm() / n);
-    const double limit = std::max(3 * rms, 0.2);
-    for (std::size_t i = 0; i < t.size(); ++i)
-      keep[i] = std::abs(e[i] - (c(0) + c(1) * t[i] + c(2) * t[i] * t[i])) <= limit;
-  }
-  return true;
-}
-
-std::optional<cv::Point2d> intersect(const EdgeCurve& u, const EdgeCurve& v, cv::Point2d start) {
-  cv::Point2d p = start;
-  for (int it = 0; it < 8; ++it) {
-    const double tu = (p - u.origin).dot(u.along), tv = (p - v.origin).dot(v.along);
-    const cv::Point2d pu = u.point(tu), du = u.tangent(tu), pv = v.point(tv), dv = v.tangent(tv);
-    // pu + s du = pv + w dv
-    const double det = du.cross(-dv);
-    if (std::abs(det) < 1e-9) return std::nullopt;
-    const cv::Point2d rhs = pv - pu;
-    const double s = rhs.cross(-dv) / det;
-    const cv::Point2d next = pu + s * du;
-    const double step = cv::norm(next - p);
-    p = next;
-    if (step < 1e-9) break;
-  }
-  return p;
 }
 
 // OpenCV's saddle-point refinement (cornerSubPix) in a window that stays inside the corner's
@@ -234,7 +175,7 @@ Status<CalibrationFailure> refineChessboardCorners(const cv::Mat& image, int col
           onY.push_back(e.position);
       }
       std::optional<cv::Point2d> q;
-      if (fitCurve(onX, lx) && fitCurve(onY, ly)) q = intersect(lx, ly, p);
+      if (fitEdgeCurve(onX, lx) && fitEdgeCurve(onY, ly)) q = intersectEdgeCurves(lx, ly, p);
       if (q && cv::norm(*q - p) <= 2.0) {
         refined[i] = *q;
       } else if (saddleVisible && outer < 2.0 * inner) {

@@ -29,4 +29,12 @@ std::vector<cv::Point2d> gridOutline(const std::vector<cv::Point2d>& p, int cols
   return out;
 }
 
+std::vector<cv::Point2d> patternOutline(const std::vector<cv::Point2d>& points,
+                                        const std::vector<int>& ids, int cols, int rows) {
+  if (ids.empty()) return gridOutline(points, cols, rows);
+  std::vector<cv::Point2f> in(points.begin(), points.end()), hull;
+  if (in.size() >= 3) cv::convexHull(in, hull);
+  return {hull.begin(), hull.end()};
+}
+
 }  // namespace facet

@@ -15,5 +15,9 @@ cv::Mat coveredField(cv::Size size, const std::vector<std::vector<cv::Point2d>>&
 double coveredShare(const cv::Mat& mask);
 // The outline of a cols x rows grid of points (its border points, in order).
 std::vector<cv::Point2d> gridOutline(const std::vector<cv::Point2d>& points, int cols, int rows);
+// The outline of a view's points: the grid's border when `ids` is empty (every point, in plate
+// order), else the convex hull of the points seen (a partial view).
+std::vector<cv::Point2d> patternOutline(const std::vector<cv::Point2d>& points,
+                                        const std::vector<int>& ids, int cols, int rows);
 
 }  // namespace facet

@@ -64,6 +64,7 @@ nlohmann::json viewsJson(const CameraCalibration& c) {
                      {"used", v.used},
                      {"why", v.status.message}});
     if (!v.note.empty()) views.back()["note"] = v.note;
+    if (v.status.ok()) views.back()["points"] = v.points.size();
   }
   return views;
 }
@@ -201,8 +202,9 @@ void addCalibrateCommand(CLI::App& app) {
   cmd->add_option("--images", options->images, "Folder of plate images (one camera, one size)")
       ->required();
   cmd->add_option("--board", options->board,
-                  "chessboard:COLSxROWS:SQUARE_MM (inner corners) or "
-                  "circles:COLSxROWS:PITCH_MM:DIAMETER_MM")
+                  "chessboard:COLSxROWS:SQUARE_MM (inner corners), "
+                  "circles:COLSxROWS:PITCH_MM:DIAMETER_MM or "
+                  "charuco:COLSxROWS:SQUARE_MM:MARKER_MM:DICT (squares, e.g. DICT_5X5_100)")
       ->required();
   cmd->add_option("--plane", options->plane, "Image of the plate lying where the parts lie");
   cmd->add_option("--plane-offset-mm", options->planeOffsetMm,

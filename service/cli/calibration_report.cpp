@@ -38,7 +38,7 @@ void writeCalibrationReport(const std::string& file, const BoardSpec& board, cv:
   const double gain = 40.0 / largest;
   std::vector<std::vector<cv::Point2d>> outlines;
   for (const auto& v : c.views)
-    if (v.used) outlines.push_back(gridOutline(v.points, board.cols, board.rows));
+    if (v.used) outlines.push_back(patternOutline(v.points, v.ids, board.cols, board.rows));
 
   std::ostringstream h;
   h << "<!doctype html><html><head><meta charset=\"utf-8\"><title>facet calibration</title>"

@@ -1,0 +1,229 @@
+#include "algorithms/calibration/charuco_corners.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <set>
+
+#include <opencv2/aruco/charuco.hpp>
+#include <opencv2/core/utility.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/calibration/edge_curve.hpp"
+#include "algorithms/image/grey8.hpp"
+#include "algorithms/measure/grey_profile.hpp"
+#include "algorithms/measure/measuring_path.hpp"
+#include "algorithms/measure/profile_edges.hpp"
+
+namespace facet {
+namespace {
+
+// Fewest corners a view is kept with: the solver's first guess of a view's pose is a homography,
+// and a handful of corners more than its four keep that guess from following the noise.
+constexpr int kMinCorners = 8;
+// Pixels across the edge line (along it, for the profile) that a profile averages.
+constexpr double kProfileWidth = 2.0;
+// The coarse corner is within a few tenths of a pixel: an edge farther than this from the line
+// through it belongs to something else (the marker's border, a neighbouring square).
+constexpr double kEdgeReach = 2.0;
+
+// The grid's directions and square size in the image at one corner: an affine fit to the coarse
+// corners within two squares of it (a lens-distorted grid is locally affine).
+struct LocalGrid {
+  cv::Point2d dx, dy;           // unit directions of the plate's x and y
+  double stepX = 0, stepY = 0;  // one square along them, pixels
+};
+
+bool localGrid(const std::vector<cv::Point2d>& points, const std::vector<int>& ids, int cols,
+               std::size_t self, LocalGrid& grid) {
+  const int c = ids[self] % cols, r = ids[self] / cols;
+  cv::Matx22d normal = cv::Matx22d::zeros();
+  cv::Matx22d moment = cv::Matx22d::zeros();  // sum of (image offset) (plate offset)^T
+  for (std::size_t j = 0; j < points.size(); ++j) {
+    const int dc = ids[j] % cols - c, dr = ids[j] / cols - r;
+    if (j == self || std::abs(dc) > 2 || std::abs(dr) > 2) continue;
+    const cv::Vec2d u(dc, dr);
+    const cv::Point2d d = points[j] - points[self];
+    normal += u * u.t();
+    moment += cv::Vec2d(d.x, d.y) * u.t();
+  }
+  if (cv::determinant(normal) < 1.0) return false;  // neighbours on one line only
+  const cv::Matx22d a = moment * normal.inv();      // columns: one square along x, along y
+  const cv::Point2d ax(a(0, 0), a(1, 0)), ay(a(0, 1), a(1, 1));
+  grid.stepX = cv::norm(ax), grid.stepY = cv::norm(ay);
+  if (grid.stepX < 1 || grid.stepY < 1) return false;
+  grid.dx = ax / grid.stepX, grid.dy = ay / grid.stepY;
+  return true;
+}
+
+// Edge points of the edge line through `corner` along `along`, from profiles laid along
+// `across` (the other line's direction, so that each profile keeps its distance from the other
+// line) at distances `inner`..`outer` either side of the corner.
+std::vector<cv::Point2d> lineEdgePoints(const cv::Mat& image, cv::Point2d corner, cv::Point2d along,
+                                        cv::Point2d across, double inner, double outer,
+                                        double halfLength, const ProfileEdgeParams& params) {
+  std::vector<cv::Point2d> out;
+  GreyProfileSampler sampler;
+  ProfileEdgeFinder finder(params);
+  const double angle = std::atan2(-across.y, across.x) * 180.0 / CV_PI;
+  // Profiles kProfileWidth apart are independent; at most a dozen a side is plenty.
+  const double step = std::max(kProfileWidth, (outer - inner) / 12.0);
+  for (const double side : {-1.0, 1.0})
+    for (double t = inner; t <= outer + 1e-9; t += step) {
+      const cv::Point2d centre = corner + side * t * along;
+      const MeasuringPath path(
+          MeasuringRect{centre.x, centre.y, 2 * halfLength, kProfileWidth, angle});
+      const GreyProfile& profile = sampler.sample(image, path);
+      if (profile.partial || profile.values.empty()) continue;
+      const ProfileEdge* nearest = nullptr;
+      for (const ProfileEdge& e : finder.find(profile))
+        if (std::abs(e.position) <= kEdgeReach &&
+            (!nearest || std::abs(e.position) < std::abs(nearest->position)))
+          nearest = &e;
+      if (nearest) out.push_back(path.at(nearest->position, 0));
+    }
+  return out;
+}
+
+// The blur width of the edges around a corner (fitted step width, pixels), from one profile
+// across the x line halfway to the next corner; 1.5 px when none is found.
+double localBlur(const cv::Mat& image, cv::Point2d corner, const LocalGrid& g,
+                 const ProfileEdgeParams& params) {
+  const cv::Point2d centre = corner + 0.5 * g.stepX * g.dx;
+  const double angle = std::atan2(-g.dy.y, g.dy.x) * 180.0 / CV_PI;
+  const MeasuringPath path(MeasuringRect{centre.x, centre.y, 0.8 * g.stepY, kProfileWidth, angle});
+  const GreyProfile profile = sampleGreyProfile(image, path);
+  double blur = 1.5, best = kEdgeReach;
+  if (profile.partial || profile.values.empty()) return blur;
+  for (const ProfileEdge& e : findProfileEdges(profile, params))
+    if (std::abs(e.position) <= best) best = std::abs(e.position), blur = e.blur;
+  return blur;
+}
+
+enum class Refined { EdgeLines, Saddle, Dropped };
+
+Refined refineCorner(const cv::Mat& image, const cv::Mat& image8, const LocalGrid& g,
+                     cv::Point2d& corner) {
+  const double sine = std::max(std::abs(g.dx.cross(g.dy)), 0.3);
+  // Steps below a third of the local contrast are marker bits' blur or noise, not the edge.
+  const double reach = 0.5 * std::min(g.stepX, g.stepY);
+  const cv::Rect box = cv::Rect(cvRound(corner.x - reach), cvRound(corner.y - reach),
+                                cvRound(2 * reach) + 1, cvRound(2 * reach) + 1) &
+                       cv::Rect(0, 0, image8.cols, image8.rows);
+  if (box.area() < 9) return Refined::Dropped;
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(image8(box), &lo, &hi);
+  ProfileEdgeParams params;
+  params.minAmplitude = std::max(8.0, (hi - lo) / 3.0);
+  const double blur = localBlur(image, corner, g, params);
+  // A profile parallel to the other line stays clear of that line's blur (3.5 widths) and of
+  // its own width's half, measured across the narrower angle of the X.
+  const double inner = (3.5 * blur + 0.5 * kProfileWidth) / sine + 1.0;
+  const double outerX = g.stepX - inner, outerY = g.stepY - inner;
+  if (std::min(outerX, outerY) < inner + 4.0) return Refined::Saddle;
+  // Each profile runs to the middle of the squares on either side of its line: it takes in the
+  // marker's border beside the edge (a neighbouring step for the estimator), never another line.
+  const std::vector<cv::Point2d> onX =
+      lineEdgePoints(image, corner, g.dx, g.dy, inner, outerX, 0.5 * g.stepY * sine, params);
+  const std::vector<cv::Point2d> onY =
+      lineEdgePoints(image, corner, g.dy, g.dx, inner, outerY, 0.5 * g.stepX * sine, params);
+  EdgeCurve lx{corner, g.dx, {-g.dx.y, g.dx.x}}, ly{corner, g.dy, {-g.dy.y, g.dy.x}};
+  if (!fitEdgeCurve(onX, lx) || !fitEdgeCurve(onY, ly)) return Refined::Dropped;
+  const auto q = intersectEdgeCurves(lx, ly, corner);
+  if (!q || cv::norm(*q - corner) > kEdgeReach) return Refined::Dropped;
+  corner = *q;
+  return Refined::EdgeLines;
+}
+
+}  // namespace
+
+PatternDetection detectCharuco(const cv::Mat& image, const BoardSpec& board) {
+  PatternDetection out;
+  const cv::Mat image8 = toGrey8(image);
+  const auto dictionary = cv::aruco::getPredefinedDictionary(board.dictionary);
+  const auto cvBoard = cv::aruco::CharucoBoard::create(
+      board.cols + 1, board.rows + 1, static_cast<float>(board.pitchMm),
+      static_cast<float>(board.markerMm), dictionary);
+  std::vector<std::vector<cv::Point2f>> markers, kept;
+  std::vector<int> markerIds, keptIds;
+  cv::aruco::detectMarkers(image8, dictionary, markers, markerIds);
+  // Markers of the dictionary that are not on this board (another board in view, or the spec
+  // names fewer squares than the plate has) would be matched to the wrong squares.
+  const int boardMarkers = static_cast<int>(cvBoard->ids.size());
+  int foreign = 0;
+  for (std::size_t i = 0; i < markers.size(); ++i) {
+    if (markerIds[i] >= 0 && markerIds[i] < boardMarkers)
+      kept.push_back(markers[i]), keptIds.push_back(markerIds[i]);
+    else
+      ++foreign;
+  }
+  if (kept.empty()) {
+    out.status.message = markers.empty()
+                             ? "no " + dictionaryName(board.dictionary) +
+                                   " markers found (wrong dictionary, or the board is too blurred "
+                                   "or too small in the image)"
+                             : std::to_string(foreign) + " markers found, none of them on a " +
+                                   board.text() + " board (is the board spec right?)";
+    return out;
+  }
+  if (foreign > static_cast<int>(kept.size())) {
+    out.status.message = std::to_string(foreign) + " of " + std::to_string(markers.size()) +
+                         " markers found have ids beyond the " + std::to_string(boardMarkers) +
+                         " of a " + board.text() + " board (is the board spec right?)";
+    return out;
+  }
+  std::vector<cv::Point2f> coarse;
+  std::vector<int> coarseIds;
+  cv::aruco::interpolateCornersCharuco(kept, keptIds, image8, cvBoard, coarse, coarseIds);
+  std::vector<std::size_t> order(coarse.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return coarseIds[a] < coarseIds[b]; });
+  std::vector<cv::Point2d> points;
+  std::vector<int> ids;
+  for (std::size_t i : order) points.emplace_back(coarse[i]), ids.push_back(coarseIds[i]);
+
+  std::vector<Refined> how(points.size(), Refined::Dropped);
+  std::vector<cv::Point2d> refined = points;
+  cv::parallel_for_(cv::Range(0, static_cast<int>(points.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i) {
+      const auto k = static_cast<std::size_t>(i);
+      LocalGrid g;
+      if (!localGrid(points, ids, board.cols, k, g)) continue;  // isolated: no directions
+      how[k] = refineCorner(image, image8, g, refined[k]);
+    }
+  });
+  int saddle = 0;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (how[k] == Refined::Dropped) continue;
+    if (how[k] == Refined::Saddle) ++saddle;
+    out.points.push_back(refined[k]);
+    out.ids.push_back(ids[k]);
+  }
+  const int total = board.pointCount(), found = static_cast<int>(out.ids.size());
+  std::set<int> cols, rows;
+  for (int id : out.ids) cols.insert(id % board.cols), rows.insert(id / board.cols);
+  if (found < kMinCorners || cols.size() < 2 || rows.size() < 2) {
+    out.status.message =
+        "only " + std::to_string(found) + " of " + std::to_string(total) + " corners located (" +
+        std::to_string(kept.size()) + " markers found; at least " + std::to_string(kMinCorners) +
+        " corners over two rows and columns are needed" +
+        (kept.size() >= 4 && found < 4 ? "; do the squares and markers match the board spec?"
+                                       : "") +
+        ")";
+    out.points.clear(), out.ids.clear();
+    return out;
+  }
+  out.status = {};
+  if (found < total)
+    out.note = std::to_string(found) + " of " + std::to_string(total) +
+               " corners (part of the plate outside the image or hidden)";
+  if (saddle > 0)
+    out.note += std::string(out.note.empty() ? "" : "; ") + std::to_string(saddle) + " of " +
+                std::to_string(found) +
+                " corners by saddle point: squares too small for edge lines at this blur and "
+                "angle (a closer or larger plate is more precise)";
+  return out;
+}
+
+}  // namespace facet
