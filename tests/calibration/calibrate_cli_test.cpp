@@ -89,6 +89,50 @@ TEST_F(CalibrateCli, CalibratesWritesTheFileAndMeasuresInTheRightPlane) {
   EXPECT_EQ(c["world"]["calibration"], "lens model + plane");
 }
 
+TEST_F(CalibrateCli, CalibratesFromACharucoPlatePartlyOutsideSomeViewsWithThePlaneFromOne) {
+  const BoardSpec board = test::charucoBoard();
+  const auto camera = test::testCamera();
+  const auto views = dir / "charuco";
+  fs::create_directories(views);
+  for (int i = 0; i < 6; ++i)
+    cv::imwrite((views / ("view" + std::to_string(i) + ".png")).string(),
+                test::plateScene(board, camera, 37, i).render());
+  // A close view with the plate's top-left part beyond the image.
+  scene::PlaneScene close;
+  close.camera = camera;
+  close.placement = scene::lookAtPlane({85, 60}, 180, 25, 30, -6, camera);
+  scene::addCharucoPlate(close, board.cols + 1, board.rows + 1, board.pitchMm, board.markerMm,
+                         board.dictionary);
+  close.noiseSigma = 2;
+  cv::imwrite((views / "close.png").string(), close.render());
+  // The plane from a view that shows part of the plate, too.
+  scene::PlaneScene plane = close;
+  plane.placement = scene::lookAtPlane({70, 50}, 200, 10, 60, 4, camera);
+  cv::imwrite((dir / "charuco_plane.png").string(), plane.render());
+
+  const auto cal = dir / "charuco_calibration.yaml";
+  const auto run = test::runFacet(
+      "calibrate --images " + views.string() + " --board " + board.text() + " --min-views 6" +
+      " --plane " + (dir / "charuco_plane.png").string() + " --out " + cal.string() + " --json");
+  ASSERT_EQ(run.exitCode, 0) << run.err << run.out;
+  const auto j = nlohmann::json::parse(run.out);
+  EXPECT_LT(j["rms_px"].get<double>(), 0.1);
+  EXPECT_NEAR(j["camera_matrix"][0][0].get<double>(), 1500, 10);
+  EXPECT_NEAR(j["distortion"][0].get<double>(), -0.22, 0.03);
+  ASSERT_EQ(j["views"].size(), 7u);
+  for (const auto& v : j["views"]) {
+    EXPECT_TRUE(v["used"].get<bool>()) << v.dump();
+    if (v["file"] == "close.png") {
+      EXPECT_LT(v["points"].get<int>(), 88) << v.dump();
+      EXPECT_NE(v["note"].get<std::string>().find("of 88 corners"), std::string::npos) << v.dump();
+    } else {
+      EXPECT_EQ(v["points"].get<int>(), 88) << v.dump();
+    }
+  }
+  ASSERT_TRUE(j.contains("plane"));
+  EXPECT_NEAR(j["plane"]["translation_mm"][2].get<double>(), plane.placement.translationMm[2], 1.0);
+}
+
 // The example station's calibration file is what `facet calibrate` makes of the plate images
 // shipped beside it (recipes/README.md): nobody edited it by hand, and the command still reads
 // those plates the same way.

@@ -1,6 +1,7 @@
 #pragma once
 // Rendered plate views shared by the calibration tests.
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -21,13 +22,15 @@ inline scene::PlaneScene plateScene(const BoardSpec& board, const scene::LensCam
                                     std::uint64_t seed, int index, double noise = 2.0) {
   scene::PlaneScene s;
   s.camera = camera;
-  const double margin =
-      board.kind == BoardSpec::Kind::Chessboard ? 2 * board.pitchMm : board.pitchMm;
+  const double margin = board.kind == BoardSpec::Kind::Circles ? board.pitchMm : 2 * board.pitchMm;
   s.placement = scene::seriesPlacement(
       camera, {(board.cols - 1) * board.pitchMm, (board.rows - 1) * board.pitchMm}, margin, seed,
       index);
   if (board.kind == BoardSpec::Kind::Chessboard)
     scene::addChessboardPlate(s, board.cols, board.rows, board.pitchMm);
+  else if (board.kind == BoardSpec::Kind::Charuco)
+    scene::addCharucoPlate(s, board.cols + 1, board.rows + 1, board.pitchMm, board.markerMm,
+                           board.dictionary);
   else
     scene::addCirclePlate(s, board.cols, board.rows, board.pitchMm, board.diameterMm);
   s.noiseSigma = noise;
@@ -40,6 +43,11 @@ inline BoardSpec chessboard() {
 }
 inline BoardSpec circleGrid() {
   return {BoardSpec::Kind::Circles, 9, 7, 12.0, 6.0};
+}
+// 12 x 9 squares: the chessboard's 11 x 8 inner corners, with 54 markers.
+inline BoardSpec charucoBoard() {
+  std::string why;
+  return *parseBoardSpec("charuco:12x9:10:7:DICT_5X5_100", why);
 }
 
 }  // namespace facet::test

@@ -1,6 +1,7 @@
 // Calibration from rendered views against the renderer's camera.
 #include "algorithms/calibration/camera_calibration.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -58,6 +59,34 @@ TEST(CameraCalibration, ChessboardViewsGiveTheRenderedCamera) {
                                  renderViews(test::chessboard(), camera, 10, 21));
   expectCamera(c, camera);
   EXPECT_GT(c.coverage, 0.3);
+}
+
+TEST(CameraCalibration, CharucoViewsSomeShowingPartOfThePlateGiveTheRenderedCamera) {
+  const auto camera = test::testCamera();
+  const BoardSpec board = test::charucoBoard();
+  std::vector<PlateView> views = renderViews(board, camera, 8, 23);
+  // Two close views reaching into the image's corners, each with part of the plate outside.
+  for (const auto& [target, name] : {std::pair{cv::Point2d(85, 60), "top-left"},
+                                     std::pair{cv::Point2d(15, 10), "bottom-right"}}) {
+    scene::PlaneScene s;
+    s.camera = camera;
+    s.placement = scene::lookAtPlane(target, 180, 25, 30, -6, camera);
+    scene::addCharucoPlate(s, board.cols + 1, board.rows + 1, board.pitchMm, board.markerMm,
+                           board.dictionary);
+    s.noiseSigma = 2;
+    views.push_back(detectPlate(s.render(), board, name));
+  }
+  const auto c = calibrateCamera(board, camera.size, views);
+  expectCamera(c, camera);
+  for (const std::string partial : {"top-left", "bottom-right"}) {
+    const auto v = std::find_if(c.views.begin(), c.views.end(),
+                                [&](const ViewFit& f) { return f.name == partial; });
+    ASSERT_NE(v, c.views.end());
+    EXPECT_TRUE(v->used) << v->status.message;
+    EXPECT_LT(v->points.size(), 88u);
+    EXPECT_EQ(v->points.size(), v->ids.size());
+    EXPECT_LT(v->rmsPx, 0.1);
+  }
 }
 
 TEST(CameraCalibration, ADistortedWideLensKeepsItsHigherTerms) {
