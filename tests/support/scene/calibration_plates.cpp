@@ -3,24 +3,31 @@
 #include <random>
 
 namespace facet::scene {
+namespace {
+
+std::vector<cv::Point2d> rectangle(double x0, double y0, double x1, double y1) {
+  return {{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}};
+}
+
+}  // namespace
 
 void addChessboardPlate(PlaneScene& scene, int cols, int rows, double pitch, double dark,
                         double light) {
   // Squares i = 0..cols, j = 0..rows span [(i-1) p, i p] x [(j-1) p, j p]; dark when i + j is even.
+  // The dark squares meet at the inner corners, so they are one shape: exact at the corners.
   const double x0 = -2 * pitch, y0 = -2 * pitch, x1 = (cols + 1) * pitch, y1 = (rows + 1) * pitch;
-  scene.addPolygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, light);
+  scene.addPolygon(rectangle(x0, y0, x1, y1), light);
+  std::vector<std::vector<cv::Point2d>> squares;
   for (int j = 0; j <= rows; ++j)
-    for (int i = 0; i <= cols; ++i) {
-      if ((i + j) % 2 != 0) continue;
-      const double a = (i - 1) * pitch, b = (j - 1) * pitch;
-      scene.addPolygon({{a, b}, {a + pitch, b}, {a + pitch, b + pitch}, {a, b + pitch}}, dark);
-    }
+    for (int i = 0; i <= cols; ++i)
+      if ((i + j) % 2 == 0)
+        squares.push_back(rectangle((i - 1) * pitch, (j - 1) * pitch, i * pitch, j * pitch));
+  scene.addPolygons(std::move(squares), dark);
 }
 
 void addCirclePlate(PlaneScene& scene, int cols, int rows, double pitch, double diameter,
                     double dark, double light) {
-  const double x0 = -pitch, y0 = -pitch, x1 = cols * pitch, y1 = rows * pitch;
-  scene.addPolygon({{x0, y0}, {x1, y0}, {x1, y1}, {x0, y1}}, light);
+  scene.addPolygon(rectangle(-pitch, -pitch, cols * pitch, rows * pitch), light);
   for (int j = 0; j < rows; ++j)
     for (int i = 0; i < cols; ++i) scene.addDisc({i * pitch, j * pitch}, diameter / 2, dark);
 }
