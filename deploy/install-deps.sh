@@ -9,7 +9,7 @@ packages=(
   build-essential cmake ninja-build ccache pkg-config git
   clang clang-format clang-tidy libclang-rt-14-dev
   # algorithms
-  libopencv-dev libeigen3-dev libnanoflann-dev
+  libopencv-dev libopencv-contrib-dev libeigen3-dev libnanoflann-dev
   # camera
   libopenimageio-dev openimageio-tools libaravis-dev aravis-tools-cli libusb-1.0-0-dev zlib1g-dev libpng-dev libjpeg-dev libtiff-dev
   libv4l-dev
