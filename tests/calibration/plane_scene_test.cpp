@@ -2,6 +2,7 @@
 // projections against OpenCV's projectPoints, blur before integration against the pixel sum.
 #include <cmath>
 #include <random>
+#include <utility>
 
 #include <gtest/gtest.h>
 #include <opencv2/calib3d.hpp>
@@ -90,6 +91,71 @@ TEST(PlaneScene, ChessboardCornersLieOnTheSquaresEdges) {
                       image.at<double>(p.y + 1, p.x) + image.at<double>(p.y + 1, p.x + 1)) /
                      4;
   EXPECT_NEAR(mid, 125, 40);
+}
+
+// A plate seen square on through a distortion-free lens at 10 px/mm: the squares are axis-aligned
+// in the image, the plate origin at `cornerPx`, so a pixel's coverages are products of overlaps.
+// With the corner's y on a multiple of 1/256 px the edge falls between two sub-scanlines and the
+// analytic value is the renderer's exact answer.
+PlaneScene squareOnScene(cv::Point2d cornerPx) {
+  PlaneScene s;
+  s.camera.size = {160, 120};
+  s.camera.fx = s.camera.fy = 1000;
+  s.camera.cx = cornerPx.x, s.camera.cy = cornerPx.y;
+  s.placement.translationMm = {0, 0, 100};
+  return s;
+}
+
+TEST(PlaneScene, ChessboardCornerPixelIsExact) {
+  const double dark = 25, light = 225;
+  // The corner at 0.3 of its pixel across and 0.25 down: the dark squares up-left and down-right
+  // cover 0.3 * 0.25 and 0.7 * 0.75 of the pixel.
+  const cv::Point2d corner(60.3 - 0.5, 50.25 - 0.5);
+  const double a = 0.3, b = 0.25;
+  const double darkShare = a * b + (1 - a) * (1 - b);
+  const double exact = dark * darkShare + light * (1 - darkShare);
+
+  PlaneScene s = squareOnScene(corner);
+  addChessboardPlate(s, 3, 3, 1);
+  const double value = s.renderIdeal().at<double>(50, 60);
+  EXPECT_NEAR(value, exact, 1e-9);
+
+  // The same squares painted one by one leave the second's share of the first's coverage light:
+  // (light - dark) times the product of their coverages, 7.9 grey levels here.
+  PlaneScene painter = squareOnScene(corner);
+  painter.addPolygon({{-2, -2}, {4, -2}, {4, 4}, {-2, 4}}, light);
+  for (const auto& square : s.shapes[1].morePolygons) painter.addPolygon(square, dark);
+  painter.addPolygon(s.shapes[1].polygon, dark);
+  const double painted = painter.renderIdeal().at<double>(50, 60);
+  EXPECT_NEAR(painted - exact, (light - dark) * (a * b) * ((1 - a) * (1 - b)), 1e-9);
+  EXPECT_GT(std::abs(painted - exact), 7.0);
+}
+
+TEST(PlaneScene, TouchingPolygonsOfOneShapePaintAsTheirUnion) {
+  PlaneScene one;
+  one.camera = distortedCamera();
+  one.camera.size = {320, 256};
+  one.camera.cx = 159.5, one.camera.cy = 127.5, one.camera.fx = one.camera.fy = 400;
+  one.placement = lookAtPlane({10, 10}, 300, 30, 60, 15, one.camera);
+  one.background = 200;
+  PlaneScene two = one, painter = one;
+  one.addPolygon({{0, 0}, {20, 0}, {20, 20}, {0, 20}}, 40);
+  const std::vector<cv::Point2d> left{{0, 0}, {8, 0}, {8, 20}, {0, 20}};
+  const std::vector<cv::Point2d> right{{8, 0}, {20, 0}, {20, 20}, {8, 20}};
+  two.addPolygons({left, right}, 40);
+  painter.addPolygon(left, 40);
+  painter.addPolygon(right, 40);
+  // Painted one after the other, a pixel the shared edge halves stays a quarter light:
+  // (200 - 40) / 4 = 40 grey levels off, spread by the lens blur to about 3.
+  for (const auto& [blur, painterOff] : {std::pair{0.0, 30.0}, std::pair{1.2, 2.0}}) {
+    one.lensBlurSigma = two.lensBlurSigma = painter.lensBlurSigma = blur;
+    const cv::Mat reference = one.renderIdeal();
+    // The shared edge is cut into chords at other points than the whole square's edge is, a few
+    // 1e-6 px apart on the bent image of the edge: 2e-6 grey levels here.
+    EXPECT_LT(cv::norm(two.renderIdeal() - reference, cv::NORM_INF), 1e-4) << "blur " << blur;
+    EXPECT_GT(cv::norm(painter.renderIdeal() - reference, cv::NORM_INF), painterOff)
+        << "blur " << blur;
+  }
 }
 
 }  // namespace

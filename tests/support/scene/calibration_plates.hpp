@@ -16,6 +16,18 @@ namespace facet::scene {
 // lies at (c * pitch, r * pitch).
 void addChessboardPlate(PlaneScene& scene, int cols, int rows, double pitchMm, double dark = 25,
                         double light = 225);
+// A ChArUco plate laid out as OpenCV 4.6's
+// cv::aruco::CharucoBoard::create(squaresX, squaresY, squareMm, markerMm,
+// getPredefinedDictionary(dictionary)), with a light margin of one square. OpenCV's board frame
+// has its origin at the board's outer top-left corner, x along the columns and y DOWN the
+// printed board (its objPoints put marker 0 in the top row and its chessboard corners at
+// (c+1, r+1) * square, as CharucoBoard::draw shows); the plate frame here is that frame less
+// (square, square), so its origin is the first inner corner and inner corner (c, r) lies at
+// (c * square, r * square), OpenCV's ChArUco corner id r * (squaresX - 1) + c. The top-left
+// square is dark; markers 0, 1, 2... sit centred in the light squares, row by row, with a black
+// border one bit wide. charuco_plate_test.cpp checks all of this against OpenCV.
+void addCharucoPlate(PlaneScene& scene, int squaresX, int squaresY, double squareMm,
+                     double markerMm, int dictionary, double dark = 25, double light = 225);
 // A light plate with cols x rows dark discs at (c * pitch, r * pitch), margin of one pitch.
 void addCirclePlate(PlaneScene& scene, int cols, int rows, double pitchMm, double diameterMm,
                     double dark = 25, double light = 225);

@@ -9,6 +9,10 @@
 // area average of the painted plane over the pixel's square (exact along x, 256 sub-scanlines per
 // pixel along y: the midpoint rule is exact between the outline's kinks, leaving < 1e-5 of a
 // grey level per pixel; plane_scene_test.cpp checks areas against the polygon formula).
+// Shapes are painted in order, each over what lies beneath in proportion to its coverage of the
+// pixel; that is exact for one shape over another, but two shapes of one grey that touch would
+// each only partly paint their shared pixels, so touching polygons go into one shape
+// (addPolygons), whose coverage is their sum.
 //
 // Lens blur happens before the pixel integrates: with `lensBlurSigma` the coverage is rendered
 // on a grid `fineFactor` times finer, blurred there with a Gaussian of that sigma, and then
@@ -52,9 +56,14 @@ PlanePlacement lookAtPlane(cv::Point2d target, double distanceMm, double tiltDeg
 
 struct PlaneShape {
   std::vector<cv::Point2d> polygon;  // mm, either orientation; empty for a disc
-  cv::Point2d centre;                // disc centre, mm
-  double radius = 0;                 // disc radius, mm
-  double grey = 0;                   // 8-bit scale
+  // Further polygons of the same grey, disjoint from `polygon` and from one another. The shape's
+  // coverage is the sum of its polygons' coverages, painted once: exact where they touch (two
+  // chessboard squares at a corner, two marker cells along an edge), where painting them one
+  // after another would leave the shared pixels partly unpainted.
+  std::vector<std::vector<cv::Point2d>> morePolygons;
+  cv::Point2d centre;  // disc centre, mm
+  double radius = 0;   // disc radius, mm
+  double grey = 0;     // 8-bit scale
 };
 
 struct PlaneScene {
@@ -68,14 +77,21 @@ struct PlaneScene {
   std::uint64_t seed = 1;
 
   void addPolygon(std::vector<cv::Point2d> mm, double grey);
+  // One shape of several disjoint polygons (mm) of one grey; none may be empty.
+  void addPolygons(std::vector<std::vector<cv::Point2d>> mm, double grey);
   void addDisc(cv::Point2d centreMm, double radiusMm, double grey);
   [[nodiscard]] cv::Point2d imageOf(cv::Point2d planeMm) const;  // exact ground truth, pixels
   [[nodiscard]] cv::Mat renderIdeal() const;  // CV_64F, blurred, no noise, not quantised
   [[nodiscard]] cv::Mat render() const;       // CV_8U
 };
 
-// The projected, subdivided outline of a shape, in pixels (exposed for the area test).
+// The projected, subdivided outline of a shape's first polygon (or its disc), in pixels (exposed
+// for the area test).
 std::vector<cv::Point2d> projectOutline(const PlaneScene& scene, const PlaneShape& shape,
+                                        double scale = 1.0);
+// The projected, subdivided outline of a plane polygon (mm), in pixels.
+std::vector<cv::Point2d> projectPolygon(const PlaneScene& scene,
+                                        const std::vector<cv::Point2d>& polygonMm,
                                         double scale = 1.0);
 // Exact-in-x, sub-scanline-in-y coverage of a pixel polygon on a grid of `size` cells.
 cv::Mat polygonCoverage(const std::vector<cv::Point2d>& polygon, cv::Size size, int subrows = 256);
