@@ -56,32 +56,32 @@ bool localGrid(const std::vector<cv::Point2d>& points, const std::vector<int>& i
   return true;
 }
 
-// Edge points of the edge line through `corner` along `along`, from profiles laid along
-// `across` (the other line's direction, so that each profile keeps its distance from the other
-// line) at distances `inner`..`outer` either side of the corner.
-std::vector<cv::Point2d> lineEdgePoints(const cv::Mat& image, cv::Point2d corner, cv::Point2d along,
-                                        cv::Point2d across, double inner, double outer,
-                                        double halfLength, const ProfileEdgeParams& params) {
+// Edge points of one stretch of an edge line: profiles laid along `across` (the other line's
+// direction at the corner, so that each profile keeps its distance from that line) at distances
+// `from`..`to` from `origin` along `along`.
+std::vector<cv::Point2d> stretchEdgePoints(const cv::Mat& image, cv::Point2d origin,
+                                           cv::Point2d along, cv::Point2d across, double from,
+                                           double to, double halfLength,
+                                           const ProfileEdgeParams& params) {
   std::vector<cv::Point2d> out;
   GreyProfileSampler sampler;
   ProfileEdgeFinder finder(params);
   const double angle = std::atan2(-across.y, across.x) * 180.0 / CV_PI;
-  // Profiles kProfileWidth apart are independent; at most a dozen a side is plenty.
-  const double step = std::max(kProfileWidth, (outer - inner) / 12.0);
-  for (const double side : {-1.0, 1.0})
-    for (double t = inner; t <= outer + 1e-9; t += step) {
-      const cv::Point2d centre = corner + side * t * along;
-      const MeasuringPath path(
-          MeasuringRect{centre.x, centre.y, 2 * halfLength, kProfileWidth, angle});
-      const GreyProfile& profile = sampler.sample(image, path);
-      if (profile.partial || profile.values.empty()) continue;
-      const ProfileEdge* nearest = nullptr;
-      for (const ProfileEdge& e : finder.find(profile))
-        if (std::abs(e.position) <= kEdgeReach &&
-            (!nearest || std::abs(e.position) < std::abs(nearest->position)))
-          nearest = &e;
-      if (nearest) out.push_back(path.at(nearest->position, 0));
-    }
+  // Profiles kProfileWidth apart are independent; at most a dozen a stretch is plenty.
+  const double step = std::max(kProfileWidth, (to - from) / 12.0);
+  for (double t = from; t <= to + 1e-9; t += step) {
+    const cv::Point2d centre = origin + t * along;
+    const MeasuringPath path(
+        MeasuringRect{centre.x, centre.y, 2 * halfLength, kProfileWidth, angle});
+    const GreyProfile& profile = sampler.sample(image, path);
+    if (profile.partial || profile.values.empty()) continue;
+    const ProfileEdge* nearest = nullptr;
+    for (const ProfileEdge& e : finder.find(profile))
+      if (std::abs(e.position) <= kEdgeReach &&
+          (!nearest || std::abs(e.position) < std::abs(nearest->position)))
+        nearest = &e;
+    if (nearest) out.push_back(path.at(nearest->position, 0));
+  }
   return out;
 }
 
@@ -100,39 +100,71 @@ double localBlur(const cv::Mat& image, cv::Point2d corner, const LocalGrid& g,
   return blur;
 }
 
-enum class Refined { EdgeLines, Saddle, Dropped };
+// What a corner's refinement needs to know of its surroundings.
+struct CornerSetup {
+  enum class Kind { EdgeLines, Saddle, Dropped } kind = Kind::Dropped;
+  LocalGrid grid;
+  double sine = 1;   // of the X's angle
+  double inner = 0;  // nearest a profile comes to the corner, along a line, pixels
+  ProfileEdgeParams params;
+};
 
-Refined refineCorner(const cv::Mat& image, const cv::Mat& image8, const LocalGrid& g,
-                     cv::Point2d& corner) {
-  const double sine = std::max(std::abs(g.dx.cross(g.dy)), 0.3);
+CornerSetup setUpCorner(const cv::Mat& image, const cv::Mat& image8, const LocalGrid& g,
+                        cv::Point2d corner) {
+  CornerSetup setup;
+  setup.grid = g;
+  setup.sine = std::max(std::abs(g.dx.cross(g.dy)), 0.3);
   // Steps below a third of the local contrast are marker bits' blur or noise, not the edge.
   const double reach = 0.5 * std::min(g.stepX, g.stepY);
   const cv::Rect box = cv::Rect(cvRound(corner.x - reach), cvRound(corner.y - reach),
                                 cvRound(2 * reach) + 1, cvRound(2 * reach) + 1) &
                        cv::Rect(0, 0, image8.cols, image8.rows);
-  if (box.area() < 9) return Refined::Dropped;
+  if (box.area() < 9) return setup;
   double lo = 0, hi = 0;
   cv::minMaxLoc(image8(box), &lo, &hi);
-  ProfileEdgeParams params;
-  params.minAmplitude = std::max(8.0, (hi - lo) / 3.0);
-  const double blur = localBlur(image, corner, g, params);
+  setup.params.minAmplitude = std::max(8.0, (hi - lo) / 3.0);
+  const double blur = localBlur(image, corner, g, setup.params);
   // A profile parallel to the other line stays clear of that line's blur (3.5 widths) and of
   // its own width's half, measured across the narrower angle of the X.
-  const double inner = (3.5 * blur + 0.5 * kProfileWidth) / sine + 1.0;
-  const double outerX = g.stepX - inner, outerY = g.stepY - inner;
-  if (std::min(outerX, outerY) < inner + 4.0) return Refined::Saddle;
+  setup.inner = (3.5 * blur + 0.5 * kProfileWidth) / setup.sine + 1.0;
+  const double outer = std::min(g.stepX, g.stepY) - setup.inner;
+  setup.kind = outer < setup.inner + 4.0 ? CornerSetup::Kind::Saddle : CornerSetup::Kind::EdgeLines;
+  return setup;
+}
+
+// One stretch of edge line beside a corner: to the neighbouring corner (shared by the two, and
+// searched once), or, with no neighbour found, one square's length out from the corner.
+struct Stretch {
+  std::size_t corner = 0;
+  int neighbour = -1;  // index into the corners, or -1
+  bool alongX = true;  // part of the corner's x line (else its y line)
+  double sign = 1;     // direction from the corner: +x / +y or -x / -y
+  std::vector<cv::Point2d> points;
+};
+
+void searchStretch(const cv::Mat& image, const std::vector<cv::Point2d>& corners,
+                   const std::vector<CornerSetup>& setups, Stretch& s) {
+  const CornerSetup& a = setups[s.corner];
+  const LocalGrid& g = a.grid;
+  const cv::Point2d origin = corners[s.corner];
   // Each profile runs to the middle of the squares on either side of its line: it takes in the
   // marker's border beside the edge (a neighbouring step for the estimator), never another line.
-  const std::vector<cv::Point2d> onX =
-      lineEdgePoints(image, corner, g.dx, g.dy, inner, outerX, 0.5 * g.stepY * sine, params);
-  const std::vector<cv::Point2d> onY =
-      lineEdgePoints(image, corner, g.dy, g.dx, inner, outerY, 0.5 * g.stepX * sine, params);
-  EdgeCurve lx{corner, g.dx, {-g.dx.y, g.dx.x}}, ly{corner, g.dy, {-g.dy.y, g.dy.x}};
-  if (!fitEdgeCurve(onX, lx) || !fitEdgeCurve(onY, ly)) return Refined::Dropped;
-  const auto q = intersectEdgeCurves(lx, ly, corner);
-  if (!q || cv::norm(*q - corner) > kEdgeReach) return Refined::Dropped;
-  corner = *q;
-  return Refined::EdgeLines;
+  cv::Point2d along = s.sign * (s.alongX ? g.dx : g.dy), across = s.alongX ? g.dy : g.dx;
+  double halfLength = 0.5 * (s.alongX ? g.stepY : g.stepX) * a.sine;
+  double from = a.inner, to = (s.alongX ? g.stepX : g.stepY) - a.inner;
+  ProfileEdgeParams params = a.params;
+  if (s.neighbour >= 0) {
+    const auto j = static_cast<std::size_t>(s.neighbour);
+    const CornerSetup& b = setups[j];
+    const cv::Point2d span = corners[j] - origin;
+    along = span / cv::norm(span);
+    const cv::Point2d acrossB = s.alongX ? b.grid.dy : b.grid.dx;
+    across = (across + acrossB) / cv::norm(across + acrossB);
+    halfLength = std::min(halfLength, 0.5 * (s.alongX ? b.grid.stepY : b.grid.stepX) * b.sine);
+    to = cv::norm(span) - b.inner;
+    params.minAmplitude = std::min(params.minAmplitude, b.params.minAmplitude);
+  }
+  s.points = stretchEdgePoints(image, origin, along, across, from, to, halfLength, params);
 }
 
 }  // namespace
@@ -183,21 +215,64 @@ PatternDetection detectCharuco(const cv::Mat& image, const BoardSpec& board) {
   std::vector<int> ids;
   for (std::size_t i : order) points.emplace_back(coarse[i]), ids.push_back(coarseIds[i]);
 
-  std::vector<Refined> how(points.size(), Refined::Dropped);
-  std::vector<cv::Point2d> refined = points;
+  // Each corner's surroundings; then the stretches of edge line between and beside corners,
+  // each searched once (a stretch between two corners serves both); then each corner where its
+  // two lines cross.
+  std::vector<CornerSetup> setups(points.size());
   cv::parallel_for_(cv::Range(0, static_cast<int>(points.size())), [&](const cv::Range& range) {
     for (int i = range.start; i < range.end; ++i) {
       const auto k = static_cast<std::size_t>(i);
       LocalGrid g;
-      if (!localGrid(points, ids, board.cols, k, g)) continue;  // isolated: no directions
-      how[k] = refineCorner(image, image8, g, refined[k]);
+      if (localGrid(points, ids, board.cols, k, g))  // else isolated: no directions
+        setups[k] = setUpCorner(image, image8, g, points[k]);
     }
   });
+  std::vector<int> indexOf(static_cast<std::size_t>(board.pointCount()), -1);
+  for (std::size_t k = 0; k < ids.size(); ++k) indexOf[static_cast<std::size_t>(ids[k])] = int(k);
+  std::vector<Stretch> stretches;
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    if (setups[k].kind != CornerSetup::Kind::EdgeLines) continue;
+    const int c = ids[k] % board.cols, r = ids[k] / board.cols;
+    for (const auto& [dc, dr] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+      const int nc = c + dc, nr = r + dr;
+      int j = -1;
+      if (nc >= 0 && nr >= 0 && nc < board.cols && nr < board.rows)
+        j = indexOf[static_cast<std::size_t>(nr * board.cols + nc)];
+      if (j >= 0 && setups[static_cast<std::size_t>(j)].kind != CornerSetup::Kind::EdgeLines)
+        j = -1;
+      if (j >= 0 && static_cast<std::size_t>(j) < k) continue;  // searched from the other end
+      stretches.push_back({k, j, dr == 0, dc + dr > 0 ? 1.0 : -1.0, {}});
+    }
+  }
+  cv::parallel_for_(cv::Range(0, static_cast<int>(stretches.size())), [&](const cv::Range& range) {
+    for (int i = range.start; i < range.end; ++i)
+      searchStretch(image, points, setups, stretches[static_cast<std::size_t>(i)]);
+  });
+  std::vector<std::vector<cv::Point2d>> onX(points.size()), onY(points.size());
+  for (const Stretch& s : stretches) {
+    auto& line = s.alongX ? onX : onY;
+    line[s.corner].insert(line[s.corner].end(), s.points.begin(), s.points.end());
+    if (s.neighbour >= 0) {
+      auto& other = line[static_cast<std::size_t>(s.neighbour)];
+      other.insert(other.end(), s.points.begin(), s.points.end());
+    }
+  }
   int saddle = 0;
   for (std::size_t k = 0; k < points.size(); ++k) {
-    if (how[k] == Refined::Dropped) continue;
-    if (how[k] == Refined::Saddle) ++saddle;
-    out.points.push_back(refined[k]);
+    const CornerSetup& setup = setups[k];
+    if (setup.kind == CornerSetup::Kind::Dropped) continue;
+    cv::Point2d corner = points[k];  // Saddle: OpenCV's cornerSubPix position
+    if (setup.kind == CornerSetup::Kind::EdgeLines) {
+      const LocalGrid& g = setup.grid;
+      EdgeCurve lx{corner, g.dx, {-g.dx.y, g.dx.x}}, ly{corner, g.dy, {-g.dy.y, g.dy.x}};
+      if (!fitEdgeCurve(onX[k], lx) || !fitEdgeCurve(onY[k], ly)) continue;
+      const auto q = intersectEdgeCurves(lx, ly, corner);
+      if (!q || cv::norm(*q - corner) > kEdgeReach) continue;
+      corner = *q;
+    } else {
+      ++saddle;
+    }
+    out.points.push_back(corner);
     out.ids.push_back(ids[k]);
   }
   const int total = board.pointCount(), found = static_cast<int>(out.ids.size());
