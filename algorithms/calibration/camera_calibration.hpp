@@ -27,8 +27,12 @@ struct PlateView {
   std::vector<std::vector<cv::Point2d>> rims;  // circle grids: each mark's rim points
 };
 
-// Detects the plate in an 8-bit or 16-bit grey image.
+// Detects the plate in an 8-bit or 16-bit grey image (empty: an image that could not be read).
 PlateView detectPlate(const cv::Mat& image, const BoardSpec& board, std::string name);
+// detectPlate for many images (names[i] for images[i]), several at once: the views are
+// independent, and so the serial parts of OpenCV's grid, blob and marker searches use every core.
+std::vector<PlateView> detectPlates(const std::vector<cv::Mat>& images, const BoardSpec& board,
+                                    const std::vector<std::string>& names);
 
 struct CalibrationOptions {
   // Fewest views with the pattern found that a calibration accepts. Default 8.

@@ -2,9 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <string>
 
 #include <opencv2/calib3d.hpp>
+#include <opencv2/core/utility.hpp>
 #include <opencv2/features2d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "algorithms/calibration/conic.hpp"
 #include "algorithms/edges/subpixel_edges.hpp"
@@ -39,13 +42,29 @@ std::optional<cv::Matx33d> robustConic(std::vector<cv::Point2d> pts) {
 CircleMarks detectCircleMarks(const cv::Mat& image, const BoardSpec& board) {
   CircleMarks out;
   const cv::Mat image8 = toGrey8(image);
-  cv::SimpleBlobDetector::Params blobs;
-  blobs.minArea = 20;
-  blobs.maxArea = static_cast<float>(image.total()) / static_cast<float>(board.pointCount());
+  // The grid only needs to be found to within a pixel or two (each mark's rim does the rest):
+  // large images are searched at half size first, where the blob search (17 thresholds) runs
+  // about 4x faster; marks too small for that are searched at full size.
+  const auto findGrid = [&](const cv::Mat& grey, double scale, std::vector<cv::Point2f>& found) {
+    cv::SimpleBlobDetector::Params blobs;
+    blobs.minArea = 20;
+    blobs.maxArea = static_cast<float>(grey.total()) / static_cast<float>(board.pointCount());
+    if (!cv::findCirclesGrid(grey, cv::Size(board.cols, board.rows), found,
+                             cv::CALIB_CB_SYMMETRIC_GRID, cv::SimpleBlobDetector::create(blobs)))
+      return false;
+    // Pixel centres: pixel i of the half-size image covers full-size pixels 2i and 2i + 1.
+    const auto k = static_cast<float>(scale), shift = static_cast<float>(0.5 * (scale - 1));
+    for (auto& f : found) f = f * k + cv::Point2f(shift, shift);
+    return true;
+  };
   std::vector<cv::Point2f> found;
-  const bool ok =
-      cv::findCirclesGrid(image8, cv::Size(board.cols, board.rows), found,
-                          cv::CALIB_CB_SYMMETRIC_GRID, cv::SimpleBlobDetector::create(blobs));
+  bool ok = false;
+  if (image8.cols > 800) {
+    cv::Mat half;
+    cv::resize(image8, half, {}, 0.5, 0.5, cv::INTER_AREA);
+    ok = findGrid(half, 2.0, found);
+  }
+  if (!ok) ok = findGrid(image8, 1.0, found);
   if (!ok) {
     out.detection.status.message =
         "no grid of " + std::to_string(board.cols) + "x" + std::to_string(board.rows) +
@@ -56,9 +75,16 @@ CircleMarks detectCircleMarks(const cv::Mat& image, const BoardSpec& board) {
   std::vector<cv::Point2d> coarse(found.begin(), found.end());
   toPlateOrder(board.cols, board.rows, coarse);
   const double radiusShare = board.diameterMm / (2 * board.pitchMm);
-  for (int r = 0; r < board.rows; ++r) {
-    for (int c = 0; c < board.cols; ++c) {
-      const cv::Point2d p = coarse[static_cast<std::size_t>(r * board.cols + c)];
+  const auto count = static_cast<std::size_t>(board.pointCount());
+  std::vector<cv::Point2d> centres(count);
+  std::vector<std::vector<cv::Point2d>> rims(count);
+  std::vector<std::string> failures(count);  // why a mark failed (empty: it did not)
+  // Marks are independent: fitted in parallel.
+  cv::parallel_for_(cv::Range(0, static_cast<int>(count)), [&](const cv::Range& range) {
+    for (int index = range.start; index < range.end; ++index) {
+      const int r = index / board.cols, c = index % board.cols;
+      const auto i = static_cast<std::size_t>(index);
+      const cv::Point2d p = coarse[i];
       double spacing = 1e9;
       for (const auto& [dc, dr] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
         const int cc = c + dc, rr = r + dr;
@@ -81,24 +107,27 @@ CircleMarks detectCircleMarks(const cv::Mat& image, const BoardSpec& board) {
         rim.push_back(e.position);
       }
       const auto conic = robustConic(rim);
+      const std::string mark = "mark (" + std::to_string(c) + ", " + std::to_string(r) + ")";
       if (!conic || rim.size() < 12) {
-        out.detection.status.message =
-            "mark (" + std::to_string(c) + ", " + std::to_string(r) +
-            ") has no clean rim (blurred, partly hidden or touching another)";
-        out.rims.clear();
-        return out;
+        failures[i] = mark + " has no clean rim (blurred, partly hidden or touching another)";
+        continue;
       }
-      const cv::Point2d centre = conicPole(*conic, {0, 0, 1});
-      if (cv::norm(centre - p) > 3.0) {
-        out.detection.status.message = "mark (" + std::to_string(c) + ", " + std::to_string(r) +
-                                       ") rim does not fit an ellipse around its blob";
-        out.rims.clear();
-        return out;
+      centres[i] = conicPole(*conic, {0, 0, 1});
+      if (cv::norm(centres[i] - p) > 3.0) {
+        failures[i] = mark + " rim does not fit an ellipse around its blob";
+        continue;
       }
-      out.detection.points.push_back(centre);
-      out.rims.push_back(std::move(rim));
+      rims[i] = std::move(rim);
     }
-  }
+  });
+  // The first failing mark in plate order, as a serial search would name it.
+  for (const std::string& why : failures)
+    if (!why.empty()) {
+      out.detection.status.message = why;
+      return out;
+    }
+  out.detection.points = std::move(centres);
+  out.rims = std::move(rims);
   out.detection.status = {};
   return out;
 }

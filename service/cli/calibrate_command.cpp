@@ -91,29 +91,27 @@ void run(const CalibrateOptions& o) {
   if (o.out.empty()) throw InputError("--out: a calibration file name is needed");
   const auto files = imageFiles(o.images);
 
-  std::vector<PlateView> views;
+  // Every image is read (and its size checked) first; the readable ones are then searched for
+  // the plate together.
+  std::vector<cv::Mat> images;
+  std::vector<std::string> names;
   cv::Size size;
   std::string sizeFrom;
   for (const auto& file : files) {
     const cv::Mat image = readGrey(file);
     const std::string name = file.filename().string();
-    if (image.empty()) {
-      PlateView v;
-      v.name = name;
-      v.detection.status.message = "cannot read the image (unknown format or corrupt)";
-      views.push_back(std::move(v));
-      continue;
-    }
-    if (size.empty()) {
+    if (!image.empty() && size.empty()) {
       size = image.size();
       sizeFrom = name;
-    } else if (image.size() != size) {
+    } else if (!image.empty() && image.size() != size) {
       throw InputError(file.string() + ": the image is " + sizeText(image.size()) + " but " +
                        sizeFrom + " is " + sizeText(size) +
                        "; all calibration images must come from the same camera at one resolution");
     }
-    views.push_back(detectPlate(image, *board, name));
+    images.push_back(image);
+    names.push_back(name);
   }
+  const std::vector<PlateView> views = detectPlates(images, *board, names);
   if (size.empty()) throw InputError(o.images + ": none of the images could be read");
 
   CameraCalibration c = calibrateCamera(*board, size, views, o.limits);
