@@ -26,6 +26,8 @@ constexpr double kProfileWidth = 2.0;
 // The coarse corner is within a few tenths of a pixel: an edge farther than this from the line
 // through it belongs to something else (the marker's border, a neighbouring square).
 constexpr double kEdgeReach = 2.0;
+// The step fit's reach either side of an edge (ProfileEdgeParams::window), beyond kEdgeReach.
+constexpr double kFitReach = kEdgeReach + 8.0;
 
 // The grid's directions and square size in the image at one corner: an affine fit to the coarse
 // corners within two squares of it (a lens-distorted grid is locally affine).
@@ -74,7 +76,11 @@ std::vector<cv::Point2d> stretchEdgePoints(const cv::Mat& image, cv::Point2d ori
     const MeasuringPath path(
         MeasuringRect{centre.x, centre.y, 2 * halfLength, kProfileWidth, angle});
     const GreyProfile& profile = sampler.sample(image, path);
-    if (profile.partial || profile.values.empty()) continue;
+    // A profile cut short by the image's border still serves while it holds a step fit's window
+    // either side of the line.
+    if (profile.values.empty() ||
+        (profile.partial && (profile.start > -kFitReach || profile.end() < kFitReach)))
+      continue;
     const ProfileEdge* nearest = nullptr;
     for (const ProfileEdge& e : finder.find(profile))
       if (std::abs(e.position) <= kEdgeReach &&
@@ -167,6 +173,40 @@ void searchStretch(const cv::Mat& image, const std::vector<cv::Point2d>& corners
   s.points = stretchEdgePoints(image, origin, along, across, from, to, halfLength, params);
 }
 
+// OpenCV interpolates a corner only from two whole markers beside it, so along the image's border
+// (and beside a hidden marker) a ring of corners in view goes missing. Each is predicted one
+// square on from two found neighbours in its row or column (the mean of the predictions there
+// are); the edge-line refinement then keeps those whose lines are there, as for any corner.
+// Appended after the interpolated corners, in no particular order of ids.
+void addPredictedCorners(const BoardSpec& board, cv::Size size, std::vector<cv::Point2d>& points,
+                         std::vector<int>& ids) {
+  std::vector<int> indexOf(static_cast<std::size_t>(board.pointCount()), -1);
+  for (std::size_t k = 0; k < ids.size(); ++k) indexOf[static_cast<std::size_t>(ids[k])] = int(k);
+  const auto found = [&](int c, int r) -> const cv::Point2d* {
+    if (c < 0 || r < 0 || c >= board.cols || r >= board.rows) return nullptr;
+    const int k = indexOf[static_cast<std::size_t>(r * board.cols + c)];
+    return k < 0 ? nullptr : &points[static_cast<std::size_t>(k)];
+  };
+  const cv::Rect2d inside(4, 4, size.width - 9, size.height - 9);
+  std::vector<cv::Point2d> predicted;
+  std::vector<int> predictedIds;
+  for (int r = 0; r < board.rows; ++r)
+    for (int c = 0; c < board.cols; ++c) {
+      if (found(c, r)) continue;
+      cv::Point2d sum(0, 0);
+      int n = 0;
+      for (const auto& [dc, dr] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+        const cv::Point2d *near = found(c + dc, r + dr), *far = found(c + 2 * dc, r + 2 * dr);
+        if (near && far) sum += 2 * *near - *far, ++n;
+      }
+      if (n == 0 || !inside.contains(sum / n)) continue;
+      predicted.push_back(sum / n);
+      predictedIds.push_back(r * board.cols + c);
+    }
+  points.insert(points.end(), predicted.begin(), predicted.end());
+  ids.insert(ids.end(), predictedIds.begin(), predictedIds.end());
+}
+
 }  // namespace
 
 PatternDetection detectCharuco(const cv::Mat& image, const BoardSpec& board) {
@@ -214,6 +254,8 @@ PatternDetection detectCharuco(const cv::Mat& image, const BoardSpec& board) {
   std::vector<cv::Point2d> points;
   std::vector<int> ids;
   for (std::size_t i : order) points.emplace_back(coarse[i]), ids.push_back(coarseIds[i]);
+  const std::size_t interpolated = points.size();
+  addPredictedCorners(board, image.size(), points, ids);
 
   // Each corner's surroundings; then the stretches of edge line between and beside corners,
   // each searched once (a stretch between two corners serves both); then each corner where its
@@ -261,6 +303,8 @@ PatternDetection detectCharuco(const cv::Mat& image, const BoardSpec& board) {
   for (std::size_t k = 0; k < points.size(); ++k) {
     const CornerSetup& setup = setups[k];
     if (setup.kind == CornerSetup::Kind::Dropped) continue;
+    // A predicted corner has no position but its lines': located by them, or not at all.
+    if (k >= interpolated && setup.kind != CornerSetup::Kind::EdgeLines) continue;
     cv::Point2d corner = points[k];  // Saddle: OpenCV's cornerSubPix position
     if (setup.kind == CornerSetup::Kind::EdgeLines) {
       const LocalGrid& g = setup.grid;
@@ -275,6 +319,15 @@ PatternDetection detectCharuco(const cv::Mat& image, const BoardSpec& board) {
     out.points.push_back(corner);
     out.ids.push_back(ids[k]);
   }
+  // In the order of the ids (the predicted corners came last).
+  std::vector<std::size_t> byId(out.ids.size());
+  std::iota(byId.begin(), byId.end(), 0);
+  std::sort(byId.begin(), byId.end(),
+            [&](std::size_t a, std::size_t b) { return out.ids[a] < out.ids[b]; });
+  std::vector<cv::Point2d> sortedPoints;
+  std::vector<int> sortedIds;
+  for (std::size_t i : byId) sortedPoints.push_back(out.points[i]), sortedIds.push_back(out.ids[i]);
+  out.points = std::move(sortedPoints), out.ids = std::move(sortedIds);
   const int total = board.pointCount(), found = static_cast<int>(out.ids.size());
   std::set<int> cols, rows;
   for (int id : out.ids) cols.insert(id % board.cols), rows.insert(id / board.cols);

@@ -176,13 +176,17 @@ TEST(PlateDetection, APartialCharucoViewKeepsTheCornersInView) {
   const PlateView view = detectPlate(s.render(), board, "partial");
   ASSERT_TRUE(view.detection.status.ok()) << view.detection.status.message;
   const std::size_t found = view.detection.points.size();
-  std::printf("%zu of %zu corners in the image, %zu found: %s\n", inside, truth.size(), found,
-              view.detection.note.c_str());
-  EXPECT_GE(found, inside * 3 / 4);
+  const double rms = rmsErrorById(view.detection, truth);
+  std::printf("%zu of %zu corners in the image, %zu found, RMS %.4f px: %s\n", inside, truth.size(),
+              found, rms, view.detection.note.c_str());
+  // OpenCV names a corner only from two whole markers beside it; the corners next to the
+  // markers the border cuts are found from their neighbours. Those closer to the border than
+  // the lines' clean stretches are not.
+  EXPECT_GE(found, inside * 8 / 10);
   EXPECT_LT(found, truth.size());
   EXPECT_NE(view.detection.note.find(" of 88 corners"), std::string::npos) << view.detection.note;
   EXPECT_TRUE(std::is_sorted(view.detection.ids.begin(), view.detection.ids.end()));
-  EXPECT_LT(rmsErrorById(view.detection, truth), 0.03);
+  EXPECT_LT(rms, 0.03);
 }
 
 TEST(PlateDetection, ACharucoSpecThatDoesNotMatchThePlateIsRefusedWithAReason) {
