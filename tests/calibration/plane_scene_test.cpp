@@ -25,6 +25,16 @@ LensCamera distortedCamera() {
   return c;
 }
 
+// A 320x256 view of the plane around (10, 10) mm, tilted 30 degrees, through the distorted lens.
+PlaneScene smallTiltedScene() {
+  PlaneScene s;
+  s.camera = distortedCamera();
+  s.camera.size = {320, 256};
+  s.camera.cx = 159.5, s.camera.cy = 127.5, s.camera.fx = s.camera.fy = 400;
+  s.placement = lookAtPlane({10, 10}, 300, 30, 60, 15, s.camera);
+  return s;
+}
+
 TEST(PlaneScene, CoverageSumsToTheOutlinesArea) {
   std::mt19937_64 rng(3);
   std::uniform_real_distribution<double> u(0, 1);
@@ -63,11 +73,7 @@ TEST(PlaneScene, ProjectionAgreesWithOpenCv) {
 }
 
 TEST(PlaneScene, DarkAreaMatchesTheProjectedSquareWithAndWithoutLensBlur) {
-  PlaneScene s;
-  s.camera = distortedCamera();
-  s.camera.size = {320, 256};
-  s.camera.cx = 159.5, s.camera.cy = 127.5, s.camera.fx = s.camera.fy = 400;
-  s.placement = lookAtPlane({10, 10}, 300, 30, 60, 15, s.camera);
+  PlaneScene s = smallTiltedScene();
   s.background = 0;
   s.addPolygon({{0, 0}, {20, 0}, {20, 20}, {0, 20}}, 100);
   const double area = shoelace(projectOutline(s, s.shapes[0]));
@@ -132,11 +138,7 @@ TEST(PlaneScene, ChessboardCornerPixelIsExact) {
 }
 
 TEST(PlaneScene, TouchingPolygonsOfOneShapePaintAsTheirUnion) {
-  PlaneScene one;
-  one.camera = distortedCamera();
-  one.camera.size = {320, 256};
-  one.camera.cx = 159.5, one.camera.cy = 127.5, one.camera.fx = one.camera.fy = 400;
-  one.placement = lookAtPlane({10, 10}, 300, 30, 60, 15, one.camera);
+  PlaneScene one = smallTiltedScene();
   one.background = 200;
   PlaneScene two = one, painter = one;
   one.addPolygon({{0, 0}, {20, 0}, {20, 20}, {0, 20}}, 40);
