@@ -189,6 +189,25 @@ TEST(PlateDetection, APartialCharucoViewKeepsTheCornersInView) {
   EXPECT_LT(rms, 0.03);
 }
 
+TEST(PlateDetection, ACharucoPlateIsFoundAlikeIn16BitImagesAndNotInDegenerateOnes) {
+  const BoardSpec board = test::charucoBoard();
+  const auto s = test::plateScene(board, test::testCamera(), 11, 1);
+  const auto truth = scene::patternImagePoints(s, board.cols, board.rows, board.pitchMm);
+  cv::Mat image16;
+  s.render().convertTo(image16, CV_16U, 256.0);
+  const PlateView view = detectPlate(image16, board, "16 bit");
+  ASSERT_TRUE(view.detection.status.ok()) << view.detection.status.message;
+  EXPECT_EQ(view.detection.points.size(), truth.size());
+  EXPECT_LT(rmsErrorById(view.detection, truth), 0.02);
+  for (const cv::Mat& degenerate : {cv::Mat(480, 640, CV_8U, cv::Scalar(128)),
+                                    cv::Mat(6, 6, CV_8U, cv::Scalar(0)), cv::Mat()}) {
+    const PlateView none = detectPlate(degenerate, board, "degenerate");
+    EXPECT_FALSE(none.detection.status.ok());
+    EXPECT_FALSE(none.detection.status.message.empty());
+    EXPECT_TRUE(none.detection.points.empty());
+  }
+}
+
 TEST(PlateDetection, ACharucoSpecThatDoesNotMatchThePlateIsRefusedWithAReason) {
   const auto s = test::plateScene(test::charucoBoard(), test::testCamera(), 11, 0);
   const cv::Mat image = s.render();
