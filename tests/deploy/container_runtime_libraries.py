@@ -1,0 +1,52 @@
+#!/usr/bin/env python3
+"""The container's runtime stage installs every Debian library facet and facetd load.
+
+deploy/Containerfile builds in one stage and runs in another that installs only the runtime
+packages it names; a library the binaries link that no named package (or a package they pull in)
+provides makes facetd fail at start inside the container, which nothing else here would notice.
+For each binary: ldd's libraries -> their Debian packages (dpkg -S) -> each must be named in the
+runtime stage or be among the dependencies of those named (apt-cache depends, recursively).
+
+Usage: container_runtime_libraries.py SOURCE_DIR BINARY...
+"""
+import re
+import subprocess
+import sys
+
+source, binaries = sys.argv[1], sys.argv[2:]
+with open(f"{source}/deploy/Containerfile") as f:
+    text = f.read()
+# The runtime stage: after the last FROM, the packages of its apt-get install.
+runtime = text[text.rindex("\nFROM "):]
+install = re.search(r"apt-get install -y --no-install-recommends(.*?)&&", runtime, re.S)
+if not install:
+    sys.exit("deploy/Containerfile: no apt-get install in the runtime stage")
+named = install.group(1).replace("\\", " ").split()
+deps = subprocess.run(
+    ["apt-cache", "depends", "--recurse", "--no-recommends", "--no-suggests", "--no-conflicts",
+     "--no-breaks", "--no-replaces", "--no-enhances", *named],
+    capture_output=True, text=True, check=True).stdout
+provided = set(named) | {line.strip() for line in deps.splitlines() if not line.startswith(" ")}
+
+missing = []
+for binary in binaries:
+    ldd = subprocess.run(["ldd", binary], capture_output=True, text=True, check=True).stdout
+    for path in re.findall(r"=> (/\S+)", ldd):
+        owner = subprocess.run(["dpkg", "-S", path], capture_output=True, text=True)
+        if owner.returncode != 0:
+            # /lib is a link to /usr/lib on Debian 12: dpkg knows the file by one of the two.
+            alt = path[4:] if path.startswith("/usr/") else "/usr" + path
+            owner = subprocess.run(["dpkg", "-S", alt], capture_output=True, text=True)
+        if owner.returncode != 0:
+            continue  # not from a Debian package (built here, or the loader's vdso)
+        package = owner.stdout.split(":")[0]
+        # The sanitizer build's own runtime, which no shipped binary carries.
+        if re.fullmatch(r"lib(a|ub|l|t)san\d*", package):
+            continue
+        if package not in provided:
+            missing.append(f"{binary}: {path} comes from {package}")
+if missing:
+    print("deploy/Containerfile's runtime stage does not install:")
+    print("\n".join(sorted(set(missing))))
+    sys.exit(1)
+print(f"every Debian library of {len(binaries)} binaries is installed by the runtime stage")
