@@ -28,23 +28,33 @@ deps = subprocess.run(
     capture_output=True, text=True, check=True).stdout
 provided = set(named) | {line.strip() for line in deps.splitlines() if not line.startswith(" ")}
 
-missing = []
+# Every library of every binary, then one dpkg query for all of them (each query reads dpkg's
+# whole database). /lib is a link to /usr/lib on Debian 12: dpkg knows a file by one of the two.
+users = {}
 for binary in binaries:
     ldd = subprocess.run(["ldd", binary], capture_output=True, text=True, check=True).stdout
     for path in re.findall(r"=> (/\S+)", ldd):
-        owner = subprocess.run(["dpkg", "-S", path], capture_output=True, text=True)
-        if owner.returncode != 0:
-            # /lib is a link to /usr/lib on Debian 12: dpkg knows the file by one of the two.
-            alt = path[4:] if path.startswith("/usr/") else "/usr" + path
-            owner = subprocess.run(["dpkg", "-S", alt], capture_output=True, text=True)
-        if owner.returncode != 0:
-            continue  # not from a Debian package (built here, or the loader's vdso)
-        package = owner.stdout.split(":")[0]
-        # The sanitizer build's own runtime, which no shipped binary carries.
-        if re.fullmatch(r"lib(a|ub|l|t)san\d*", package):
-            continue
-        if package not in provided:
-            missing.append(f"{binary}: {path} comes from {package}")
+        users.setdefault(path, []).append(binary)
+aliases = {}
+for path in users:
+    other = path[4:] if path.startswith("/usr/") else "/usr" + path
+    aliases[path], aliases[other] = path, path
+owners = subprocess.run(["dpkg", "-S", *aliases], capture_output=True, text=True).stdout
+owner = {}
+for line in owners.splitlines():
+    package, _, file = line.partition(": ")
+    if file in aliases:
+        owner[aliases[file]] = package.split(":")[0]
+
+missing = []
+for path, binaries_using in users.items():
+    package = owner.get(path)
+    # Not from a Debian package (built here), or the sanitizer build's own runtime, which no
+    # shipped binary carries.
+    if package is None or re.fullmatch(r"lib(a|ub|l|t)san\d*", package):
+        continue
+    if package not in provided:
+        missing += [f"{b}: {path} comes from {package}" for b in binaries_using]
 if missing:
     print("deploy/Containerfile's runtime stage does not install:")
     print("\n".join(sorted(set(missing))))
