@@ -31,6 +31,7 @@ enum class SubpixelMode {
 };
 
 inline constexpr double kMaxScaleTolerance = 0.1;
+inline constexpr int kMaxDeformation = 8;
 
 struct FindParams {
   // Lowest score a match may have, in (0, 1]. Default 0.7.
@@ -69,6 +70,14 @@ struct FindParams {
   // 0 = keep the scale fixed; at most kMaxScaleTolerance (a part 10% off its template is another
   // part, or wants a model with a scale range). Default 0.02.
   double refineScaleTolerance = 0.02;
+  // Tolerance for parts whose contour differs from the model's by up to this many pixels in x and
+  // y (a moulded or stamped part, a lens window set off-centre in its housing): each model point
+  // matches the best image direction within that distance, on every pyramid level (divided by the
+  // level's factor, rounded up) and in the score, which then reads "share of the model seen within
+  // maxDeformation pixels". The least-squares refinement fits the pose to the whole contour as it
+  // is. 0 = rigid. 0..kMaxDeformation; not with Polarity::IgnoreGlobal (use IgnoreLocal). Scoring
+  // costs up to (2 maxDeformation + 1)^2 times as much on the levels below the top. Default 0.
+  int maxDeformation = 0;
   // Number of pyramid levels used, 0 = all of the model's. Fewer levels = slower, more robust.
   int numLevels = 0;
   // Parallelism on OpenCV's worker pool: stripes of the top-level search (1..8), and, when > 1,

@@ -40,8 +40,9 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
         for (int dy = -radius; dy <= radius; ++dy)
           for (int dx = -radius; dx <= radius; ++dx) {
             const cv::Point at(cvRound(centre.x) + dx, cvRound(centre.y) + dy);
-            const double score = scorePose(*s.field, posed, at, s.polarity,
-                                           std::max(s.minScore, best.score), s.greediness);
+            const double score =
+                scorePose(*s.field, posed, at, s.polarity, std::max(s.minScore, best.score),
+                          s.greediness, s.spread);
             if (score > best.score) {
               best = {double(at.x), double(at.y), a, sc, score};
               onBorder = std::abs(dx) == radius || std::abs(dy) == radius ||
@@ -57,6 +58,11 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
   return best;
 }
 
+double scoreOnLevel(const LevelSearch& s, const Candidate& c) {
+  return scorePose(*s.field, posePoints(s.level->points, c.angle, c.scale),
+                   cv::Point(cvRound(c.x), cvRound(c.y)), s.polarity, 0.0, 0.0, s.spread);
+}
+
 Candidate interpolate(const LevelSearch& s, Candidate c) {
   // The five scores at the candidate's own angle and scale share its posed points.
   const PosedPoints centre = posePoints(s.level->points, c.angle + 0.0, c.scale + 0.0);
@@ -65,7 +71,8 @@ Candidate interpolate(const LevelSearch& s, Candidate c) {
     const PosedPoints posed =
         turned ? posePoints(s.level->points, c.angle + da, c.scale + ds) : PosedPoints{};
     return scorePose(*s.field, turned ? posed : centre,
-                     cv::Point(cvRound(c.x + dx), cvRound(c.y + dy)), s.polarity, 0.0, 0.0);
+                     cv::Point(cvRound(c.x + dx), cvRound(c.y + dy)), s.polarity, 0.0, 0.0,
+                     s.spread);
   };
   auto vertex = [](double m, double z, double p) {
     const double d = m - 2.0 * z + p;

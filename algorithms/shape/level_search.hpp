@@ -29,11 +29,15 @@ struct LevelSearch {
   Polarity polarity = Polarity::Use;
   double minScore = 0.0;
   double greediness = 0.0;
+  int spread = 0;  // FindParams::maxDeformation on this level, pixels of the level
 };
 
 // Best pose in a neighbourhood of `c`: (2 radius + 1)^2 positions x (2 angleSteps + 1) angles x 3
 // scales, climbing while the best lies on the border. Score -1 when nothing reaches minScore.
 Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angleSteps = 1);
+
+// The score of one pose on the level (no early termination).
+double scoreOnLevel(const LevelSearch& s, const Candidate& c);
 
 // Score-parabola interpolation around a level-0 maximum in x, y, angle and scale.
 Candidate interpolate(const LevelSearch& s, Candidate c);

@@ -93,7 +93,8 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
                                       const std::vector<ShapePoint>& modelPoints,
                                       const std::vector<double>& angles,
                                       const std::vector<double>& scales, Polarity polarity,
-                                      double threshold, int threads, int maxCandidates) {
+                                      int spread, double threshold, int threads,
+                                      int maxCandidates) {
   std::vector<ShapePoint> points = modelPoints;
   if (points.size() > kMaxTopPoints) {
     std::vector<ShapePoint> kept;
@@ -144,6 +145,8 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
         for (int b = 0; b < kBins; ++b) {
           float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
           if (local) v = std::abs(v);
+          // Spread, a point scores its best response nearby or 0 (as scorePose): never below.
+          if (spread > 0) v = std::max(v, 0.0f);
           // A rounded direction may be up to 127.7 long: clamped, so that 128 cannot wrap.
           maps[static_cast<std::size_t>(b * plane + base + x)] =
               static_cast<std::int8_t>(std::min(cvRound(v), 127));
@@ -151,6 +154,20 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
       }
     }
   });
+  if (spread > 0) {
+    // The best response within `spread` of each pixel, per orientation: a maximum filter over the
+    // image (a point outside it scores 0, as at spread 0). OpenCV dilates unsigned bytes;
+    // flipping the sign bit maps -128..127 onto 0..255 in order.
+    const cv::Mat kernel =
+        cv::getStructuringElement(cv::MORPH_RECT, {2 * spread + 1, 2 * spread + 1});
+    for (int b = 0; b < kBins; ++b) {
+      cv::Mat map(h + 2 * border, stride, CV_8U, maps.data() + static_cast<std::size_t>(b * plane));
+      cv::Mat inImage = map(cv::Rect(border, border, w, h));
+      cv::bitwise_xor(inImage, cv::Scalar(0x80), inImage);
+      cv::dilate(inImage, inImage, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT | cv::BORDER_ISOLATED);
+      cv::bitwise_xor(inImage, cv::Scalar(0x80), inImage);
+    }
+  }
 
   // Offsets lie within the border, less than half a row's stride either side: a pixel's offset
   // y * stride + x is unique, so the set's sharing (counted per (x, y)) is the same.
@@ -188,6 +205,10 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
       auto* d = directed.ptr<uchar>(y);
       for (int x = 0; x < w; ++x) d[x] = (row[x][0] != 0 || row[x][1] != 0) ? 1 : 0;
     }
+    // Spread, a map is non-zero within `spread` of a pixel with a direction.
+    if (spread > 0)
+      cv::dilate(directed, directed,
+                 cv::getStructuringElement(cv::MORPH_RECT, {2 * spread + 1, 2 * spread + 1}));
     cv::integral(directed, count, CV_32S);
     const int reach = border;
     for (int y = 0; y < h; ++y) {

@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <optional>
+
+#include <opencv2/core/hal/intrin.hpp>
 
 #include "algorithms/shape/image_gradients.hpp"
 
@@ -25,8 +29,77 @@ PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, doub
   return out;
 }
 
+namespace {
+
+// The best dot product of a turned model direction (mx, my; 128 long) with the image directions in
+// a window of `side` (<= 8) pixels a row, rows v0..v1, starting at column u0, with at least 8
+// columns from u0 inside the field: a row's eight directions are one 16-byte load. Columns past
+// the window meet a zero model direction and give 0, which never beats a pixel without a direction.
+int bestDotInWindow(const cv::Mat& field, int u0, int v0, int v1, int side, int mx, int my,
+                    bool local) {
+  alignas(16) std::int16_t lanes[16] = {};
+  for (int k = 0; k < side; ++k)
+    lanes[2 * k] = static_cast<std::int16_t>(mx), lanes[2 * k + 1] = static_cast<std::int16_t>(my);
+  const cv::v_int16x8 mLow = cv::v_load_aligned(lanes), mHigh = cv::v_load_aligned(lanes + 8);
+  cv::v_int32x4 best = cv::v_setzero_s32();
+  for (int v = v0; v <= v1; ++v) {
+    const auto* row = reinterpret_cast<const schar*>(field.ptr<Direction>(v) + u0);
+    cv::v_int16x8 low, high;
+    cv::v_expand(cv::v_load(row), low, high);
+    const auto magnitude = [local](cv::v_int32x4 dots) {
+      return local ? cv::v_reinterpret_as_s32(cv::v_abs(dots)) : dots;
+    };
+    best = cv::v_max(best, magnitude(cv::v_dotprod(low, mLow)));
+    if (side > 4) best = cv::v_max(best, magnitude(cv::v_dotprod(high, mHigh)));
+  }
+  return cv::v_reduce_max(best);
+}
+
+// scorePose with each point's best direction within `spread`, apart from the rigid loop, which is
+// most of the tracking down the pyramid. Integer dot products (image directions 127 long, the
+// model's 128); reads (2 spread + 1)^2 pixels a point, a row at a time where it can.
+double scoreSpreadPose(const cv::Mat& field, const PosedPoints& posed, cv::Point at,
+                       Polarity polarity, double minScore, double greediness, int spread) {
+  const int n = static_cast<int>(posed.offsets.size());
+  const double invN = 1.0 / n, unit = 1.0 / (127.0 * 128.0);
+  const double safe = minScore - 1.0, greedy = minScore;
+  const bool local = polarity == Polarity::IgnoreLocal;
+  const int w = field.cols, h = field.rows;
+  long sum = 0;
+  for (int j = 0; j < n; ++j) {
+    const int x = at.x + posed.offsets[j].x, y = at.y + posed.offsets[j].y;
+    if (x < 0 || y < 0 || x >= w || y >= h) continue;
+    const int mx = static_cast<int>(std::lround(posed.directions[j].x * 128.0f));
+    const int my = static_cast<int>(std::lround(posed.directions[j].y * 128.0f));
+    const int u0 = std::max(x - spread, 0), u1 = std::min(x + spread, w - 1);
+    const int v0 = std::max(y - spread, 0), v1 = std::min(y + spread, h - 1);
+    int best = 0;  // a pixel without a direction
+    if (u0 + 8 <= w && u1 - u0 < 8) {
+      best = bestDotInWindow(field, u0, v0, v1, u1 - u0 + 1, mx, my, local);
+    } else {
+      for (int v = v0; v <= v1; ++v) {
+        const Direction* row = field.ptr<Direction>(v);
+        for (int u = u0; u <= u1; ++u) {
+          const int dot = row[u][0] * mx + row[u][1] * my;
+          best = std::max(best, local ? std::abs(dot) : dot);
+        }
+      }
+    }
+    sum += best;
+    if ((j & 7) == 7 && minScore > 0.0) {
+      const double f = (j + 1) * invN;
+      if (sum * unit * invN < (1.0 - greediness) * (safe + f) + greediness * greedy * f)
+        return -1.0;
+    }
+  }
+  return sum * unit * invN;
+}
+
+}  // namespace
+
 double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, Polarity polarity,
-                 double minScore, double greediness) {
+                 double minScore, double greediness, int spread) {
+  if (spread > 0) return scoreSpreadPose(field, posed, at, polarity, minScore, greediness, spread);
   const int n = static_cast<int>(posed.offsets.size());
   const double invN = 1.0 / n;
   const double safe = minScore - 1.0, greedy = minScore;
@@ -63,14 +136,15 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
 }
 
 double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
-                    Polarity polarity) {
+                    Polarity polarity, int spread) {
   const double c = std::cos(pose.angle), s = std::sin(pose.angle);
   const Pose2D::Map toImage = pose.map();
-  double sum = 0.0;
-  for (const auto& mp : model.finePoints) {
-    const cv::Point2d q = toImage(mp.position);
+  const bool local = polarity == Polarity::IgnoreLocal;
+  // The normalised, bilinearly interpolated image direction at q against the turned model
+  // direction (tx, ty); nullopt outside the image or where no direction is.
+  auto similarity = [&](cv::Point2d q, double tx, double ty) -> std::optional<double> {
     const int x0 = static_cast<int>(std::floor(q.x)), y0 = static_cast<int>(std::floor(q.y));
-    if (x0 < 0 || y0 < 0 || x0 + 1 >= field.cols || y0 + 1 >= field.rows) continue;
+    if (x0 < 0 || y0 < 0 || x0 + 1 >= field.cols || y0 + 1 >= field.rows) return std::nullopt;
     const double fx = q.x - x0, fy = q.y - y0;
     const Direction* r0 = field.ptr<Direction>(y0) + x0;
     const Direction* r1 = field.ptr<Direction>(y0 + 1) + x0;
@@ -79,11 +153,26 @@ double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D&
     const Direction* d[4] = {r0, r0 + 1, r1, r1 + 1};
     for (int k = 0; k < 4; ++k) gx += w[k] * (*d[k])[0], gy += w[k] * (*d[k])[1];
     const double norm = std::hypot(gx, gy);
-    if (norm < 1e-6) continue;
-    const double dot = ((c * mp.direction.x + s * mp.direction.y) * gx +
-                        (-s * mp.direction.x + c * mp.direction.y) * gy) /
-                       norm;
-    sum += polarity == Polarity::IgnoreLocal ? std::abs(dot) : dot;
+    if (norm < 1e-6) return std::nullopt;
+    const double dot = (tx * gx + ty * gy) / norm;
+    return local ? std::abs(dot) : dot;
+  };
+  double sum = 0.0;
+  for (const auto& mp : model.finePoints) {
+    const cv::Point2d q = toImage(mp.position);
+    const double tx = c * mp.direction.x + s * mp.direction.y;
+    const double ty = -s * mp.direction.x + c * mp.direction.y;
+    if (spread == 0) {
+      sum += similarity(q, tx, ty).value_or(0.0);
+      continue;
+    }
+    // As on the pyramid: a point outside the image scores 0, one without a direction near it 0.
+    if (q.x < 0 || q.y < 0 || q.x + 1 >= field.cols || q.y + 1 >= field.rows) continue;
+    double best = 0.0;
+    for (int v = -spread; v <= spread; ++v)
+      for (int u = -spread; u <= spread; ++u)
+        best = std::max(best, similarity(q + cv::Point2d(u, v), tx, ty).value_or(0.0));
+    sum += best;
   }
   const double n = static_cast<double>(model.finePoints.size());
   return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) / n;

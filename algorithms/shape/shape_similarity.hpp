@@ -26,14 +26,16 @@ PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, doub
 // early termination: after j of n points the pose is abandoned when the partial mean falls below a
 // bound between the safe one (every remaining point matches perfectly, greediness 0) and the
 // greedy one (the remaining points match at exactly minScore, greediness 1). Returns the score,
-// or -1 if abandoned.
+// or -1 if abandoned. With `spread` > 0 each point inside the image takes the best direction within
+// `spread` pixels in x and y (FindParams::maxDeformation); not with Polarity::IgnoreGlobal.
 double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, Polarity polarity,
-                 double minScore, double greediness);
+                 double minScore, double greediness, int spread);
 
 // The similarity of the model's subpixel points at a subpixel pose, with the image's directions
-// interpolated bilinearly: the score of a refined match.
+// interpolated bilinearly: the score of a refined match. With `spread` > 0 each point takes the
+// best of the directions at whole-pixel shifts of up to `spread` in x and y.
 double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
-                    Polarity polarity);
+                    Polarity polarity, int spread);
 
 // Which of the model's subpixel points have an image gradient (any direction above the field's
 // contrast) within a pixel of where `pose` puts them. One entry per fine point, 1 = near one.

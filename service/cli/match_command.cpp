@@ -52,6 +52,9 @@ void checkSearchOptions(const FindParams& find) {
   if (!(find.refineScaleTolerance >= 0.0 && find.refineScaleTolerance <= kMaxScaleTolerance))
     throw InputError("--scale-tolerance must lie in [0, " + number(kMaxScaleTolerance) + "] (got " +
                      number(find.refineScaleTolerance) + ")");
+  if (find.maxDeformation < 0 || find.maxDeformation > kMaxDeformation)
+    throw InputError("--max-deformation must lie in [0, " + std::to_string(kMaxDeformation) +
+                     "] pixels (got " + std::to_string(find.maxDeformation) + ")");
 }
 
 constexpr double kTurn = 2.0 * std::numbers::pi;
@@ -109,6 +112,10 @@ void run(MatchOptions o) {
   else
     throw InputError("--polarity must be use, ignore_global or ignore_local (got \"" + o.polarity +
                      "\")");
+  if (o.find.maxDeformation > 0 && o.find.polarity == Polarity::IgnoreGlobal)
+    throw InputError(
+        "--max-deformation cannot be combined with --polarity ignore_global (use "
+        "ignore_local)");
   if (o.subpixel == "none")
     o.find.subpixel = SubpixelMode::None;
   else if (o.subpixel == "interpolation")
@@ -179,6 +186,10 @@ void addMatchCommand(CLI::App& app) {
   cmd->add_option("--scale-tolerance", o->find.refineScaleTolerance,
                   "Scale change the subpixel fit may find on a part whose model has one scale, "
                   "relative, 0..0.1 (default 0.02; 0 = the model's scale)");
+  cmd->add_option("--max-deformation", o->find.maxDeformation,
+                  "Pixels by which the part's contour may differ from the model's, 0.." +
+                      std::to_string(kMaxDeformation) +
+                      " (default 0: rigid; not with --polarity ignore_global)");
   cmd->add_option("--polarity", o->polarity, "use | ignore_global | ignore_local (default use)");
   cmd->add_option("--subpixel", o->subpixel,
                   "none | interpolation | least_squares (default least_squares)");

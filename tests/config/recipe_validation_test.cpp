@@ -121,6 +121,15 @@ TEST_F(RecipeValidation, ShapeScaleToleranceIsLimited) {
       << r.diagnostics.text();
 }
 
+TEST_F(RecipeValidation, ShapeMaxDeformationIsLimited) {
+  const auto r = load(
+      "schema_version: 1\nid: 7\nname: x\nsteps:\n  - id: part\n"
+      "    kind: shape\n    template: t.png\n    max_deformation: 9\n");
+  EXPECT_TRUE(
+      hasDiagnostic(r.diagnostics, 8, 22, "'max_deformation' must be between 0 and 8 (got 9)"))
+      << r.diagnostics.text();
+}
+
 TEST_F(RecipeValidation, MissingRequiredKeyIsReportedAtItsMapping) {
   const auto r = load(kHead + R"(  - id: hole
     kind: circle

@@ -34,7 +34,8 @@ std::vector<scene::Primitive> nestedContoursPart() {
 
 }  // namespace
 
-cv::Mat nestedPartScene(cv::Size size, const Pose2D& pose, std::uint64_t seed, bool sharpened) {
+cv::Mat nestedPartScene(cv::Size size, const Pose2D& pose, std::uint64_t seed, bool sharpened,
+                        cv::Point2d lensShift) {
   scene::SceneSpec spec;
   spec.size = size;
   spec.background = 40.0;
@@ -43,11 +44,16 @@ cv::Mat nestedPartScene(cv::Size size, const Pose2D& pose, std::uint64_t seed, b
   spec.noiseSigma = 2.0;
   spec.seed = seed;
   scene::Scene s(spec);
-  for (scene::Primitive p : nestedContoursPart()) {
-    if (p.kind == scene::Primitive::Kind::Disc)
-      p.centre = pose.apply(p.centre);
+  const std::vector<scene::Primitive> part = nestedContoursPart();
+  for (std::size_t i = 0; i < part.size(); ++i) {
+    scene::Primitive p = part[i];
+    // The housing (the first) stays, the frame's boxes move one way and the lens's discs the other.
+    const bool disc = p.kind == scene::Primitive::Kind::Disc;
+    const cv::Point2d shift = i == 0 ? cv::Point2d(0.0, 0.0) : disc ? lensShift : -lensShift;
+    if (disc)
+      p.centre = pose.apply(p.centre + shift);
     else
-      for (auto& v : p.vertices) v = pose.apply(v);
+      for (auto& v : p.vertices) v = pose.apply(v + shift);
     s.add(std::move(p));
   }
   const cv::Mat image = s.render();

@@ -15,6 +15,10 @@ namespace facet::testing {
 // lens (blur 0.9, noise 2). `sharpened`: then sharpened as cameras do by default (an unsharp
 // mask: the image plus its difference from a blurred copy), which gives every edge an overshoot
 // that no blurred step has. The template is the part at ((w-1)/2, (h-1)/2) in 140 x 100.
-cv::Mat nestedPartScene(cv::Size size, const Pose2D& pose, std::uint64_t seed, bool sharpened);
+// `lensShift`: the lens moved by that much in part coordinates and the frame by as much the other
+// way, the housing in place, as they sit in some parts of a batch: a part whose contours differ
+// from the template's by a few pixels, which no rigid pose matches.
+cv::Mat nestedPartScene(cv::Size size, const Pose2D& pose, std::uint64_t seed, bool sharpened,
+                        cv::Point2d lensShift = {0.0, 0.0});
 
 }  // namespace facet::testing

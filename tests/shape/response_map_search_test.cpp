@@ -55,17 +55,31 @@ Template templateOf(const std::vector<ShapePoint>& points, double angle, double 
 }
 
 // The template's sum with its reference point at (x, y); pixels outside the field add nothing.
-int directSum(const cv::Mat& field, const Template& t, int x, int y) {
+// With `spread` each point inside the field adds its best response within `spread` pixels in x
+// and y, or 0 where that is lower.
+int directSum(const cv::Mat& field, const Template& t, int x, int y, int spread = 0) {
   int sum = 0;
   for (std::size_t i = 0; i < t.offsets.size(); ++i) {
     const int u = x + t.offsets[i].x, v = y + t.offsets[i].y;
     if (u < 0 || v < 0 || u >= field.cols || v >= field.rows) continue;
-    sum += response(field.at<Direction>(v, u), t.bins[i]);
+    if (spread == 0) {
+      sum += response(field.at<Direction>(v, u), t.bins[i]);
+      continue;
+    }
+    int best = 0;
+    for (int b = std::max(v - spread, 0); b <= std::min(v + spread, field.rows - 1); ++b)
+      for (int a = std::max(u - spread, 0); a <= std::min(u + spread, field.cols - 1); ++a)
+        best = std::max(best, response(field.at<Direction>(b, a), t.bins[i]));
+    sum += best;
   }
   return sum;
 }
 
-TEST(TopLevelSearch, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
+// Rigid, and with each point's best response within 1 or 2 pixels (FindParams::maxDeformation).
+class TopLevelSearchSpread : public ::testing::TestWithParam<int> {};
+
+TEST_P(TopLevelSearchSpread, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
+  const int spread = GetParam();
   // A model's top level and a scene's top level (pyramid level 3 of a 640x480 scene).
   const ShapeModel model = createShapeModel(testing::bracketTemplate());
   const int top = model.numLevels() - 1;
@@ -82,7 +96,7 @@ TEST(TopLevelSearch, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
   for (int k = 0; k < 24; ++k) angles.push_back(k * kTwoPi / 24);
   const double threshold = 0.4;
   const auto candidates = shape_detail::searchTopLevel(field, points, angles, {1.0}, Polarity::Use,
-                                                       threshold, 1, 100000);
+                                                       spread, threshold, 1, 100000);
   ASSERT_FALSE(candidates.empty());
 
   // Best sum and template per pixel, directly.
@@ -93,12 +107,13 @@ TEST(TopLevelSearch, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
   for (int y = 0; y < field.rows; ++y)
     for (int x = 0; x < field.cols; ++x)
       for (const Template& t : templates)
-        best.at<int>(y, x) = std::max(best.at<int>(y, x), directSum(field, t, x, y));
+        best.at<int>(y, x) = std::max(best.at<int>(y, x), directSum(field, t, x, y, spread));
 
   for (const Candidate& c : candidates) {
     const int x = static_cast<int>(c.x), y = static_cast<int>(c.y);
     EXPECT_DOUBLE_EQ(c.score, best.at<int>(y, x) / norm) << "at " << x << "," << y;
-    EXPECT_EQ(directSum(field, templateOf(points, c.angle, c.scale), x, y), best.at<int>(y, x));
+    EXPECT_EQ(directSum(field, templateOf(points, c.angle, c.scale), x, y, spread),
+              best.at<int>(y, x));
   }
   // Every local maximum over 5x5 (strict towards the top-left, as the search) is a candidate.
   int maxima = 0;
@@ -125,6 +140,9 @@ TEST(TopLevelSearch, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
   EXPECT_EQ(maxima, static_cast<int>(candidates.size()));
 }
 
+INSTANTIATE_TEST_SUITE_P(Rigid, TopLevelSearchSpread, ::testing::Values(0));
+INSTANTIATE_TEST_SUITE_P(Deformable, TopLevelSearchSpread, ::testing::Values(1, 2));
+
 TEST(TopLevelSearch, AnAlignedDirectionLongerThan127DoesNotWrap) {
   // A rounded direction can be longer than 127: (117, 51) is 127.6 long, and its response on
   // bin 2 (22.5 degrees) rounds to 128, which does not fit in 8 bits. Kept as 127, a field of
@@ -136,7 +154,7 @@ TEST(TopLevelSearch, AnAlignedDirectionLongerThan127DoesNotWrap) {
                           static_cast<float>(std::sin(kTwoPi / 16)));
   for (int k = -5; k <= 5; ++k) points.push_back({{static_cast<float>(k), 0.0f}, along});
   const auto candidates =
-      shape_detail::searchTopLevel(field, points, {0.0}, {1.0}, Polarity::Use, 0.9, 1, 10);
+      shape_detail::searchTopLevel(field, points, {0.0}, {1.0}, Polarity::Use, 0, 0.9, 1, 10);
   ASSERT_FALSE(candidates.empty());
   EXPECT_NEAR(candidates.front().score, 1.0, 1e-12);
 }

@@ -173,7 +173,9 @@ TEST(ShapeCli, MatchSaysWhenTheModelCutsTheRequestedRange) {
 
   for (const std::string option :
        {"--min-score 1.5", "--min-score 0", "--max-overlap 2", "--greediness -1",
-        "--num-matches -3", "--scale-tolerance 0.2", "--scale-tolerance -0.01"}) {
+        "--num-matches -3", "--scale-tolerance 0.2", "--scale-tolerance -0.01",
+        "--max-deformation 9", "--max-deformation -1",
+        "--max-deformation 1 --polarity ignore_global"}) {
     const CliRun bad = run(match + " " + option, err);
     EXPECT_EQ(bad.exitCode, 1) << option;
     const std::string message = readText(err);
@@ -203,6 +205,26 @@ TEST(ShapeCli, ScaleToleranceDecidesWhetherTheFitFollowsAPartsScale) {
     else
       EXPECT_EQ(scale, 1.0) << r.out;
   }
+  fs::remove_all(scene.dir);
+}
+
+// --max-deformation reaches the search: on an exact part the pose is the rigid one and the score
+// can only rise (every model point meets its edge within the tolerance).
+TEST(ShapeCli, MaxDeformationKeepsTheRigidPoseOfAnExactPart) {
+  const Pose2D truth{240.3, 180.6, radians(31.0), 1.0};
+  const TrainedScene scene = trainedScene("facet_shape_cli_deformation_test", truth, 6);
+  ASSERT_TRUE(scene.trained) << readText(scene.err);
+  const CliRun rigid = run(scene.match + " --json", scene.err);
+  const CliRun tolerant = run(scene.match + " --max-deformation 2 --json", scene.err);
+  ASSERT_EQ(rigid.exitCode, 0) << readText(scene.err);
+  ASSERT_EQ(tolerant.exitCode, 0) << readText(scene.err);
+  const auto a = nlohmann::json::parse(rigid.out).at("matches");
+  const auto b = nlohmann::json::parse(tolerant.out).at("matches");
+  ASSERT_EQ(a.size(), 1u) << rigid.out;
+  ASSERT_EQ(b.size(), 1u) << tolerant.out;
+  EXPECT_NEAR(b[0].at("x").get<double>(), a[0].at("x").get<double>(), 1e-6);
+  EXPECT_NEAR(b[0].at("y").get<double>(), a[0].at("y").get<double>(), 1e-6);
+  EXPECT_GE(b[0].at("score").get<double>(), a[0].at("score").get<double>());
   fs::remove_all(scene.dir);
 }
 

@@ -85,9 +85,11 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
 }
 
 FindParams findParamsFor(double minScore, int numMatches, double maxOverlap,
-                         const config::AngleRange& range, double scaleTolerance) {
+                         const config::AngleRange& range, double scaleTolerance,
+                         int maxDeformation) {
   FindParams p;
   p.refineScaleTolerance = scaleTolerance;
+  p.maxDeformation = maxDeformation;
   p.minScore = minScore;
   p.numMatches = numMatches;
   p.maxOverlap = maxOverlap;

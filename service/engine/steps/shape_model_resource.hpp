@@ -43,7 +43,8 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
 // The search parameters of a step's shape model (least-squares subpixel poses).
 FindParams findParamsFor(double minScore, int numMatches, double maxOverlap,
                          const config::AngleRange& range,
-                         double scaleTolerance = FindParams{}.refineScaleTolerance);
+                         double scaleTolerance = FindParams{}.refineScaleTolerance,
+                         int maxDeformation = FindParams{}.maxDeformation);
 
 // A found contour (a point set, not an ordered polyline) drawn as dots, offset into the image.
 void drawContour(Overlay& overlay, const std::vector<cv::Point2d>& contour, cv::Point offset,

@@ -37,6 +37,11 @@ ShapeStep::ShapeStep() : TableStep({.point = true, .pose = true, .line = true}) 
                  "Scale change the subpixel fit may find on a part that differs a little from its "
                  "template (lens, working distance), relative; 0 = the template's scale.",
                  {.minimum = 0.0, .maximum = kMaxScaleTolerance});
+  fields_.integer("max_deformation", &ShapeParams::maxDeformation,
+                  "Pixels by which a part's contours may differ from the template's (a moulded "
+                  "part, a lens set off-centre in its housing); scores then count a model point "
+                  "met that far off. 0 = rigid. Costs search time: try 1 first.",
+                  {.minimum = 0.0, .maximum = double(kMaxDeformation)});
   const std::string xDoc = "Offset of the found position from nominal along x (mm by default).";
   const std::string yDoc = "Offset of the found position from nominal along y (mm by default).";
   checks_ = {"shape checks",
@@ -79,9 +84,9 @@ StepResult ShapeStep::run(const config::Step& step, StepContext& part) const {
   if (search.empty()) return StepResult::failed("search region outside the image");
   part.overlay.polygon(outerCorners(search), true, true);
   const auto& shape = step.resourcesAs<ShapeModelResource>();
-  const auto matches = findShapeModel(
-      part.grey(search), shape.model,
-      findParamsFor(s.minScore, s.numMatches, s.maxOverlap, angles, s.scaleTolerance));
+  const auto matches = findShapeModel(part.grey(search), shape.model,
+                                      findParamsFor(s.minScore, s.numMatches, s.maxOverlap, angles,
+                                                    s.scaleTolerance, s.maxDeformation));
   StepResult r;
   r.values["count"] = static_cast<double>(matches.size());
   for (const auto& m : matches) drawContour(part.overlay, m.contour, search.tl(), true);

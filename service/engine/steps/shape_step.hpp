@@ -20,6 +20,7 @@ struct ShapeParams : config::StepParams {
   config::AngleRange angleRange;
   double maxOverlap = 0.5;
   double scaleTolerance = 0.02;  // FindParams::refineScaleTolerance
+  int maxDeformation = 0;        // FindParams::maxDeformation
 };
 
 class ShapeStep : public TableStep<ShapeParams> {
