@@ -207,19 +207,20 @@ struct Finisher {
                  cv::Size(2 * margin, 2 * margin) - cv::Point(margin, margin));
     // Occluders and clutter can bend the score surface so that tracking stops on a secondary
     // peak next to the true one; a wider look around each match about to be returned finds it.
-    if (const Candidate wide = refineOnLevel(search, c, 2, 3); wide.score > c.score) c = wide;
-    if (c.score < 0.0) return std::nullopt;
     // With a deformation allowed the score is flat within maxDeformation of the part (on an exact
-    // part it is 1 across that square): where the model's points meet their edges exactly, the
-    // rigid score's peak nearby, is where the pose is.
+    // part it is 1 across that square): the look is taken on the rigid score, whose peak is where
+    // the model's points meet their edges exactly, and the match keeps its tolerant score.
     LevelSearch rigid = search;
     rigid.spread = 0;
-    if (search.spread > 0) {
+    if (search.spread == 0) {
+      if (const Candidate wide = refineOnLevel(search, c, 2, 3); wide.score > c.score) c = wide;
+    } else {
       rigid.minScore = 0.0;
-      Candidate centred = refineOnLevel(rigid, c, search.spread + 1, 1);
+      Candidate centred = refineOnLevel(rigid, c, search.spread + 2, 3);
       centred.score = shape_detail::scoreOnLevel(search, centred);
       c = centred;
     }
+    if (c.score < 0.0) return std::nullopt;
     if (params.subpixel == SubpixelMode::None)
       return Finished{{c.x, c.y, c.angle, c.scale}, c.score};
     c = shape_detail::interpolate(rigid, c);
