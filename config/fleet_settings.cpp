@@ -1,9 +1,10 @@
 #include "config/fleet_settings.hpp"
 
-#include <libpq-fe.h>
-
 #include <memory>
+#include <stdexcept>
+#include <string>
 
+#include "config/libpq_library.hpp"
 #include "config/yaml_document.hpp"
 
 namespace facet::config {
@@ -136,14 +137,20 @@ PostgresSettings readPostgresSettings(const YAML::Node& node, const std::filesys
   s.reconnectMaxMs = static_cast<int>(r.integer("reconnect_max_ms", s.reconnectMaxMs));
   s.batchParts = static_cast<int>(r.integer("batch_parts", s.batchParts));
   // libpq's own parser: a misspelt keyword is refused here, with its line, not at first connect.
-  char* error = nullptr;
-  std::unique_ptr<PQconninfoOption, decltype(&PQconninfoFree)> options(
-      PQconninfoParse(s.connection.c_str(), &error), &PQconninfoFree);
-  if (!options) {
-    std::string message = error ? error : "cannot be parsed";
-    PQfreemem(error);
-    while (!message.empty() && message.back() == '\n') message.pop_back();
-    r.error(node["connection"] ? node["connection"] : node, "'connection': " + message);
+  const YAML::Node& at = node["connection"] ? node["connection"] : node;
+  try {
+    const LibPq& pq = libpq();
+    char* error = nullptr;
+    std::unique_ptr<PQconninfoOption, decltype(LibPq::conninfoFree)> options(
+        pq.conninfoParse(s.connection.c_str(), &error), pq.conninfoFree);
+    if (!options) {
+      std::string message = error ? error : "cannot be parsed";
+      pq.freemem(error);
+      while (!message.empty() && message.back() == '\n') message.pop_back();
+      r.error(at, "'connection': " + message);
+    }
+  } catch (const std::runtime_error& e) {
+    r.error(at, "'connection' cannot be checked: " + std::string(e.what()));
   }
   s.outbox = r.outbox("postgres-outbox");
   return s;

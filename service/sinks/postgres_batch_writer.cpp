@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <thread>
 
+#include "config/libpq_library.hpp"
 #include "service/sinks/postgres_connection.hpp"
 
 namespace facet::service {
@@ -41,8 +42,9 @@ PostgresBatchWriter::PostgresBatchWriter(std::string connection, std::string sta
     if (!succeeded(ids))
       throw std::runtime_error("postgres " + peer +
                                ": cannot read the station's parts: " + postgresError(conn.get()));
-    for (int row = 0; row < PQntuples(ids.get()); ++row)
-      already_.insert(std::stoull(PQgetvalue(ids.get(), row, 0)));
+    const config::LibPq& pq = config::libpq();
+    for (int row = 0; row < pq.ntuples(ids.get()); ++row)
+      already_.insert(std::stoull(pq.getvalue(ids.get(), row, 0)));
   }
   config::PostgresSettings settings;
   settings.enabled = true;

@@ -8,20 +8,21 @@ PgResult executeWithText(PGconn* conn, const char* sql,
                          const std::vector<std::optional<std::string>>& params) {
   std::vector<const char*> values;
   for (const auto& p : params) values.push_back(p ? p->c_str() : nullptr);
-  return PgResult(PQexecParams(conn, sql, static_cast<int>(values.size()), nullptr, values.data(),
-                               nullptr, nullptr, 0));
+  return PgResult(config::libpq().execParams(conn, sql, static_cast<int>(values.size()), nullptr,
+                                             values.data(), nullptr, nullptr, 0));
 }
 
 bool succeeded(const PgResult& r) {
-  const auto s = PQresultStatus(r.get());
+  const auto s = config::libpq().resultStatus(r.get());
   return s == PGRES_COMMAND_OK || s == PGRES_TUPLES_OK;
 }
 
 std::string postgresPeer(const std::string& connection) {
   char* error = nullptr;
-  std::unique_ptr<PQconninfoOption, decltype(&PQconninfoFree)> options(
-      PQconninfoParse(connection.c_str(), &error), &PQconninfoFree);
-  PQfreemem(error);
+  const config::LibPq& pq = config::libpq();
+  std::unique_ptr<PQconninfoOption, decltype(config::LibPq::conninfoFree)> options(
+      pq.conninfoParse(connection.c_str(), &error), pq.conninfoFree);
+  pq.freemem(error);
   std::string host = "localhost", port = "5432", db;
   for (auto* o = options.get(); o && o->keyword; ++o) {
     if (!o->val) continue;
@@ -34,14 +35,15 @@ std::string postgresPeer(const std::string& connection) {
 }
 
 std::string postgresError(const PGconn* conn) {
-  std::string s = PQerrorMessage(conn);
+  std::string s = config::libpq().errorMessage(conn);
   while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
   return s;
 }
 
 PgConnection connectOrThrow(const std::string& connection) {
-  PgConnection conn(PQconnectdb(connection.c_str()));
-  if (PQstatus(conn.get()) != CONNECTION_OK)
+  const config::LibPq& pq = config::libpq();
+  PgConnection conn(pq.connectdb(connection.c_str()));
+  if (pq.status(conn.get()) != CONNECTION_OK)
     throw std::runtime_error("postgres " + postgresPeer(connection) +
                              ": cannot connect: " + postgresError(conn.get()));
   return conn;

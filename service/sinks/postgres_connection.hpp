@@ -3,22 +3,22 @@
 // that clears itself, parameters sent as text, and how the server and its errors are named in
 // messages (never with the password).
 
-#include <libpq-fe.h>
-
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "config/libpq_library.hpp"
+
 namespace facet::service {
 
 struct PgResultDeleter {
-  void operator()(PGresult* r) const { PQclear(r); }
+  void operator()(PGresult* r) const { config::libpq().clear(r); }
 };
 using PgResult = std::unique_ptr<PGresult, PgResultDeleter>;
 
 struct PgConnDeleter {
-  void operator()(PGconn* c) const { PQfinish(c); }
+  void operator()(PGconn* c) const { config::libpq().finish(c); }
 };
 using PgConnection = std::unique_ptr<PGconn, PgConnDeleter>;
 

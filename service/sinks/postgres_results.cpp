@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "config/libpq_library.hpp"
 #include "service/daemon/part_export.hpp"
 #include "service/sinks/postgres_connection.hpp"
 
@@ -12,9 +13,9 @@ namespace facet::service {
 
 namespace {
 
-std::optional<double> number(const PGresult* r, int row, int column) {
-  if (PQgetisnull(r, row, column)) return std::nullopt;
-  return std::stod(PQgetvalue(r, row, column));
+std::optional<double> number(const config::LibPq& pq, const PGresult* r, int row, int column) {
+  if (pq.getisnull(r, row, column)) return std::nullopt;
+  return std::stod(pq.getvalue(r, row, column));
 }
 
 }  // namespace
@@ -23,6 +24,7 @@ std::vector<StationPart> readPostgresResults(const std::string& connection,
                                              const std::optional<std::string>& station,
                                              std::chrono::system_clock::time_point since,
                                              std::size_t limit) {
+  const config::LibPq& pq = config::libpq();
   const std::string peer = postgresPeer(connection);
   const PgConnection conn = connectOrThrow(connection);
   auto fail = [&](const std::string& what) {
@@ -38,7 +40,7 @@ std::vector<StationPart> readPostgresResults(const std::string& connection,
   if (!succeeded(executeWithText(conn.get(), chosen.c_str(), {sinceUs, station})))
     throw fail("cannot read the parts (is this facet's results database?)");
 
-  const PgResult parts(PQexec(
+  const PgResult parts(pq.exec(
       conn.get(),
       "SELECT station, part_id, time_us, recipe_id, recipe_name, recipe_version, frame_id, "
       "source, serial, expected, verdict, failed_checks, error, inspection_ms, timings_json, "
@@ -47,8 +49,8 @@ std::vector<StationPart> readPostgresResults(const std::string& connection,
   std::vector<StationPart> out;
   std::map<std::tuple<std::string, std::string, std::string>, std::size_t> index;
   const PGresult* r = parts.get();
-  for (int i = 0; i < PQntuples(r); ++i) {
-    auto text = [&](int c) { return std::string(PQgetvalue(r, i, c)); };
+  for (int i = 0; i < pq.ntuples(r); ++i) {
+    auto text = [&](int c) { return std::string(pq.getvalue(r, i, c)); };
     StationPart s;
     s.station = text(0);
     PartResult& p = s.part;
@@ -72,25 +74,25 @@ std::vector<StationPart> readPostgresResults(const std::string& connection,
     out.push_back(std::move(s));
   }
 
-  const PgResult values(PQexec(
+  const PgResult values(pq.exec(
       conn.get(),
       "SELECT m.station, m.part_id, m.time_us, m.name, m.value, m.unit, m.nominal, m.tol_minus, "
       "m.tol_plus, m.checked, m.pass FROM measurements m JOIN chosen c USING (station, part_id, "
       "time_us) ORDER BY m.ctid"));
   if (!succeeded(values)) throw fail("cannot read the measurements");
   const PGresult* v = values.get();
-  for (int i = 0; i < PQntuples(v); ++i) {
-    const auto it = index.find({PQgetvalue(v, i, 0), PQgetvalue(v, i, 1), PQgetvalue(v, i, 2)});
+  for (int i = 0; i < pq.ntuples(v); ++i) {
+    const auto it = index.find({pq.getvalue(v, i, 0), pq.getvalue(v, i, 1), pq.getvalue(v, i, 2)});
     if (it == index.end()) continue;
     Measurement m;
-    m.name = PQgetvalue(v, i, 3);
-    m.value = number(v, i, 4).value_or(std::nan(""));
-    m.unit = PQgetvalue(v, i, 5);
-    m.nominal = number(v, i, 6);
-    m.tolMinus = number(v, i, 7);
-    m.tolPlus = number(v, i, 8);
-    m.checked = std::string(PQgetvalue(v, i, 9)) == "t";
-    m.pass = std::string(PQgetvalue(v, i, 10)) == "t";
+    m.name = pq.getvalue(v, i, 3);
+    m.value = number(pq, v, i, 4).value_or(std::nan(""));
+    m.unit = pq.getvalue(v, i, 5);
+    m.nominal = number(pq, v, i, 6);
+    m.tolMinus = number(pq, v, i, 7);
+    m.tolPlus = number(pq, v, i, 8);
+    m.checked = std::string(pq.getvalue(v, i, 9)) == "t";
+    m.pass = std::string(pq.getvalue(v, i, 10)) == "t";
     out[it->second].part.measurements.push_back(std::move(m));
   }
   return out;

@@ -1,14 +1,14 @@
 #include "service/sinks/postgres_sink.hpp"
 
-#include <libpq-fe.h>
-
 #include <cmath>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
+#include "config/libpq_library.hpp"
 #include "service/daemon/results_store.hpp"
 #include "service/sinks/fleet_message.hpp"
 #include "service/sinks/postgres_connection.hpp"
@@ -67,7 +67,7 @@ bool createPostgresSchema(pg_conn* conn) {
           "SET LOCAL client_min_messages = warning;"
           "SELECT pg_advisory_xact_lock(hashtext('facet results schema'));") +
       kPostgresSchema;
-  return succeeded(PgResult(PQexec(conn, locked.c_str())));
+  return succeeded(PgResult(config::libpq().exec(conn, locked.c_str())));
 }
 
 namespace {
@@ -101,7 +101,7 @@ PostgresSink::PostgresSink(config::PostgresSettings settings, std::string statio
 
 PostgresSink::~PostgresSink() {
   stop(0ms);
-  if (conn_) PQfinish(conn_);
+  if (conn_) config::libpq().finish(conn_);
 }
 
 void PostgresSink::start() {
@@ -143,6 +143,14 @@ void PostgresSink::sleepFor(std::chrono::milliseconds wait) {
 }
 
 bool PostgresSink::connect() {
+  const config::LibPq* loaded = nullptr;
+  try {
+    loaded = &config::libpq();
+  } catch (const std::runtime_error& e) {
+    setError(e.what());  // kept and retried, as a server away would be
+    return false;
+  }
+  const config::LibPq& pq = *loaded;
   const std::string timeout = std::to_string(settings_.connectTimeoutS);
   const std::string application = "facet-" + station_;
   std::vector<const char*> keys{"dbname", "connect_timeout", "application_name"};
@@ -155,20 +163,20 @@ bool PostgresSink::connect() {
   keys.push_back(nullptr);
   values.push_back(nullptr);
   // expand_dbname = 1: the first value is the whole connection string.
-  conn_ = PQconnectdbParams(keys.data(), values.data(), 1);
-  if (PQstatus(conn_) != CONNECTION_OK) {
+  conn_ = pq.connectdbParams(keys.data(), values.data(), 1);
+  if (pq.status(conn_) != CONNECTION_OK) {
     std::string why = postgresError(conn_);
     if (why.find("password authentication failed") != std::string::npos ||
         why.find("no password supplied") != std::string::npos)
       why += " (check postgres.connection's user and postgres.password)";
     setError("cannot connect: " + why);
-    PQfinish(conn_);
+    pq.finish(conn_);
     conn_ = nullptr;
     return false;
   }
   if (!createPostgresSchema(conn_)) {
     setError("cannot create the tables: " + postgresError(conn_));
-    PQfinish(conn_);
+    pq.finish(conn_);
     conn_ = nullptr;
     return false;
   }
@@ -181,8 +189,9 @@ bool PostgresSink::connect() {
 }
 
 bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
-  auto rollback = [this] { PQclear(PQexec(conn_, "ROLLBACK")); };
-  if (!succeeded(PgResult(PQexec(conn_, "BEGIN")))) return false;
+  const config::LibPq& pq = config::libpq();  // loaded: there is a connection
+  auto rollback = [&] { pq.clear(pq.exec(conn_, "ROLLBACK")); };
+  if (!succeeded(PgResult(pq.exec(conn_, "BEGIN")))) return false;
   std::vector<std::uint64_t> done;
   for (const auto& record : records) {
     std::string station;
@@ -211,7 +220,7 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
       return false;
     }
     // 0 rows: the part is there already (sent again after a lost COMMIT answer).
-    if (std::string(PQcmdTuples(part.get())) == "1") {
+    if (std::string(pq.cmdTuples(part.get())) == "1") {
       for (const auto& m : p.measurements) {
         const PgResult value = executeWithText(
             conn_, kInsertValue,
@@ -227,7 +236,7 @@ bool PostgresSink::write(const std::vector<OutboxRecord>& records) {
     }
     done.push_back(record.seq);
   }
-  if (!succeeded(PgResult(PQexec(conn_, "COMMIT")))) return false;
+  if (!succeeded(PgResult(pq.exec(conn_, "COMMIT")))) return false;
   outbox_.remove(done);
   std::lock_guard lock(statusMutex_);
   status_.delivered += done.size();
@@ -254,9 +263,10 @@ void PostgresSink::run() {
     if (records.empty() || write(records)) continue;
     // Failed: a lost connection is reconnected; a statement the server refused (a bug, a
     // changed table) is logged and retried after the back-off, never silently skipped.
-    const bool lost = PQstatus(conn_) != CONNECTION_OK;
+    const config::LibPq& pq = config::libpq();  // loaded: there was a connection
+    const bool lost = pq.status(conn_) != CONNECTION_OK;
     setError((lost ? "connection lost: " : "write failed: ") + postgresError(conn_));
-    PQfinish(conn_);
+    pq.finish(conn_);
     conn_ = nullptr;
     sleepFor(backoff);
     backoff = std::min<std::chrono::milliseconds>(

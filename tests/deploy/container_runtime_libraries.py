@@ -7,6 +7,9 @@ provides makes facetd fail at start inside the container, which nothing else her
 For each binary: ldd's libraries -> their Debian packages (dpkg -S) -> each must be named in the
 runtime stage or be among the dependencies of those named (apt-cache depends, recursively).
 
+A BINARY without a slash is a library the binaries load by its soname at run time (dlopen, as
+libpq.so.5): found through ldconfig's cache, it is checked itself beside the libraries it loads.
+
 Usage: container_runtime_libraries.py SOURCE_DIR BINARY...
 """
 import re
@@ -31,7 +34,17 @@ provided = set(named) | {line.strip() for line in deps.splitlines() if not line.
 # Every library of every binary, then one dpkg query for all of them (each query reads dpkg's
 # whole database). /lib is a link to /usr/lib on Debian 12: dpkg knows a file by one of the two.
 users = {}
-for binary in binaries:
+cache = None
+for i, binary in enumerate(binaries):
+    if "/" not in binary:
+        if cache is None:
+            cache = subprocess.run(["ldconfig", "-p"], capture_output=True, text=True,
+                                   check=True).stdout
+        found = re.search(rf"^\s*{re.escape(binary)} \(.*\) => (\S+)$", cache, re.M)
+        if not found:
+            sys.exit(f"{binary}: not in ldconfig's cache (not installed on this machine?)")
+        binaries[i] = binary = found.group(1)
+        users.setdefault(binary, []).append(binary)
     ldd = subprocess.run(["ldd", binary], capture_output=True, text=True, check=True).stdout
     for path in re.findall(r"=> (/\S+)", ldd):
         users.setdefault(path, []).append(binary)

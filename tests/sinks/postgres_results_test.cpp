@@ -121,5 +121,25 @@ TEST(CentralResultsCli, StationWithoutPostgresAndNeitherSourceAreRefused) {
   EXPECT_NE(neither.err.find("needs --db FILE or --postgres"), std::string::npos) << neither.err;
 }
 
+// libpq is loaded when first used: a command that needs no database starts without it (and the 20
+// libraries it brings), and where it cannot be loaded the command that needs it says so.
+TEST(CentralResultsCli, LibpqIsLoadedOnlyByTheCommandsThatUseIt) {
+  const auto version = test::runFacet("version");
+  ASSERT_EQ(version.exitCode, 0) << version.err;
+  ::setenv("LD_DEBUG", "files", 1);  // the loader lists every library it opens on stderr
+  const auto traced = test::runFacet("version");
+  ::unsetenv("LD_DEBUG");
+  ASSERT_NE(traced.err.find("libopencv_core"), std::string::npos) << "no loader trace";
+  EXPECT_EQ(traced.err.find("libpq"), std::string::npos) << "facet version loaded libpq";
+
+  ::setenv("FACET_LIBPQ", "/nonexistent/libpq.so.5", 1);
+  const auto missing = test::runFacet("results export --postgres 'host=127.0.0.1 dbname=x'");
+  ::unsetenv("FACET_LIBPQ");
+  EXPECT_EQ(missing.exitCode, 1) << missing.out;
+  EXPECT_NE(missing.err.find("PostgreSQL's client library cannot be loaded"), std::string::npos)
+      << missing.err;
+  EXPECT_NE(missing.err.find("/nonexistent/libpq.so.5"), std::string::npos) << missing.err;
+}
+
 }  // namespace
 }  // namespace facet::sinks_test
