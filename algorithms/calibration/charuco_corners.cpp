@@ -247,6 +247,8 @@ PatternDetection detectCharuco(const cv::Mat& image, const BoardSpec& board) {
   std::vector<cv::Point2f> coarse;
   std::vector<int> coarseIds;
   cv::aruco::interpolateCornersCharuco(kept, keptIds, image8, cvBoard, coarse, coarseIds);
+  // In the order of the ids, so that what follows (which end of a stretch searches it, the sums
+  // of a corner's neighbours) does not depend on the order OpenCV returns them in.
   std::vector<std::size_t> order(coarse.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
