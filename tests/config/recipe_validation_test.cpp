@@ -1,6 +1,8 @@
 // Recipe validation: every kind of problem is reported with its exact line and column, all of
 // them in one run, and a recipe with an error is never returned.
 #include <fstream>
+#include <string>
+#include <tuple>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -112,22 +114,19 @@ TEST_F(RecipeValidation, OutOfRangeValuesGiveTheRange) {
   EXPECT_EQ(r.diagnostics.errorCount(), 4u) << r.diagnostics.text();
 }
 
-TEST_F(RecipeValidation, ShapeScaleToleranceIsLimited) {
-  const auto r = load(
-      "schema_version: 1\nid: 7\nname: x\nsteps:\n  - id: part\n"
-      "    kind: shape\n    template: t.png\n    scale_tolerance: 0.5\n");
-  EXPECT_TRUE(
-      hasDiagnostic(r.diagnostics, 8, 22, "'scale_tolerance' must be between 0 and 0.1 (got 0.5)"))
-      << r.diagnostics.text();
-}
-
-TEST_F(RecipeValidation, ShapeMaxDeformationIsLimited) {
-  const auto r = load(
-      "schema_version: 1\nid: 7\nname: x\nsteps:\n  - id: part\n"
-      "    kind: shape\n    template: t.png\n    max_deformation: 9\n");
-  EXPECT_TRUE(
-      hasDiagnostic(r.diagnostics, 8, 22, "'max_deformation' must be between 0 and 8 (got 9)"))
-      << r.diagnostics.text();
+TEST_F(RecipeValidation, ShapeSearchTolerancesAreLimited) {
+  for (const auto& [key, value, message] :
+       {std::tuple{"scale_tolerance", "0.5",
+                   "'scale_tolerance' must be between 0 and 0.1 (got 0.5)"},
+        std::tuple{"max_deformation", "9", "'max_deformation' must be between 0 and 8 (got 9)"}}) {
+    const auto r = load(std::string("schema_version: 1\nid: 7\nname: x\nsteps:\n  - id: part\n"
+                                    "    kind: shape\n    template: t.png\n    ") +
+                        key + ": " + value + "\n");
+    // The value's column: after four spaces, the key and ": ".
+    EXPECT_TRUE(
+        hasDiagnostic(r.diagnostics, 8, 7 + static_cast<int>(std::string(key).size()), message))
+        << r.diagnostics.text();
+  }
 }
 
 TEST_F(RecipeValidation, MissingRequiredKeyIsReportedAtItsMapping) {
