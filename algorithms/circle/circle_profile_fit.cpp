@@ -4,8 +4,10 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <memory>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -153,7 +155,6 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     int column, row, bin;
     bool narrow;  // within kNarrowBand of the rim
   };
-  std::vector<BandPixel> band;
   const double rOut = radius + halfBand, rIn = std::max(0.0, radius - halfBand);
   const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - rOut)));
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
@@ -195,7 +196,9 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       annulusRowRuns(centre, rIn, rOut, cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
   std::size_t runPixels = 0;
   for (const RowRun& run : runs) runPixels += static_cast<std::size_t>(run.x1 - run.x0);
-  band.resize(runPixels);
+  // Buffers every pixel of which is written before it is read: zeroing them cost as much as
+  // filling them.
+  const auto bandPixels = std::make_unique_for_overwrite<BandPixel[]>(runPixels);
   std::vector<int> runBins;
   std::vector<std::uint8_t> runNarrow;
   std::size_t inBand = 0, narrowPixels = 0;
@@ -209,13 +212,13 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     for (int i = 0; i < n; ++i) {
       const int bin = runBins[i];
       const bool narrow = runNarrow[i] != 0;
-      band[inBand] = {run.x0 + i, run.y, bin, narrow};
+      bandPixels[inBand] = {run.x0 + i, run.y, bin, narrow};
       const bool keep = (covered[bin] != 0) & (taint == nullptr || taint[run.x0 + i] == 0);
       inBand += keep;
       narrowPixels += keep & narrow;
     }
   }
-  band.resize(inBand);
+  const std::span<const BandPixel> band(bandPixels.get(), inBand);
   if (band.size() < 30) return std::nullopt;
 
   // Start: outside and inside levels from the band's two halves, blur 1.2 px, no ramp.
@@ -260,7 +263,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     for (int b = 0; b < bins; ++b)
       keptBin[b] = std::floor((b + 1) * share) != std::floor(b * share);
   // The band's pixels the share keeps, listed without a branch per pixel, then read.
-  std::vector<std::uint32_t> picks(band.size());
+  const auto picks = std::make_unique_for_overwrite<std::uint32_t[]>(band.size());
   std::size_t picked = 0;
   for (std::size_t i = 0; i < band.size(); ++i) {
     picks[picked] = static_cast<std::uint32_t>(i);
