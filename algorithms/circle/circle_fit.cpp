@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numbers>
 
 #include <Eigen/Dense>
@@ -15,28 +16,46 @@ constexpr double kPi = std::numbers::pi;
 
 // Weighted geometric (orthogonal distance) fit by Levenberg-Marquardt: minimises
 // sum w_i (|p_i - c| - R)^2 over (cx, cy, R). The offsets and distances of a trial are kept for
-// the normal equations at it once it is accepted: one pass of square roots per iteration.
+// the normal equations at it once it is accepted: one pass of square roots per iteration. They
+// are left uninitialised (every pass writes them all before reading): zeroing them cost more than
+// a pass.
 class GeometricCircleFit {
  public:
   GeometricCircleFit(const std::vector<Eigen::Vector2d>& pts, const std::vector<double>& w)
-      : pts_(pts), w_(w), current_(pts.size()), trial_(pts.size()) {}
+      : pts_(pts),
+        w_(w),
+        current_(std::make_unique_for_overwrite<Offset[]>(pts.size())),
+        trial_(std::make_unique_for_overwrite<Offset[]>(pts.size())) {}
 
-  double cost(const Eigen::Vector3d& x) { return evaluate(x, current_); }
+  double cost(const Eigen::Vector3d& x) { return evaluate(x, current_.get()); }
+  // J^T W J (its lower triangle, mirrored: the step's LDLT reads no more) and J^T W r, with the
+  // Jacobian row j = (-dx / n, -dy / n, -1): each sum accumulates (w j_a) j_b in the points'
+  // order, as the outer product w j j^T did.
   void normalEquations(int, const Eigen::Vector3d& x, Eigen::Matrix3d& jtj, Eigen::Vector3d& jtr,
                        double&) const {
-    jtj.setZero();
-    jtr.setZero();
+    double h00 = 0, h10 = 0, h11 = 0, h20 = 0, h21 = 0, h22 = 0, g0 = 0, g1 = 0, g2 = 0;
+    const double radius = x.z();
     for (std::size_t i = 0; i < pts_.size(); ++i) {
-      const Eigen::Vector2d& d = current_[i].offset;
-      const double n = current_[i].distance;
-      if (n < 1e-12 || w_[i] == 0.0) continue;
-      const Eigen::Vector3d j{-d.x() / n, -d.y() / n, -1.0};
-      const double r = n - x.z();
-      jtj.noalias() += w_[i] * j * j.transpose();
-      jtr.noalias() += w_[i] * j * r;
+      const Offset& o = current_[i];
+      const double n = o.distance, w = w_[i];
+      if (n < 1e-12 || w == 0.0) continue;
+      const double j0 = -o.dx / n, j1 = -o.dy / n;
+      const double r = n - radius;
+      const double wj0 = w * j0, wj1 = w * j1, wj2 = -w;
+      h00 += wj0 * j0;
+      h10 += wj1 * j0;
+      h11 += wj1 * j1;
+      h20 += wj2 * j0;
+      h21 += wj2 * j1;
+      h22 += w;  // (w j2) j2 with j2 = -1
+      g0 += wj0 * r;
+      g1 += wj1 * r;
+      g2 += wj2 * r;
     }
+    jtj << h00, h10, h20, h10, h11, h21, h20, h21, h22;
+    jtr << g0, g1, g2;
   }
-  std::optional<double> trialCost(const Eigen::Vector3d& x) { return evaluate(x, trial_); }
+  std::optional<double> trialCost(const Eigen::Vector3d& x) { return evaluate(x, trial_.get()); }
   void accept() { std::swap(current_, trial_); }
   bool converged(int, const Eigen::Vector3d& step) const {
     return step.norm() < 1e-5;  // pixels: far below the accuracy sought
@@ -44,15 +63,17 @@ class GeometricCircleFit {
 
  private:
   struct Offset {
-    Eigen::Vector2d offset;  // p_i - c
-    double distance = 0;     // |p_i - c|
+    double dx, dy;    // p_i - c
+    double distance;  // |p_i - c|
   };
-  double evaluate(const Eigen::Vector3d& x, std::vector<Offset>& out) const {
+  double evaluate(const Eigen::Vector3d& x, Offset* out) const {
+    const double cx = x.x(), cy = x.y(), radius = x.z();
     double s = 0;
     for (std::size_t i = 0; i < pts_.size(); ++i) {
-      out[i].offset = pts_[i] - x.head<2>();
-      out[i].distance = out[i].offset.norm();
-      const double r = out[i].distance - x.z();
+      const double dx = pts_[i].x() - cx, dy = pts_[i].y() - cy;
+      const double n = std::sqrt(dx * dx + dy * dy);
+      out[i] = {dx, dy, n};
+      const double r = n - radius;
       s += w_[i] * r * r;
     }
     return s;
@@ -60,7 +81,7 @@ class GeometricCircleFit {
 
   const std::vector<Eigen::Vector2d>& pts_;
   const std::vector<double>& w_;
-  std::vector<Offset> current_, trial_;
+  std::unique_ptr<Offset[]> current_, trial_;
 };
 
 }  // namespace

@@ -4,8 +4,11 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <memory>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -52,19 +55,49 @@ int angularBin(double dx, double dy, int bins) {
   return b < bins - 1 ? b : bins - 1;
 }
 
-// The angular bins of the n pixels from column x0 on of the row dy below the centre, and whether
-// each lies within the narrow band (squared distance from the centre in [lo2, hi2]). Distinct
-// arrays and no branch: the loop vectorises.
-void rowBins(int x0, int n, double centreX, double dy, int bins, double lo2, double hi2,
-             int* __restrict bin, std::uint8_t* __restrict narrow) {
-  // The column from the integer counter: a floating-point counter (x += 1) keeps the loop from
-  // vectorising.
-  for (int i = 0; i < n; ++i) {
-    const double dx = static_cast<double>(x0 + i) - centreX;
-    bin[i] = angularBin(dx, dy, bins);
-    const double rho2 = dx * dx + dy * dy;
-    narrow[i] = static_cast<std::uint8_t>((rho2 >= lo2) & (rho2 <= hi2));
-  }
+// The angular bins of the n pixels from column x0 on of the row dy below the centre. No branch:
+// the loop vectorises. The column from the integer counter: a floating-point counter (x += 1)
+// keeps the loop from vectorising.
+void rowBins(int x0, int n, double centreX, double dy, int bins, int* __restrict bin) {
+  for (int i = 0; i < n; ++i) bin[i] = angularBin(static_cast<double>(x0 + i) - centreX, dy, bins);
+}
+
+// A stretch of a row of the band: columns [x0, x1).
+struct Stretch {
+  int row, x0, x1;
+};
+
+// Appends the columns of stretch s (on the row dy below the centre) within the narrow band,
+// squared distance from the centre in [lo2, hi2], to `out`: at most two stretches, since along a
+// row the squared distance falls up to the centre's column and rises after it. Their ends come
+// from square roots and are then moved to where the per-pixel test itself changes.
+void narrowStretches(const Stretch& s, double centreX, double dy, double lo2, double hi2,
+                     std::vector<Stretch>& out) {
+  const double dy2 = dy * dy;
+  if (dy2 > hi2) return;  // no pixel of the row is near enough
+  auto rho2 = [&](int x) {
+    const double dx = static_cast<double>(x) - centreX;
+    return dx * dx + dy2;
+  };
+  // The first column of [a, b) at which `test` holds (false, then true along the row), or b,
+  // looked for from `guess`.
+  auto first = [](int a, int b, double guess, auto test) {
+    int x = static_cast<int>(
+        std::clamp(std::ceil(guess), static_cast<double>(a), static_cast<double>(b)));
+    while (x > a && test(x - 1)) --x;
+    while (x < b && !test(x)) ++x;
+    return x;
+  };
+  const double inner = lo2 > dy2 ? std::sqrt(lo2 - dy2) : 0.0, outer = std::sqrt(hi2 - dy2);
+  // The first column right of the centre: to its left the squared distance falls.
+  const int split = static_cast<int>(
+      std::clamp(std::floor(centreX) + 1.0, static_cast<double>(s.x0), static_cast<double>(s.x1)));
+  const int a = first(s.x0, split, centreX - outer, [&](int x) { return rho2(x) <= hi2; });
+  const int b = first(a, split, centreX - inner, [&](int x) { return rho2(x) < lo2; });
+  if (a < b) out.push_back({s.row, a, b});
+  const int c = first(split, s.x1, centreX + inner, [&](int x) { return rho2(x) >= lo2; });
+  const int d = first(c, s.x1, centreX + outer, [&](int x) { return rho2(x) > hi2; });
+  if (c < d) out.push_back({s.row, c, d});
 }
 
 // One pass of the blurred-step model over the band at parameters q (cx, cy, R, s, level, ramp x,
@@ -146,14 +179,9 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const double halfBand = smallRim ? 8.0 : 6.0;
   constexpr double kNarrowBand = 4.0;
 
-  // The band |rho - R| <= halfBand inside the image, first as pixels and bins only: a big rim's
-  // band holds several times the pixels the fit keeps (the thinning below), and only those need
-  // their coordinates and grey values.
-  struct BandPixel {
-    int column, row, bin;
-    bool narrow;  // within kNarrowBand of the rim
-  };
-  std::vector<BandPixel> band;
+  // The band |rho - R| <= halfBand inside the image, as stretches of rows: a big rim's band holds
+  // several times the pixels the fit keeps (the thinning below), and only those need their bins,
+  // coordinates and grey values.
   const double rOut = radius + halfBand, rIn = std::max(0.0, radius - halfBand);
   const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - rOut)));
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
@@ -164,12 +192,16 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // a quarter of the noise. The step's height follows from the edge's gradient magnitude (a step
   // b blurred by s peaks at b / (sqrt(2 pi) s)); a fixed 2 px let the halo of a high-contrast blob
   // next to the rim (several grey levels there, radial like the rim's own gradient) into the fit.
+  // A row of the map is zeroed when an edge first reaches it (most rows have none; zeroing the
+  // whole map cost more than marking it); a row not zeroed holds no tainted pixel.
   cv::Mat tainted;
+  std::vector<std::uint8_t> taintedRow;  // 1: the row of `tainted` is zeroed and marked
   if (!foreignPoints.empty() && x1 >= x0 && y1 >= y0) {
     constexpr double kEdgeBlur = 1.0;  // pixels; a sharp edge seen through the pixel grid
     constexpr double kMinTaint = 2.0, kMaxTaint = 4.0;                    // pixels
     const double tolerance = noiseSigma > 0.0 ? 0.25 * noiseSigma : 0.5;  // grey levels
-    tainted = cv::Mat::zeros(y1 - y0 + 1, x1 - x0 + 1, CV_8U);
+    tainted.create(y1 - y0 + 1, x1 - x0 + 1, CV_8U);
+    taintedRow.assign(y1 - y0 + 1, 0);
     for (const EdgePoint& e : foreignPoints) {
       const double step = e.magnitude * std::sqrt(2.0 * kPi) * kEdgeBlur;
       auto halo = [&](double d) {  // grey change d px from the edge
@@ -181,53 +213,75 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       const cv::Point2d q = e.position;
       const int qx = static_cast<int>(std::lround(q.x)), qy = static_cast<int>(std::lround(q.y));
       const int span = static_cast<int>(std::ceil(reach));
-      for (int v = std::max(y0, qy - span); v <= std::min(y1, qy + span); ++v)
+      for (int v = std::max(y0, qy - span); v <= std::min(y1, qy + span); ++v) {
+        if (!taintedRow[v - y0]) {
+          std::memset(tainted.ptr<std::uint8_t>(v - y0), 0, static_cast<std::size_t>(tainted.cols));
+          taintedRow[v - y0] = 1;
+        }
         for (int u = std::max(x0, qx - span); u <= std::min(x1, qx + span); ++u)
           if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= reach * reach)
             tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
+      }
     }
   }
-  // Bins and the narrow band's test in loops of their own, which vectorise; the band is then
-  // filled without a branch per pixel (whether a bin is covered follows no pattern the branch
-  // predictor learns) and cut to the pixels kept.
-  const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
+  // The band's pixels that take part (in a covered bin, clear of foreign edges), in the runs'
+  // order. Along a row the angular bin is monotonic (diamondAngle), so a run whose end pixels'
+  // bins enclose covered bins only is covered throughout and needs no bin per pixel here; the
+  // others are tested pixel by pixel.
+  std::vector<int> uncoveredBelow(bins + 1, 0);  // bins below b that are not covered
+  for (int b = 0; b < bins; ++b) uncoveredBelow[b + 1] = uncoveredBelow[b] + (covered[b] == 0);
   const RowRuns runs =
       annulusRowRuns(centre, rIn, rOut, cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
-  std::size_t runPixels = 0;
-  for (const RowRun& run : runs) runPixels += static_cast<std::size_t>(run.x1 - run.x0);
-  band.resize(runPixels);
-  std::vector<int> runBins;
-  std::vector<std::uint8_t> runNarrow;
-  std::size_t inBand = 0, narrowPixels = 0;
+  std::vector<Stretch> band;
+  band.reserve(runs.size());
+  std::vector<int> pixelBins;
+  std::size_t inBand = 0;
   for (const RowRun& run : runs) {
     const int n = run.x1 - run.x0;
+    if (n <= 0) continue;
     const double dy = run.y - centre.y;
-    runBins.resize(n);
-    runNarrow.resize(n);
-    rowBins(run.x0, n, centre.x, dy, bins, lo * lo, hi * hi, runBins.data(), runNarrow.data());
-    const auto* taint = tainted.empty() ? nullptr : tainted.ptr<std::uint8_t>(run.y - y0) - x0;
+    const auto* taint = !taintedRow.empty() && taintedRow[run.y - y0]
+                            ? tainted.ptr<std::uint8_t>(run.y - y0) - x0
+                            : nullptr;
+    const int first = angularBin(static_cast<double>(run.x0) - centre.x, dy, bins);
+    const int last = angularBin(static_cast<double>(run.x1 - 1) - centre.x, dy, bins);
+    if (taint == nullptr &&
+        uncoveredBelow[std::max(first, last) + 1] == uncoveredBelow[std::min(first, last)]) {
+      band.push_back({run.y, run.x0, run.x1});
+      inBand += static_cast<std::size_t>(n);
+      continue;
+    }
+    pixelBins.resize(n);
+    rowBins(run.x0, n, centre.x, dy, bins, pixelBins.data());
     for (int i = 0; i < n; ++i) {
-      const int bin = runBins[i];
-      const bool narrow = runNarrow[i] != 0;
-      band[inBand] = {run.x0 + i, run.y, bin, narrow};
-      const bool keep = (covered[bin] != 0) & (taint == nullptr || taint[run.x0 + i] == 0);
-      inBand += keep;
-      narrowPixels += keep & narrow;
+      const int x = run.x0 + i;
+      if (!covered[pixelBins[i]] || (taint != nullptr && taint[x] != 0)) continue;
+      if (!band.empty() && band.back().row == run.y && band.back().x1 == x)
+        ++band.back().x1;
+      else
+        band.push_back({run.y, x, x + 1});
+      ++inBand;
     }
   }
-  band.resize(inBand);
-  if (band.size() < 30) return std::nullopt;
+  if (inBand < 30) return std::nullopt;
 
   // Start: outside and inside levels from the band's two halves, blur 1.2 px, no ramp.
   // Every few pixels suffice for a starting level (a big rim's band has thousands).
   std::vector<double> inside, outside;
-  const std::size_t levelStride = std::max<std::size_t>(1, band.size() / 1024);
-  for (std::size_t i = 0; i < band.size(); i += levelStride) {
-    const BandPixel& e = band[i];
-    const double dx = e.column - centre.x, dy = e.row - centre.y;
-    const double d = std::sqrt(dx * dx + dy * dy) - radius;
-    if (d < -2.0) inside.push_back(greyAt(image, e.column, e.row));
-    if (d > 2.0) outside.push_back(greyAt(image, e.column, e.row));
+  const std::size_t levelStride = std::max<std::size_t>(1, inBand / 1024);
+  {
+    std::size_t next = 0, start = 0;  // band indices: the next pixel read, the stretch's first
+    for (const Stretch& s : band) {
+      const std::size_t end = start + static_cast<std::size_t>(s.x1 - s.x0);
+      for (; next < end; next += levelStride) {
+        const int column = s.x0 + static_cast<int>(next - start);
+        const double dx = column - centre.x, dy = s.row - centre.y;
+        const double d = std::sqrt(dx * dx + dy * dy) - radius;
+        if (d < -2.0) inside.push_back(greyAt(image, column, s.row));
+        if (d > 2.0) outside.push_back(greyAt(image, column, s.row));
+      }
+      start = end;
+    }
   }
   if (inside.empty() || outside.empty()) return std::nullopt;
   Vector8 p;
@@ -240,16 +294,24 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // bounds the time of big, high-contrast circles and keeps every pixel of faint ones. When
   // pixels are to spare, the narrower band goes first: its pixels carry more about the rim.
   constexpr double kTargetSigma = 0.0035;
+  const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
   bool narrow = false;  // keep the pixels within kNarrowBand of the rim only
   double share = 1.0;   // ... and of their bins this share
+  // The narrow band's pixels of the band (filled when narrow), in the band's order.
+  std::vector<Stretch> narrowBand;
+  std::size_t narrowPixels = 0;
   if (noiseSigma > 0.0) {
     const double snr = p(7) / noiseSigma;
     auto needed = [&](double halfWidth) {
       const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * halfWidth);
       return std::max(1000.0, 1.0 / (kTargetSigma * kTargetSigma * infoPerPixel));
     };
-    if (static_cast<double>(band.size()) > needed(halfBand)) {
+    if (static_cast<double>(inBand) > needed(halfBand)) {
       narrow = true;
+      narrowBand.reserve(2 * band.size());
+      for (const Stretch& s : band)
+        narrowStretches(s, centre.x, s.row - centre.y, lo * lo, hi * hi, narrowBand);
+      for (const Stretch& s : narrowBand) narrowPixels += static_cast<std::size_t>(s.x1 - s.x0);
       share = needed(kNarrowBand) / static_cast<double>(narrowPixels);
     }
   }
@@ -259,16 +321,26 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   if (narrow && share < 1.0)
     for (int b = 0; b < bins; ++b)
       keptBin[b] = std::floor((b + 1) * share) != std::floor(b * share);
-  // The band's pixels the share keeps, listed without a branch per pixel, then read.
-  std::vector<std::uint32_t> picks(band.size());
+  // The pixels kept, in the band's order: all of the band's, or the narrow band's in kept bins,
+  // picked without a branch per pixel (whether a bin is kept follows no pattern the branch
+  // predictor learns).
+  struct Pick {
+    int column, row, bin;
+  };
+  const auto picks = std::make_unique_for_overwrite<Pick[]>(narrow ? narrowPixels : inBand);
   std::size_t picked = 0;
-  for (std::size_t i = 0; i < band.size(); ++i) {
-    picks[picked] = static_cast<std::uint32_t>(i);
-    picked += !narrow || (band[i].narrow & (keptBin[band[i].bin] != 0));
+  for (const Stretch& s : narrow ? narrowBand : band) {
+    const int n = s.x1 - s.x0;
+    pixelBins.resize(n);
+    rowBins(s.x0, n, centre.x, s.row - centre.y, bins, pixelBins.data());
+    for (int k = 0; k < n; ++k) {
+      picks[picked] = {s.x0 + k, s.row, pixelBins[k]};
+      picked += keptBin[pixelBins[k]];
+    }
   }
   samples.reserve(picked);
   for (std::size_t k = 0; k < picked; ++k) {
-    const BandPixel& e = band[picks[k]];
+    const Pick& e = picks[k];
     samples.push_back({e.column - centre.x, e.row - centre.y, greyAt(image, e.column, e.row), e.bin,
                        e.column, e.row});
   }

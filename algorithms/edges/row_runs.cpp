@@ -46,22 +46,33 @@ RowRuns dilateRowRuns(const RowRuns& runs, cv::Rect clip) {
   if (runs.empty() || clip.empty()) return out;
   const int yFirst = std::max(clip.y, runs.front().y - 1);
   const int yLast = std::min(clip.y + clip.height - 1, runs.back().y + 1);
-  std::vector<RowRun> row;  // the grown runs of the three rows around one output row
-  std::size_t from = 0;     // first run of row y - 1 or later
+  const int xEnd = clip.x + clip.width;
+  out.reserve(runs.size() + static_cast<std::size_t>(yLast - yFirst + 1));
+  std::size_t from = 0;  // first run of row y - 1 or later
   for (int y = yFirst; y <= yLast; ++y) {
     while (from < runs.size() && runs[from].y < y - 1) ++from;
-    row.clear();
-    for (std::size_t i = from; i < runs.size() && runs[i].y <= y + 1; ++i) {
-      const int x0 = std::max(clip.x, runs[i].x0 - 1);
-      const int x1 = std::min(clip.x + clip.width, runs[i].x1 + 1);
-      if (runs[i].x0 < runs[i].x1 && x0 < x1) row.push_back({y, x0, x1});
+    // The runs of rows y - 1, y and y + 1, each sorted by x0 already: merged by x0 (a run's grown
+    // start only depends on its start), they come in the order a sort of all of them would give.
+    std::size_t next[3], end[3];
+    std::size_t i = from;
+    for (int k = 0; k < 3; ++k) {
+      next[k] = i;
+      while (i < runs.size() && runs[i].y == y - 1 + k) ++i;
+      end[k] = i;
     }
-    std::sort(row.begin(), row.end(), [](const RowRun& a, const RowRun& b) { return a.x0 < b.x0; });
-    for (const RowRun& r : row) {
-      if (!out.empty() && out.back().y == y && r.x0 <= out.back().x1)
-        out.back().x1 = std::max(out.back().x1, r.x1);
+    for (;;) {
+      int first = -1;
+      for (int k = 0; k < 3; ++k)
+        if (next[k] < end[k] && (first < 0 || runs[next[k]].x0 < runs[next[first]].x0)) first = k;
+      if (first < 0) break;
+      const RowRun& run = runs[next[first]++];
+      const int x0 = std::max(clip.x, run.x0 - 1);
+      const int x1 = std::min(xEnd, run.x1 + 1);
+      if (run.x0 >= run.x1 || x0 >= x1) continue;
+      if (!out.empty() && out.back().y == y && x0 <= out.back().x1)
+        out.back().x1 = std::max(out.back().x1, x1);
       else
-        out.push_back(r);
+        out.push_back({y, x0, x1});
     }
   }
   return out;
