@@ -402,7 +402,7 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   const Box box = modelBox(model);
   search.field = &fields[0].directions();
   search.level = &model.levels[0];
-  search.spread = params.maxDeformation;
+  search.spread = spreadOnLevel(params.maxDeformation, 0);
   search.minScore = params.minScore * kFinalFactor;
   const bool fixedScale = scaleMax <= scaleMin;
   const Finisher finisher{image, model, box, search, fields[0], params, !fixedScale};

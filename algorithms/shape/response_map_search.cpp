@@ -154,17 +154,20 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
       }
     }
   });
+  // The square a point's best response is taken from (spread > 0).
+  const cv::Mat spreadSquare =
+      spread > 0 ? cv::getStructuringElement(cv::MORPH_RECT, {2 * spread + 1, 2 * spread + 1})
+                 : cv::Mat();
   if (spread > 0) {
     // The best response within `spread` of each pixel, per orientation: a maximum filter over the
     // image (a point outside it scores 0, as at spread 0). OpenCV dilates unsigned bytes;
     // flipping the sign bit maps -128..127 onto 0..255 in order.
-    const cv::Mat kernel =
-        cv::getStructuringElement(cv::MORPH_RECT, {2 * spread + 1, 2 * spread + 1});
     for (int b = 0; b < kBins; ++b) {
       cv::Mat map(h + 2 * border, stride, CV_8U, maps.data() + static_cast<std::size_t>(b * plane));
       cv::Mat inImage = map(cv::Rect(border, border, w, h));
       cv::bitwise_xor(inImage, cv::Scalar(0x80), inImage);
-      cv::dilate(inImage, inImage, kernel, {-1, -1}, 1, cv::BORDER_CONSTANT | cv::BORDER_ISOLATED);
+      cv::dilate(inImage, inImage, spreadSquare, {-1, -1}, 1,
+                 cv::BORDER_CONSTANT | cv::BORDER_ISOLATED);
       cv::bitwise_xor(inImage, cv::Scalar(0x80), inImage);
     }
   }
@@ -206,9 +209,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
       for (int x = 0; x < w; ++x) d[x] = (row[x][0] != 0 || row[x][1] != 0) ? 1 : 0;
     }
     // Spread, a map is non-zero within `spread` of a pixel with a direction.
-    if (spread > 0)
-      cv::dilate(directed, directed,
-                 cv::getStructuringElement(cv::MORPH_RECT, {2 * spread + 1, 2 * spread + 1}));
+    if (spread > 0) cv::dilate(directed, directed, spreadSquare);
     cv::integral(directed, count, CV_32S);
     const int reach = border;
     for (int y = 0; y < h; ++y) {
