@@ -118,12 +118,19 @@ class ApertureProfiles {
  public:
   double sigma = 0;
   bool gridBlur = false;
-  std::vector<NormalTable::Interval> rows;  // kApertureAngles x kApertureSize, built on use
+  // kApertureAngles x kApertureSize, built on use: left uninitialised (178 KB per sigma and
+  // model; a row is read only after buildRow has written all of it).
+  std::unique_ptr<NormalTable::Interval[]> rows;
   std::unique_ptr<std::once_flag[]> built;
+  std::vector<double> kernel;  // the grid model's sampled Gaussian, and its sum
+  double kernelSum = 0;
 
   ApertureProfiles(double psfSigma, bool blurOnGrid)
-      : sigma(psfSigma), gridBlur(blurOnGrid), built(new std::once_flag[kApertureAngles]) {
-    rows.resize(static_cast<size_t>(kApertureAngles) * kApertureSize);
+      : sigma(psfSigma),
+        gridBlur(blurOnGrid),
+        rows(new NormalTable::Interval[static_cast<size_t>(kApertureAngles) * kApertureSize]),
+        built(new std::once_flag[kApertureAngles]) {
+    if (gridBlur) kernel = sampledGaussian(sigma, kernelSum);
   }
 
   void buildRow(int k) {
@@ -159,7 +166,7 @@ class ApertureProfiles {
     }
   }
 
-  ProfileView view(cv::Point2d normal) {
+  ProfileView view(cv::Point2d normal, int degreeStep) {
     const double lo = std::min(std::abs(normal.x), std::abs(normal.y));
     const double hi = std::max(std::abs(normal.x), std::abs(normal.y));
     // The nearest whole degree of atan(lo / hi), by comparing with tan(k + 1/2 degree).
@@ -169,9 +176,12 @@ class ApertureProfiles {
       return t;
     }();
     const double ratio = hi > 0 ? lo / hi : 0.0;
-    const int k = std::min(
+    const int degree = std::min(
         static_cast<int>(std::lower_bound(tanHalf.begin(), tanHalf.end(), ratio) - tanHalf.begin()),
         kApertureAngles - 1);
+    const int k = degreeStep > 1 ? std::min((degree + degreeStep / 2) / degreeStep * degreeStep,
+                                            kApertureAngles - 1)
+                                 : degree;
     std::call_once(built[k], [this, k] { buildRow(k); });
     return {&rows[static_cast<size_t>(k) * kApertureSize],
             kApertureSize,
@@ -215,21 +225,34 @@ class ApertureProfiles {
     std::vector<double> offset, weight, before;
   };
 
-  GridTaps gridTaps(double c, double s) const {
+  // The Gaussian sampled at whole pixels, truncated at 4 sigma, and its sum (the taps divide
+  // by it).
+  static std::vector<double> sampledGaussian(double sigma, double& sum) {
     const int r = static_cast<int>(std::ceil(4 * sigma));
     std::vector<double> kernel(2 * r + 1);
-    double sum = 0;
+    sum = 0;
     for (int k = -r; k <= r; ++k) sum += kernel[k + r] = std::exp(-0.5 * k * k / (sigma * sigma));
+    return kernel;
+  }
+
+  GridTaps gridTaps(double c, double s) const {
+    const int r = static_cast<int>(kernel.size() / 2);
     std::vector<std::pair<double, double>> taps;
     if (s < 1e-9) {  // axis-aligned: the kernel's rows all project to the same offsets
-      for (int kx = -r; kx <= r; ++kx) taps.push_back({kx * c, kernel[kx + r] / sum});
+      taps.reserve(kernel.size());
+      for (int kx = -r; kx <= r; ++kx) taps.push_back({kx * c, kernel[kx + r] / kernelSum});
     } else {
+      taps.reserve(kernel.size() * kernel.size());
       for (int ky = -r; ky <= r; ++ky)
         for (int kx = -r; kx <= r; ++kx)
-          taps.push_back({kx * c + ky * s, kernel[kx + r] * kernel[ky + r] / (sum * sum)});
+          taps.push_back(
+              {kx * c + ky * s, kernel[kx + r] * kernel[ky + r] / (kernelSum * kernelSum)});
     }
     std::sort(taps.begin(), taps.end());
     GridTaps out;
+    out.offset.reserve(taps.size());
+    out.weight.reserve(taps.size());
+    out.before.reserve(taps.size() + 1);
     double running = 0;
     for (const auto& [t, w] : taps) {
       out.offset.push_back(t);
@@ -313,8 +336,8 @@ ProfileView erfView(double w) {
           w};
 }
 
-ProfileView apertureView(ApertureProfiles& profiles, cv::Point2d normal) {
-  return profiles.view(normal);
+ProfileView apertureView(ApertureProfiles& profiles, cv::Point2d normal, int degreeStep) {
+  return profiles.view(normal, degreeStep);
 }
 
 }  // namespace facet::edge_profile

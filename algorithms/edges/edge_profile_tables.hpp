@@ -30,6 +30,8 @@ ProfileView erfView(double w);
 // image, false = before pixel integration), cached; rows are built on first use per angle.
 class ApertureProfiles;
 std::shared_ptr<ApertureProfiles> apertureProfiles(double sigma, bool gridBlur);
-ProfileView apertureView(ApertureProfiles& profiles, cv::Point2d normal);
+// The row for a normal's angle: the nearest whole degree, or with degreeStep > 1 the nearest
+// multiple of degreeStep degrees (fewer rows to build, for the blur search; see fitBlurModel).
+ProfileView apertureView(ApertureProfiles& profiles, cv::Point2d normal, int degreeStep = 1);
 
 }  // namespace facet::edge_profile

@@ -136,6 +136,25 @@ TEST_P(ApertureProfileTable, GridRowMatchesTheSharpStepThroughTheSampledKernel) 
   }
 }
 
+// The blur search reads rows every 5 degrees: a normal gets the row of the nearest multiple of
+// 5 degrees of its nearest whole degree (folded into 0..45 like every row), the very row a normal
+// at that multiple gets with the default step.
+TEST(ApertureProfileTableByCoarseAngle, ReadsTheRowOfTheNearestMultiple) {
+  for (const bool grid : {false, true}) {
+    const auto profiles = apertureProfiles(0.74, grid);
+    for (int degrees = -180; degrees < 180; ++degrees) {
+      const double angle = (degrees + 0.3) * std::numbers::pi / 180;
+      int folded = std::abs(degrees) % 90;
+      if (folded > 45) folded = 90 - folded;
+      const int multiple = (folded + 2) / 5 * 5;
+      const double at = multiple * std::numbers::pi / 180;
+      const ProfileView coarse = apertureView(*profiles, {std::cos(angle), std::sin(angle)}, 5);
+      const ProfileView exact = apertureView(*profiles, {std::cos(at), std::sin(at)});
+      EXPECT_EQ(coarse.data, exact.data) << degrees << " deg, grid " << grid;
+    }
+  }
+}
+
 // A width that an upstream estimate failed to give (NaN) yields a profile of NaN, which no fit
 // prefers, never one of numbers.
 TEST(ApertureProfileTableOfNoWidth, IsNotANumber) {
