@@ -113,22 +113,17 @@ void evaluateProfile(const Vector8& q, std::ptrdiff_t n, const double* __restric
   const double cx0 = q(0), cy0 = q(1), radius = q(2), s = q(3), level = q(4), rampX = q(5),
                rampY = q(6), b = q(7);
   const double inv = 1.0 / s, bNorm = b * (1.0 / (std::sqrt(2.0 * kPi) * s));
-  // First pass: cx, cy hold ex / rho and ey / rho, cs holds z.
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     const double ex = x[i] - cx0, ey = y[i] - cy0;
     const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
-    cx[i] = ex / rho;
-    cy[i] = ey / rho;
-    cs[i] = (rho - radius) * inv;
-  }
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    const double z = cs[i], gauss = gaussian(z);
+    const double z = (rho - radius) * inv, gauss = gaussian(z);
     const double phi = upperTail(z, gauss);  // Phi(-d / s)
     const double bg = bNorm * gauss;         // b * pdf(d; s)
+    const double bgPerRho = bg / rho;
     out[i] = grey[i] - (level + rampX * x[i] + rampY * y[i] + b * phi);
     // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
-    cx[i] *= bg;
-    cy[i] *= bg;
+    cx[i] = ex * bgPerRho;
+    cy[i] = ey * bgPerRho;
     cr[i] = bg;
     cs[i] = bg * z;
     cb[i] = phi;
