@@ -113,22 +113,17 @@ void evaluateProfile(const Vector8& q, std::ptrdiff_t n, const double* __restric
   const double cx0 = q(0), cy0 = q(1), radius = q(2), s = q(3), level = q(4), rampX = q(5),
                rampY = q(6), b = q(7);
   const double inv = 1.0 / s, bNorm = b * (1.0 / (std::sqrt(2.0 * kPi) * s));
-  // First pass: cx, cy hold ex / rho and ey / rho, cs holds z.
   for (std::ptrdiff_t i = 0; i < n; ++i) {
     const double ex = x[i] - cx0, ey = y[i] - cy0;
     const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
-    cx[i] = ex / rho;
-    cy[i] = ey / rho;
-    cs[i] = (rho - radius) * inv;
-  }
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    const double z = cs[i], gauss = gaussian(z);
+    const double z = (rho - radius) * inv, gauss = gaussian(z);
     const double phi = upperTail(z, gauss);  // Phi(-d / s)
     const double bg = bNorm * gauss;         // b * pdf(d; s)
+    const double bgPerRho = bg / rho;
     out[i] = grey[i] - (level + rampX * x[i] + rampY * y[i] + b * phi);
     // dI/dd = -b g; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1; dI/ds = b g d / s.
-    cx[i] *= bg;
-    cy[i] *= bg;
+    cx[i] = ex * bgPerRho;
+    cy[i] = ey * bgPerRho;
     cr[i] = bg;
     cs[i] = bg * z;
     cb[i] = phi;
@@ -475,24 +470,34 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // Without the illumination ramp first: in a thin band a ramp resembles a shifted rim, and
   // fitting one costs about half the precision of a small circle. A score test at that solution
   // (chi-square of the ramp's gradient, 2 degrees of freedom, 99.9%) decides whether the image
-  // has a ramp worth fitting.
+  // has a ramp worth fitting. The block of the other parameters is the last step's (the solve
+  // ends once a step moves the rim by under 1e-3 px, so it hardly differs at the solution); only
+  // the ramp's two rows are computed here, at the solution: the full matrix again cost as much as
+  // one and a half of the solve's own.
   bool withRamp = false;
   if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
-  normalEquations(kAll);
   {
     constexpr int kRamp[2] = {5, 6};
     constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
-    Eigen::Matrix2d hgg;
-    Eigen::Matrix<double, 2, 6> hgo;
     Eigen::Matrix<double, 6, 6> hoo;
-    Eigen::Vector2d score;
-    for (int u = 0; u < 2; ++u) {
-      score(u) = jtr(kRamp[u]);
-      for (int v = 0; v < 2; ++v) hgg(u, v) = jtj(kRamp[u], kRamp[v]);
-      for (int v = 0; v < 6; ++v) hgo(u, v) = jtj(kRamp[u], kRest[v]);
-    }
     for (int u = 0; u < 6; ++u)
       for (int v = 0; v < 6; ++v) hoo(u, v) = jtj(kRest[u], kRest[v]);
+    // Rows of the ramp against the ramp and the rest: columns (ramp x, ramp y, rest...).
+    std::array<const double*, 8> columns{};
+    for (int u = 0; u < 2; ++u) columns[u] = jac.col(kRamp[u]).data();
+    for (int v = 0; v < 6; ++v) columns[2 + v] = jac.col(kRest[v]).data();
+    std::array<double, 64> h{};
+    std::array<double, 8> g{};
+    weightedNormalEquationsLeadingPair(columns, weight.data(), r.data(),
+                                       static_cast<std::ptrdiff_t>(m), h.data(), g.data());
+    Eigen::Matrix2d hgg;
+    Eigen::Matrix<double, 2, 6> hgo;
+    Eigen::Vector2d score;
+    for (int u = 0; u < 2; ++u) {
+      score(u) = g[u];
+      for (int v = 0; v < 2; ++v) hgg(u, v) = h[u * 8 + v];
+      for (int v = 0; v < 6; ++v) hgo(u, v) = h[u * 8 + 2 + v];
+    }
     const Eigen::Matrix2d schur = hgg - hgo * hoo.ldlt().solve(hgo.transpose());
     const double statistic = score.dot(schur.ldlt().solve(score)) / std::max(sigma * sigma, 1e-12);
     if (std::isfinite(statistic) && statistic > 13.8) {

@@ -65,7 +65,9 @@ void rowBlockOf(int columns, const double* const* cols, const double* weight,
   case B:                                                                         \
     rowBlock<B, pair>(cols, weight, residual, n, first, second, firstR, secondR); \
     break;
-    FACET_ROW_BLOCK(1)
+    case 1:  // a single column has no second row
+      rowBlock<1, false>(cols, weight, residual, n, first, second, firstR, secondR);
+      break;
     FACET_ROW_BLOCK(2)
     FACET_ROW_BLOCK(3)
     FACET_ROW_BLOCK(4)
@@ -79,13 +81,12 @@ void rowBlockOf(int columns, const double* const* cols, const double* weight,
   }
 }
 
-}  // namespace
-
-void weightedNormalEquations(std::span<const double* const> columns, const double* weight,
-                             const double* residual, std::ptrdiff_t n, double* jtj, double* jtr) {
+// Rows a < rows (a pair at a time) of J^T W J and J^T W r, mirrored into their columns.
+void normalRows(std::span<const double* const> columns, int rows, const double* weight,
+                const double* residual, std::ptrdiff_t n, double* jtj, double* jtr) {
   const int k = static_cast<int>(columns.size());
   double first[8] = {}, second[8] = {};
-  for (int a = 0; a < k; a += 2) {
+  for (int a = 0; a < rows; a += 2) {
     const int b = k - a;  // columns a .. k - 1
     double firstR = 0.0, secondR = 0.0;
     if (b >= 2)
@@ -99,6 +100,19 @@ void weightedNormalEquations(std::span<const double* const> columns, const doubl
       jtr[a + 1] = secondR;
     }
   }
+}
+
+}  // namespace
+
+void weightedNormalEquations(std::span<const double* const> columns, const double* weight,
+                             const double* residual, std::ptrdiff_t n, double* jtj, double* jtr) {
+  normalRows(columns, static_cast<int>(columns.size()), weight, residual, n, jtj, jtr);
+}
+
+void weightedNormalEquationsLeadingPair(std::span<const double* const> columns,
+                                        const double* weight, const double* residual,
+                                        std::ptrdiff_t n, double* jtj, double* jtr) {
+  normalRows(columns, 2, weight, residual, n, jtj, jtr);
 }
 
 }  // namespace facet

@@ -19,4 +19,12 @@ namespace facet {
 void weightedNormalEquations(std::span<const double* const> columns, const double* weight,
                              const double* residual, std::ptrdiff_t n, double* jtj, double* jtr);
 
+// Only the first two rows of J^T W J (and their mirror, the first two columns) and the first two
+// entries of J^T W r, in one pass: a score test of two parameters at a fit of the others, whose
+// block of the matrix the fit has already computed. `columns`: 2 <= k <= 8; the other entries of
+// `jtj` and `jtr` are left as they are.
+void weightedNormalEquationsLeadingPair(std::span<const double* const> columns,
+                                        const double* weight, const double* residual,
+                                        std::ptrdiff_t n, double* jtj, double* jtr);
+
 }  // namespace facet
