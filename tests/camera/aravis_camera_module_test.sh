@@ -21,8 +21,8 @@ for program in "$facet" "$facetd"; do
 done
 
 # The loader lists every library it opens on stderr.
-png_match=(match --model recipes/models/bracket.shape --image recipes/demo/bracket_shape/part_000.png
-  --json)
+png=recipes/demo/bracket_shape/part_000.png
+png_match=(match --model recipes/models/bracket.shape --image "$png" --json)
 for command in version "${png_match[*]}"; do
   # shellcheck disable=SC2086  # the command's words
   trace=$(LD_DEBUG=files "$facet" $command 2>&1 >/dev/null) || fail "facet $command failed: $trace"
