@@ -1,5 +1,6 @@
 #pragma once
-// AravisCamera: a GigE Vision / USB3 Vision camera through Aravis 0.8.
+// AravisCamera: a GigE Vision / USB3 Vision camera through Aravis 0.8. It lives in the GigE Vision
+// camera module; facet and facetd make it through makeCamera (aravis_backend.hpp), never link it.
 //
 // - Opened by address (GigE, no discovery needed), serial number, Aravis device id, or the
 //   first camera found, in that order of preference.

@@ -1,6 +1,6 @@
 #include "camera/camera_factory.hpp"
 
-#include "camera/aravis_camera.hpp"
+#include "camera/aravis_backend.hpp"
 #include "camera/replay_camera.hpp"
 #include "camera/v4l2_camera.hpp"
 
@@ -11,7 +11,7 @@ std::unique_ptr<Camera> makeCamera(const CameraSettings& settings) {
     case CameraBackend::Replay:
       return std::make_unique<ReplayCamera>(settings.replay);
     case CameraBackend::Aravis:
-      return std::make_unique<AravisCamera>(settings.aravis);
+      return makeAravisCamera(settings.aravis);  // loads the module on first use
     case CameraBackend::V4l2:
       return std::make_unique<V4l2Camera>(settings.v4l2);
   }

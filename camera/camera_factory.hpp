@@ -9,7 +9,8 @@
 namespace facet {
 
 // Builds the camera `settings.backend` asks for; it is returned closed (call open()).
-// Throws CameraError when the settings are unusable (e.g. replay without a folder).
+// Throws CameraError when the settings are unusable (e.g. replay without a folder), or when the
+// backend's module cannot be loaded (aravis_backend.hpp).
 std::unique_ptr<Camera> makeCamera(const CameraSettings& settings);
 
 }  // namespace facet

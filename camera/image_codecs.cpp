@@ -1,9 +1,6 @@
 #include "camera/image_codecs.hpp"
 
-#include <dlfcn.h>
-
 #include <cstdio>
-#include <cstdlib>
 #include <optional>
 
 #include <opencv2/imgproc.hpp>
@@ -14,6 +11,7 @@
 #include "camera/image_codec_table.hpp"
 #include "camera/image_file_reader.hpp"
 #include "camera/jpeg_file.hpp"
+#include "camera/module_file.hpp"
 #include "camera/png_file.hpp"
 #include "camera/tiff_file.hpp"
 
@@ -31,43 +29,19 @@ struct LoadedCodecs {
   std::string problem;  // empty when `table` is set
 };
 
-std::vector<fs::path> modulePaths() {
-  if (const char* file = std::getenv("FACET_IMAGE_CODECS"); file && *file) return {file};
-  std::vector<fs::path> paths;
-  std::error_code ec;
-  // The installed layout: <prefix>/bin/facet beside <prefix>/lib/facet/<module>.
-  if (const fs::path exe = fs::read_symlink("/proc/self/exe", ec); !ec)
-    paths.push_back((exe.parent_path() / FACET_IMAGE_CODECS_FROM_BIN / FACET_IMAGE_CODECS_FILE)
-                        .lexically_normal());
-  paths.emplace_back(FACET_IMAGE_CODECS_BUILD_PATH);
-  return paths;
-}
-
 LoadedCodecs load() {
+  const ModuleFile module{"FACET_IMAGE_CODECS", FACET_IMAGE_CODECS_FILE,
+                          FACET_IMAGE_CODECS_FROM_BIN, FACET_IMAGE_CODECS_BUILD_PATH};
+  const auto accept = [](void* entry) -> std::string {
+    const ImageCodecTable* table = reinterpret_cast<decltype(&facet_image_codec_table)>(entry)();
+    if (!table) return std::string("no table from ") + kImageCodecEntry;
+    if (table->abi == kImageCodecAbi) return {};
+    return "built for interface " + std::to_string(table->abi) + ", this program needs " +
+           std::to_string(kImageCodecAbi);
+  };
   std::string tried;
-  for (const fs::path& path : modulePaths()) {
-    void* handle = ::dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL);
-    if (!handle) {
-      const char* error = ::dlerror();
-      const std::string why = error ? error : "cannot load";
-      // dlerror() names the path itself for a missing file, a dependency for a broken one.
-      tried += (tried.empty() ? "" : "; ") +
-               (why.starts_with(path.string()) ? why : path.string() + ": " + why);
-      continue;
-    }
-    using Entry = const ImageCodecTable* (*)();
-    const auto entry = reinterpret_cast<Entry>(::dlsym(handle, kImageCodecEntry));
-    const ImageCodecTable* table = entry ? entry() : nullptr;
-    if (table && table->abi == kImageCodecAbi) {
-      // Never closed: decoders keep global state for the life of the process.
-      return {table, {}};
-    }
-    const std::string why = table ? "built for interface " + std::to_string(table->abi) +
-                                        ", this program needs " + std::to_string(kImageCodecAbi)
-                                  : std::string("no ") + kImageCodecEntry;
-    tried += (tried.empty() ? "" : "; ") + path.string() + ": " + why;
-    ::dlclose(handle);
-  }
+  if (void* entry = openModule(module, kImageCodecEntry, accept, tried))
+    return {reinterpret_cast<decltype(&facet_image_codec_table)>(entry)(), {}};
   LoadedCodecs failed;
   failed.problem = "image codecs not loaded (set FACET_IMAGE_CODECS to the module " +
                    std::string(FACET_IMAGE_CODECS_FILE) + "); tried " + tried;

@@ -27,7 +27,8 @@ if [[ $build_first -eq 1 ]]; then
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release
   cmake --build "$build" -j"$(nproc)" --target facetd facet
 fi
-for binary in service/daemon/facetd service/facet camera/libfacet_image_codecs.so; do
+for binary in service/daemon/facetd service/facet camera/libfacet_image_codecs.so \
+    camera/libfacet_aravis_camera.so; do
   [[ -x $build/$binary ]] || { echo "install.sh: $build/$binary is missing; build first" >&2; exit 1; }
 done
 
@@ -41,8 +42,10 @@ for group in video plugdev; do
 done
 
 # 3. Binaries: install(1) replaces atomically, so a running facetd keeps its old inode. The
-# image-codec module first: the binaries load it on first use from $prefix/lib/facet.
+# modules first (image codecs, GigE Vision camera): the binaries load them on first use from
+# $prefix/lib/facet.
 install -D -m 0644 "$build/camera/libfacet_image_codecs.so" "$prefix/lib/facet/libfacet_image_codecs.so"
+install -D -m 0644 "$build/camera/libfacet_aravis_camera.so" "$prefix/lib/facet/libfacet_aravis_camera.so"
 install -D -m 0755 "$build/service/daemon/facetd" "$prefix/bin/facetd"
 install -D -m 0755 "$build/service/facet" "$prefix/bin/facet"
 install -D -m 0644 "$root/deploy/README.md" "$prefix/share/doc/facet/README.md"

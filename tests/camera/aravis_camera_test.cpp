@@ -82,6 +82,26 @@ TEST(AravisCamera, UnknownAddressIsAClearError) {
   EXPECT_THROW(AravisCamera{s}, CameraError);
 }
 
+// makeCamera builds an aravis camera in the GigE Vision camera module: what the module throws
+// reaches the caller as the CameraError it is, with its message.
+TEST(AravisCamera, FactoryErrorsComeOutOfTheModuleAsCameraErrors) {
+  CameraSettings settings;
+  settings.backend = CameraBackend::Aravis;
+  settings.aravis.address = "127.0.0.1";  // nothing listens: no fake camera started
+  settings.aravis.pixel_format = "YUV422";
+  try {
+    makeCamera(settings);
+    FAIL() << "makeCamera should throw";
+  } catch (const CameraError& e) {
+    EXPECT_NE(std::string(e.what()).find("unsupported pixel format \"YUV422\""), std::string::npos)
+        << e.what();
+  }
+  settings.aravis.pixel_format = "Mono8";
+  const auto camera = makeCamera(settings);
+  EXPECT_EQ(camera->name(), "aravis:127.0.0.1");
+  EXPECT_THROW(camera->open(), CameraError);
+}
+
 TEST(AravisCamera, Mono8FramesArriveByteExactAndIdsCrossTheWrap) {
   FakeGigECamera fake;
   ASSERT_TRUE(fake.running());
