@@ -32,16 +32,10 @@ struct LoadedCodecs {
 LoadedCodecs load() {
   const ModuleFile module{"FACET_IMAGE_CODECS", FACET_IMAGE_CODECS_FILE,
                           FACET_IMAGE_CODECS_FROM_BIN, FACET_IMAGE_CODECS_BUILD_PATH};
-  const auto accept = [](void* entry) -> std::string {
-    const ImageCodecTable* table = reinterpret_cast<decltype(&facet_image_codec_table)>(entry)();
-    if (!table) return std::string("no table from ") + kImageCodecEntry;
-    if (table->abi == kImageCodecAbi) return {};
-    return "built for interface " + std::to_string(table->abi) + ", this program needs " +
-           std::to_string(kImageCodecAbi);
-  };
   std::string tried;
-  if (void* entry = openModule(module, kImageCodecEntry, accept, tried))
-    return {reinterpret_cast<decltype(&facet_image_codec_table)>(entry)(), {}};
+  if (const auto* table =
+          openModuleTable<ImageCodecTable>(module, kImageCodecEntry, kImageCodecAbi, tried))
+    return {table, {}};
   LoadedCodecs failed;
   failed.problem = "image codecs not loaded (set FACET_IMAGE_CODECS to the module " +
                    std::string(FACET_IMAGE_CODECS_FILE) + "); tried " + tried;

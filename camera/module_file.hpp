@@ -23,4 +23,22 @@ struct ModuleFile {
 void* openModule(const ModuleFile& module, const char* entry,
                  const std::function<std::string(void* symbol)>& accept, std::string& tried);
 
+// The table of a module whose entry point `entry` is `const Table* entry()` and whose table
+// carries the interface number `abi` this program was built for: a module from another build
+// is passed over with the reason. nullptr when no place has one, as openModule.
+template <typename Table>
+const Table* openModuleTable(const ModuleFile& module, const char* entry, int abi,
+                             std::string& tried) {
+  const auto tableOf = [](void* symbol) { return reinterpret_cast<const Table* (*)()>(symbol)(); };
+  const auto accept = [&](void* symbol) -> std::string {
+    const Table* table = tableOf(symbol);
+    if (!table) return std::string("no table from ") + entry;
+    if (table->abi == abi) return {};
+    return "built for interface " + std::to_string(table->abi) + ", this program needs " +
+           std::to_string(abi);
+  };
+  void* symbol = openModule(module, entry, accept, tried);
+  return symbol ? tableOf(symbol) : nullptr;
+}
+
 }  // namespace facet

@@ -126,8 +126,9 @@ void gradientOnRuns(const cv::Mat& image, const RowRuns& runs, EdgeGradient& g) 
     deriv.resize(n);
     verticalPasses<T, Sum>(r, run.x0 - 2, n, image.cols, smooth.data(), deriv.data());
     const int row = run.y - g.area.y, x0 = run.x0 - g.area.x;
-    horizontalPasses<Sum, D>(smooth.data(), deriv.data(), run.x1 - run.x0, scale, g.gx.ptr<D>(row) + x0,
-                        g.gy.ptr<D>(row) + x0, g.magnitude.ptr<float>(row) + x0);
+    horizontalPasses<Sum, D>(smooth.data(), deriv.data(), run.x1 - run.x0, scale,
+                             g.gx.ptr<D>(row) + x0, g.gy.ptr<D>(row) + x0,
+                             g.magnitude.ptr<float>(row) + x0);
   }
 }
 
