@@ -1,6 +1,7 @@
 #include "algorithms/circle/weighted_normal_equations.hpp"
 
 #include <cstring>
+#include <utility>
 
 namespace facet {
 namespace {
@@ -56,29 +57,33 @@ void rowBlock(const double* const* cols, const double* __restrict weight,
   }
 }
 
+// rowBlock for B columns if there are B; a single column has no second row, so its block is
+// never built as a pair.
+template <bool pair, int B>
+bool rowBlockIf(int columns, const double* const* cols, const double* weight,
+                const double* residual, std::ptrdiff_t n, double* first, double* second,
+                double& firstR, double& secondR) {
+  if (columns != B) return false;
+  constexpr bool twoRows = pair && B > 1;
+  rowBlock<B, twoRows>(cols, weight, residual, n, first, second, firstR, secondR);
+  return true;
+}
+
+// rowBlock for a run-time column count 1..8 (others do nothing).
+template <bool pair, int... B>
+void rowBlockOf(std::integer_sequence<int, B...>, int columns, const double* const* cols,
+                const double* weight, const double* residual, std::ptrdiff_t n, double* first,
+                double* second, double& firstR, double& secondR) {
+  (void)(rowBlockIf<pair, B>(columns, cols, weight, residual, n, first, second, firstR, secondR) ||
+         ...);
+}
+
 template <bool pair>
 void rowBlockOf(int columns, const double* const* cols, const double* weight,
                 const double* residual, std::ptrdiff_t n, double* first, double* second,
                 double& firstR, double& secondR) {
-  switch (columns) {
-#define FACET_ROW_BLOCK(B)                                                        \
-  case B:                                                                         \
-    rowBlock<B, pair>(cols, weight, residual, n, first, second, firstR, secondR); \
-    break;
-    case 1:  // a single column has no second row
-      rowBlock<1, false>(cols, weight, residual, n, first, second, firstR, secondR);
-      break;
-    FACET_ROW_BLOCK(2)
-    FACET_ROW_BLOCK(3)
-    FACET_ROW_BLOCK(4)
-    FACET_ROW_BLOCK(5)
-    FACET_ROW_BLOCK(6)
-    FACET_ROW_BLOCK(7)
-    FACET_ROW_BLOCK(8)
-#undef FACET_ROW_BLOCK
-    default:
-      break;
-  }
+  rowBlockOf<pair>(std::integer_sequence<int, 1, 2, 3, 4, 5, 6, 7, 8>{}, columns, cols, weight,
+                   residual, n, first, second, firstR, secondR);
 }
 
 // Rows a < rows (a pair at a time) of J^T W J and J^T W r, mirrored into their columns.
