@@ -1,6 +1,7 @@
 #include "algorithms/shape/find_shape_model.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <optional>
 #include <stdexcept>
@@ -283,6 +284,25 @@ int spreadOnLevel(int maxDeformation, int l) {
   return maxDeformation >> l;
 }
 
+// The angle steps of the level below the top that a second, wider look covers on either side of
+// a top-level candidate: two of the top level's steps. A part partly hidden can peak on the top
+// level a step or two from its own angle, where the occluder's or clutter's edges line up with
+// the model's; the usual look, one step of the level below (half a top step), left such a part to
+// climb from there, and the climb stopped on the wrong side's peak. The wider look's peak is
+// tracked beside the near one where the two differ: either may be the part, and the levels below
+// tell them apart.
+int stepsBelowTop(const ShapeLevel& top, const ShapeLevel& below) {
+  if (!(below.angleStep > 0.0) || !(top.angleStep > 0.0)) return 1;
+  return std::max(1, static_cast<int>(std::ceil(2.0 * top.angleStep / below.angleStep - 1e-9)));
+}
+
+// Two tracked poses on one level that are the same peak: within a pixel and an angle step.
+bool sameLevelPose(const Candidate& a, const Candidate& b, double angleStep) {
+  return std::abs(a.x - b.x) <= 1.0 && std::abs(a.y - b.y) <= 1.0 &&
+         std::abs(wrapAngle(a.angle - b.angle)) <= angleStep * 1.001 &&
+         std::abs(a.scale - b.scale) < 1e-9;
+}
+
 }  // namespace
 
 std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& model,
@@ -369,13 +389,21 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
                                                                                  : kFinalFactor);
     // Each candidate is tracked on its own (the field is read-only here), in parallel when
     // threads > 1; kept in their order, so the result is the same for any number of threads.
-    std::vector<Candidate> tracked(candidates.size());
+    // Below the top, a candidate may also leave a second peak (see stepsBelowTop).
+    std::vector<std::array<Candidate, 2>> tracked(candidates.size());
+    const int wideSteps = l == top - 1 ? stepsBelowTop(topLevel, model.levels[l]) : 1;
     auto track = [&](const cv::Range& r) {
       for (int i = r.start; i < r.end; ++i) {
         Candidate c = candidates[static_cast<std::size_t>(i)];
         c.x *= 2.0;
         c.y *= 2.0;
-        tracked[static_cast<std::size_t>(i)] = refineOnLevel(search, c, 2);
+        auto& out = tracked[static_cast<std::size_t>(i)];
+        out[0] = refineOnLevel(search, c, 2);
+        out[1].score = -1.0;
+        if (wideSteps > 1) {
+          const Candidate wide = refineOnLevel(search, c, 2, wideSteps);
+          if (!sameLevelPose(wide, out[0], search.level->angleStep)) out[1] = wide;
+        }
       }
     };
     const cv::Range all(0, static_cast<int>(candidates.size()));
@@ -384,8 +412,9 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
     else
       track(all);
     std::vector<Candidate> next;
-    for (const Candidate& r : tracked)
-      if (r.score >= search.minScore) next.push_back(r);
+    for (const auto& peaks : tracked)
+      for (const Candidate& r : peaks)
+        if (r.score >= search.minScore) next.push_back(r);
     candidates.swap(next);
   }
   if (top == 0) {

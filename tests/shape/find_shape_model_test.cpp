@@ -486,6 +486,37 @@ TEST(FindShapeModel, AHeldScaleKeepsAnExactRefinementBesideAnOccluder) {
   }
 }
 
+// A part 40% hidden can peak on the top pyramid level one to three of that level's angle steps
+// from its own angle, where the occluder's straight borders line up with the model's edges. The
+// level below looked only half a top step either side, and the part was lost on the way down
+// (no match, or a match 3-5 px and 3-4 degrees off). A second, wider look (two top steps) is
+// tracked beside the near one. These seeds of the generator were missed before; all score above
+// the minimum at their true pose.
+TEST(FindShapeModel, AHiddenPartWhoseTopLevelPeakLiesStepsOffItsAngleIsFound) {
+  const ShapeModel model = createShapeModel(testing::bracketTemplate());
+  FindParams p;
+  p.minScore = 0.5;
+  for (const std::uint64_t seed : {44u, 169u, 303u, 379u, 402u, 502u, 700u, 755u, 897u}) {
+    const OccludedScene sc = occludedBracket(seed);
+    const auto m = findShapeModel(sc.image, model, p);
+    ASSERT_EQ(m.size(), 1u) << "seed " << seed;
+    EXPECT_LT(std::hypot(m[0].x - sc.truth.x, m[0].y - sc.truth.y), 0.1) << "seed " << seed;
+    EXPECT_NEAR(wrapAngle(m[0].angle - sc.truth.angle), 0.0, radians(0.1)) << "seed " << seed;
+  }
+  // The same on a photograph: board_dip (tests/data/photos/cases.txt) with its left third hidden
+  // behind a plate was not found at all.
+  const std::string dir = FACET_TEST_DATA_DIR "/photos/";
+  const cv::Mat templ = cv::imread(dir + "board_dip_template.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat scene = cv::imread(dir + "board_dip_scene.png", cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(templ.empty() || scene.empty()) << "missing " << dir;
+  const Pose2D truth{503.685, 428.379, radians(171.5), 1.01};
+  const cv::Mat hidden = testing::hideSide(scene, templ.size(), truth, testing::HiddenSide::Left);
+  const auto m = findShapeModel(hidden, createShapeModel(templ), p);
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_LT(std::hypot(m[0].x - truth.x, m[0].y - truth.y), 0.1);
+  EXPECT_NEAR(wrapAngle(m[0].angle - truth.angle), 0.0, radians(0.1));
+}
+
 // A photograph (tests/data/photos, stuff_lighter: the lighter turned by a known pose, scale 1.01)
 // with a third of the part hidden behind a flat plate, from each side in turn. Hidden from the
 // left, the plate's border pulled the free scale to 0.94 and the fit at the model's scale lay
