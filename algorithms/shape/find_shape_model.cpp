@@ -400,9 +400,15 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
         auto& out = tracked[static_cast<std::size_t>(i)];
         out[0] = refineOnLevel(search, c, 2);
         out[1].score = -1.0;
-        if (wideSteps > 1) {
-          const Candidate wide = refineOnLevel(search, c, 2, wideSteps);
-          if (!sameLevelPose(wide, out[0], search.level->angleStep)) out[1] = wide;
+        // Only around a candidate that holds on this level, and only for a peak that could
+        // still be chosen over the near one (as the finish does: within kClusterMargin).
+        if (wideSteps > 1 && out[0].score >= search.minScore) {
+          LevelSearch wideSearch = search;
+          wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);
+          const Candidate wide = refineOnLevel(wideSearch, c, 2, wideSteps);
+          if (wide.score >= wideSearch.minScore &&
+              !sameLevelPose(wide, out[0], search.level->angleStep))
+            out[1] = wide;
         }
       }
     };
