@@ -40,9 +40,7 @@ FacetCoefficients fit(const cv::Mat& image, cv::Point p, double scale) {
     for (int r = 0; r < 5; ++r) s += kP[3][r] * v[r];
     row3[j] = s;
   }
-  auto norm = [&](int sum, int i, int j) {
-    return static_cast<double>(sum) * scale / (kNorm[i] * kNorm[j]);
-  };
+  auto norm = [&](double sum, int i, int j) { return sum * scale / (kNorm[i] * kNorm[j]); };
   const IntegerProjections y0 = projectInteger(row[0]), y1 = projectInteger(row[1]),
                            y2 = projectInteger(row[2]);
   const double a00 = norm(y0.p0, 0, 0), a10 = norm(y1.p0, 1, 0), a01 = norm(y0.p1, 0, 1),
@@ -53,7 +51,7 @@ FacetCoefficients fit(const cv::Mat& image, cv::Point p, double scale) {
     s30 += kP[0][r] * row3[r];
     s03 += kP[3][r] * static_cast<double>(row[0][r]);
   }
-  const double a30 = s30 * scale / (kNorm[3] * kNorm[0]), a03 = s03 * scale / (kNorm[0] * kNorm[3]);
+  const double a30 = norm(s30, 3, 0), a03 = norm(s03, 0, 3);
   // Expand P2 = r^2 - 2 and P3 = r^3 - 3.4 r into monomials.
   return {a00 - 2 * a20 - 2 * a02,
           a10 - 3.4 * a30 - 2 * a12,
