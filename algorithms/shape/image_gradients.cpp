@@ -9,6 +9,8 @@
 #include <opencv2/core/hal/intrin.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "algorithms/shape/zeroed_mat.hpp"
+
 namespace facet::shape_detail {
 
 cv::Mat toGreyFloat(const cv::Mat& image) {
@@ -114,9 +116,9 @@ void sobelRow(const cv::Mat& grey, int y, int x0, int x1, std::vector<int>& s, s
   }
 }
 
-// A search makes a field per pyramid level, and a zeroed 640x480 level 0 is 600 KB, though the
-// search computes only the tiles near its candidates. The thread keeps the fields of its last
-// searches instead; a new field of the same size clears only the tiles its predecessor computed.
+// A search makes a field per pyramid level, though it computes only the tiles near its
+// candidates. The thread keeps the fields of its last searches; a new field of the same size
+// clears only the tiles its predecessor computed.
 struct FieldBuffers {
   cv::Mat field, done;
 };
@@ -156,7 +158,7 @@ DirectionField::DirectionField(cv::Mat grey, double minContrast)
     done_.setTo(cv::Scalar::all(0));
     return;
   }
-  field_ = cv::Mat(grey_.size(), CV_8SC2, cv::Scalar(0, 0));
+  field_ = zeroedMat(grey_.size(), CV_8SC2);  // its pages touched only where computed
   done_ = cv::Mat(tiles, CV_8U, cv::Scalar(0));
 }
 

@@ -14,6 +14,7 @@
 #include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/response_sums.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
+#include "algorithms/shape/zeroed_mat.hpp"
 
 namespace facet::shape_detail {
 namespace {
@@ -87,6 +88,54 @@ const TemplateSet& templateSet(const std::vector<ShapePoint>& points,
   return kept.back();
 }
 
+// The top level's response maps: one plane per orientation bin, in each the image's pixels
+// inside a border, zero where the image has no direction. The thread keeps its buffer all zero
+// between searches: a search clears the columns it wrote on each row, not the whole buffer,
+// whose pages then stay mapped, and those it never wrote are never touched (a fresh page costs a
+// fault on its first touch, zeroed_mat.hpp). Buffers above kKeptBytes are the search's own.
+class MapPlanes {
+ public:
+  MapPlanes(std::ptrdiff_t plane, int stride, int border, cv::Size image)
+      : plane_(plane), stride_(stride), border_(border), written_(image.height, cv::Range(0, 0)) {
+    constexpr std::size_t kKeptBytes = std::size_t{64} << 20;
+    thread_local cv::Mat kept;
+    const auto bytes = static_cast<std::size_t>(plane) * kBins;
+    if (bytes > kKeptBytes) {
+      own_ = zeroedMat({static_cast<int>(plane), kBins}, CV_8S);
+      data_ = own_.ptr<std::int8_t>();
+      return;
+    }
+    if (kept.total() < bytes) kept = zeroedMat({static_cast<int>(plane), kBins}, CV_8S);
+    data_ = kept.ptr<std::int8_t>();
+  }
+  ~MapPlanes() {
+    if (!own_.empty()) return;
+    for (std::size_t y = 0; y < written_.size(); ++y) {
+      const cv::Range cols = written_[y];
+      if (cols.empty()) continue;
+      for (int b = 0; b < kBins; ++b)
+        std::memset(row(b, static_cast<int>(y)) + cols.start, 0, static_cast<size_t>(cols.size()));
+    }
+  }
+  MapPlanes(const MapPlanes&) = delete;
+  MapPlanes& operator=(const MapPlanes&) = delete;
+
+  [[nodiscard]] std::int8_t* data() const { return data_; }
+  // Image row y of bin b's plane.
+  [[nodiscard]] std::int8_t* row(int b, int y) const {
+    return data_ + b * plane_ + static_cast<std::ptrdiff_t>(y + border_) * stride_ + border_;
+  }
+  // Columns [cols.start, cols.end) of image row y hold values now (in every plane).
+  void wrote(int y, cv::Range cols) { written_[static_cast<std::size_t>(y)] = cols; }
+
+ private:
+  std::ptrdiff_t plane_;
+  int stride_, border_;
+  std::vector<cv::Range> written_;
+  cv::Mat own_;
+  std::int8_t* data_ = nullptr;
+};
+
 }  // namespace
 
 std::vector<Candidate> searchTopLevel(const cv::Mat& field,
@@ -115,7 +164,8 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   const bool local = polarity == Polarity::IgnoreLocal;
 
   // 8-bit maps (half the memory the sums read), widened as they are added.
-  std::vector<std::int8_t> maps(static_cast<std::size_t>(plane) * kBins, 0);
+  MapPlanes planes(plane, stride, border, {w, h});
+  std::int8_t* const maps = planes.data();
   std::array<float, kBins> cosB{}, sinB{};
   for (int b = 0; b < kBins; ++b) {
     cosB[b] = static_cast<float>(std::cos(b * kTwoPi / kBins));
@@ -140,8 +190,10 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
     for (int y = y0; y < y1; ++y) {
       const auto* row = field.ptr<Direction>(y);
       const std::ptrdiff_t base = static_cast<std::ptrdiff_t>(y + border) * stride + border;
+      int first = w, end = 0;  // the columns written
       for (int x = 0; x < w; ++x) {
         if (row[x][0] == 0 && row[x][1] == 0) continue;
+        first = std::min(first, x), end = x + 1;
         for (int b = 0; b < kBins; ++b) {
           float v = row[x][0] * cosB[b] + row[x][1] * sinB[b];
           if (local) v = std::abs(v);
@@ -152,6 +204,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
               static_cast<std::int8_t>(std::min(cvRound(v), 127));
         }
       }
+      if (end > first) planes.wrote(y, {first, end});
     }
   });
   // The square a point's best response is taken from (spread > 0).
@@ -161,9 +214,10 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   if (spread > 0) {
     // The best response within `spread` of each pixel, per orientation: a maximum filter over the
     // image (a point outside it scores 0, as at spread 0). OpenCV dilates unsigned bytes;
-    // flipping the sign bit maps -128..127 onto 0..255 in order.
+    // flipping the sign bit maps -128..127 onto 0..255 in order. It writes every pixel.
+    for (int y = 0; y < h; ++y) planes.wrote(y, {0, w});
     for (int b = 0; b < kBins; ++b) {
-      cv::Mat map(h + 2 * border, stride, CV_8U, maps.data() + static_cast<std::size_t>(b * plane));
+      cv::Mat map(h + 2 * border, stride, CV_8U, maps + static_cast<std::size_t>(b * plane));
       cv::Mat inImage = map(cv::Rect(border, border, w, h));
       cv::bitwise_xor(inImage, cv::Scalar(0x80), inImage);
       cv::dilate(inImage, inImage, spreadSquare, {-1, -1}, 1,
@@ -232,8 +286,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   auto work = [&](int y0, int y1) {
     alignas(16) std::int16_t sums[kSumBlock];
     for (int y = y0; y < y1; ++y) {
-      const std::int8_t* row =
-          maps.data() + static_cast<std::ptrdiff_t>(y + border) * stride + border;
+      const std::int8_t* row = maps + static_cast<std::ptrdiff_t>(y + border) * stride + border;
       std::int16_t* bestRow = best.data() + static_cast<std::size_t>(y) * paddedW;
       std::int32_t* bestIdx = bestTemplate.data() + static_cast<std::size_t>(y) * paddedW;
       for (int x0 = 0; x0 < paddedW; x0 += blockW) {

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <thread>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
@@ -157,6 +158,49 @@ TEST(TopLevelSearch, AnAlignedDirectionLongerThan127DoesNotWrap) {
       shape_detail::searchTopLevel(field, points, {0.0}, {1.0}, Polarity::Use, 0, 0.9, 1, 10);
   ASSERT_FALSE(candidates.empty());
   EXPECT_NEAR(candidates.front().score, 1.0, 1e-12);
+}
+
+// The thread keeps its response maps from search to search and clears only what a search wrote:
+// whatever came before, a search's candidates are those of a thread that never searched.
+TEST(TopLevelSearch, ASearchSeesNothingOfTheThreadsEarlierSearches) {
+  const ShapeModel model = createShapeModel(testing::bracketTemplate());
+  const int top = model.numLevels() - 1;
+  const std::vector<ShapePoint>& points = model.levels[top].points;
+  const auto topField = [&](const cv::Mat& scene) {
+    cv::Mat grey = scene;
+    for (int l = 0; l < top; ++l) cv::pyrDown(grey, grey);
+    shape_detail::DirectionField directions(grey, model.minContrast);
+    directions.ensureAll();
+    return directions.directions().clone();
+  };
+  const cv::Mat busy = topField(testing::bracketScene(
+      {640, 480}, {{300, 220, 0.4, 1.0}, {150, 330, -2.0, 1.0}, {480, 120, 2.5, 1.0}}));
+  const cv::Mat blank(busy.size(), busy.type(), cv::Scalar::all(0));
+  // Smaller, with the parts elsewhere: the earlier maps' layout does not fit it.
+  const cv::Mat other = topField(testing::bracketScene({480, 400}, {{200, 180, 1.0, 1.0}}));
+  std::vector<double> angles;
+  for (int k = 0; k < 24; ++k) angles.push_back(k * kTwoPi / 24);
+  for (const int spread : {0, 2}) {
+    const auto search = [&](const cv::Mat& field) {
+      return shape_detail::searchTopLevel(field, points, angles, {1.0}, Polarity::Use, spread, 0.3,
+                                          1, 1000);
+    };
+    std::vector<Candidate> fresh;
+    std::thread([&] { fresh = search(other); }).join();
+    ASSERT_FALSE(fresh.empty());
+
+    ASSERT_FALSE(search(busy).empty());
+    EXPECT_TRUE(search(blank).empty()) << "spread " << spread;
+    (void)search(busy);
+    const std::vector<Candidate> after = search(other);
+    ASSERT_EQ(after.size(), fresh.size()) << "spread " << spread;
+    for (std::size_t i = 0; i < after.size(); ++i) {
+      EXPECT_EQ(after[i].x, fresh[i].x);
+      EXPECT_EQ(after[i].y, fresh[i].y);
+      EXPECT_EQ(after[i].angle, fresh[i].angle);
+      EXPECT_EQ(after[i].score, fresh[i].score);
+    }
+  }
 }
 
 }  // namespace
