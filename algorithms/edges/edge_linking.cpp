@@ -8,7 +8,8 @@ namespace facet {
 namespace {
 
 // Points come in raster order of their pixels (detectSubpixelEdges scans row by row); an index
-// of where each row starts finds a pixel's point by a short search within its row. Any other
+// of where each row starts finds a pixel's point by a binary search within its row (a row of a
+// large image holds hundreds of points, and linking looks up 8 neighbours per point). Any other
 // order is sorted first.
 struct PixelIndex {
   int firstRow = 0;
@@ -34,12 +35,10 @@ struct PixelIndex {
   int find(cv::Point p) const {
     const int r = p.y - firstRow;
     if (r < 0 || r + 1 >= static_cast<int>(rowStart.size())) return -1;
-    for (int k = rowStart[r]; k < rowStart[r + 1]; ++k) {
-      const int x = (*pixels)[order[k]].x;
-      if (x == p.x) return order[k];
-      if (x > p.x) break;
-    }
-    return -1;
+    const auto first = order.begin() + rowStart[r], last = order.begin() + rowStart[r + 1];
+    const auto it =
+        std::lower_bound(first, last, p.x, [&](int i, int x) { return (*pixels)[i].x < x; });
+    return it != last && (*pixels)[*it].x == p.x ? *it : -1;
   }
 };
 
