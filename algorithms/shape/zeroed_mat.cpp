@@ -38,9 +38,10 @@ class ZeroedAllocator : public cv::MatAllocator {
 }  // namespace
 
 cv::Mat zeroedMat(cv::Size size, int type) {
-  static ZeroedAllocator allocator;
+  // Never destroyed: threads' kept buffers may outlive the statics at exit and still free.
+  static ZeroedAllocator* const allocator = new ZeroedAllocator;
   cv::Mat m;
-  m.allocator = &allocator;
+  m.allocator = allocator;
   m.create(size, type);
   return m;
 }
