@@ -61,6 +61,21 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
     throw std::invalid_argument(
         "detectSubpixelEdges: the mask must be CV_8UC1 of the image's or the ROI's size");
 
+  const bool fitMaskOfRoi = !params.fitMask.empty() && !params.roi.empty() &&
+                            params.fitMask.size() == params.roi.size() &&
+                            params.fitMask.size() != image.size();
+  if (!params.fitMask.empty() && ((!fitMaskOfRoi && params.fitMask.size() != image.size()) ||
+                                  params.fitMask.type() != CV_8UC1))
+    throw std::invalid_argument(
+        "detectSubpixelEdges: the fit mask must be CV_8UC1 of the image's or the ROI's size");
+  const cv::Point fitMaskOrigin = fitMaskOfRoi ? params.roi.tl() : cv::Point();
+  const auto fitsAt = [&](cv::Point pixel) {
+    if (params.fitMask.empty()) return true;
+    const cv::Point q = pixel - fitMaskOrigin;
+    return q.x >= 0 && q.y >= 0 && q.x < params.fitMask.cols && q.y < params.fitMask.rows &&
+           params.fitMask.at<uchar>(q) != 0;
+  };
+
   const cv::Rect full(0, 0, image.cols, image.rows);
   const cv::Rect roi = params.roi.empty() ? full : (params.roi & full);
   if (roi.empty()) return result;
@@ -150,7 +165,7 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
     // little on tight curves.
     if (!crossesInsidePixel(point, s.pixel)) continue;
     double bias = 0;
-    if (params.fitProfile && fitArea.contains(s.pixel)) {
+    if (params.fitProfile && fitArea.contains(s.pixel) && fitsAt(s.pixel)) {
       EdgeProfileParams local = profile;
       local.halfAlong = profileHalfAlong(curvatures[i], profile);
       const auto refined = fitEdgeProfile(image, s.pixel, s.normal, s.offset, local);

@@ -45,6 +45,12 @@ struct EdgeParams {
   // edge. Off gives the plain facet zero crossings. Points closer than 5 px to the image border
   // keep their facet position.
   bool fitProfile = true;
+  // Optional 8-bit mask of the image's or of `roi`'s size (like `mask`): only points whose pixel
+  // is non-zero there are refined by the profile fit; the others keep their facet position. The
+  // blur is still estimated from all the edges, so the points fitted are the same as without it
+  // (up to the curvature correction of points within 8 points along a contour of an unfitted
+  // one). For a caller that needs precise points only in part of the region (shape refinement).
+  cv::Mat fitMask;
   // Where the blur acts, for the profile fit: true = on the sampled image (a blur filter run
   // after sampling), false = before pixel integration (a lens). Unset (default): chosen per image
   // from the edges' profiles (estimateEdgeBlur), so neither has to be known.

@@ -233,7 +233,12 @@ struct Finisher {
         interpolated.score < params.minScore - kSkipRefinement)
       return interpolated;
     const cv::Rect roi = placedBox(box, start).boundingRect() + cv::Size(8, 8) - cv::Point(4, 4);
-    const shape_detail::LeastSquaresRefinement refinement(image, model, roi, params.polarity);
+    // A fit may change the scale by the tolerance, or with a scale range by about its step.
+    const double scaleFreedom =
+        scaleRange ? std::max(params.refineScaleTolerance, 2.0 * model.levels[0].scaleStep)
+                   : params.refineScaleTolerance;
+    const shape_detail::LeastSquaresRefinement refinement(image, model, roi, params.polarity, start,
+                                                          scaleFreedom);
     const auto [r, fittedFully] = refineFrom(refinement, start);
     // A refinement that wanders off by more than the search's own uncertainty has locked onto
     // something else.

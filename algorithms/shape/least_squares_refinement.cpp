@@ -5,19 +5,58 @@
 #include <vector>
 
 #include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
 
 namespace facet::shape_detail {
 
 namespace {
 constexpr double kMinCos = 0.8;  // direction agreement of a correspondence (about 37 degrees)
+// The profile fit is most of a refinement's edge detection, and a large template's region holds
+// many edges far from its contour (texture, other parts) that no fit ever pairs: a model point is
+// paired within 3 px of where the pose places it, a fit that moves the part 3 px or more is
+// refused (find_shape_model.cpp), and a point's curvature correction reads 8 points either side
+// along its contour. So only edges within this many pixels of the contour placed at the start are
+// fitted, plus what the largest scale change a fit may make moves the farthest points. A
+// bracket's whole region lies in that band; a 1126x973 template's region does not.
+constexpr int kBandPixels = 16;
 }  // namespace
 
+cv::Mat LeastSquaresRefinement::contourBand(const Pose2D& start, double scaleFreedom) const {
+  double reach = 0.0;
+  for (const auto& mp : model_.finePoints)
+    reach = std::max(reach, std::hypot(double(mp.position.x), double(mp.position.y)));
+  const int r = kBandPixels + static_cast<int>(std::ceil(scaleFreedom * reach * start.scale));
+  // Cells of r x r pixels: a pixel within r of a point lies in the point's cell or a neighbour,
+  // so the cells next to those holding points cover the band (and a little more), at the cost
+  // of marking them (a dilation of the region by 2r + 1 cost a refinement 3%).
+  const cv::Size cells((roi_.width + r - 1) / r, (roi_.height + r - 1) / r);
+  cv::Mat held(cells, CV_8U, cv::Scalar(0));
+  const Pose2D::Map toImage = start.map();
+  for (const auto& mp : model_.finePoints) {
+    const cv::Point2d q = toImage({mp.position.x, mp.position.y});
+    const int cx = static_cast<int>(std::floor((q.x - roi_.x) / r));
+    const int cy = static_cast<int>(std::floor((q.y - roi_.y) / r));
+    if (cx >= 0 && cy >= 0 && cx < cells.width && cy < cells.height) held.at<uchar>(cy, cx) = 1;
+  }
+  cv::dilate(held, held, cv::Mat());  // and their neighbours (3x3)
+  // Where the band is most of the region (a bracket's), the mask would save less than it costs.
+  if (4 * cv::countNonZero(held) >= 3 * static_cast<int>(held.total())) return {};
+  cv::Mat band(roi_.size(), CV_8U, cv::Scalar(0));
+  for (int y = 0; y < cells.height; ++y)
+    for (int x = 0; x < cells.width; ++x)
+      if (held.at<uchar>(y, x))
+        band(cv::Rect(x * r, y * r, r, r) & cv::Rect(0, 0, roi_.width, roi_.height)).setTo(255);
+  return band;
+}
+
 LeastSquaresRefinement::LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model,
-                                               cv::Rect roi, Polarity polarity)
+                                               cv::Rect roi, Polarity polarity, const Pose2D& start,
+                                               double scaleFreedom)
     : model_(model), polarity_(polarity), roi_(roi & cv::Rect(0, 0, image.cols, image.rows)) {
   if (roi_.width < 3 || roi_.height < 3) return;
   EdgeParams edgeParams;
   edgeParams.roi = roi_;
+  edgeParams.fitMask = contourBand(start, scaleFreedom);
   edgeParams.low = model.minContrast;
   edgeParams.high = std::max(2.0 * model.minContrast, 0.5 * model.contrastHigh);
   edgeParams.fitProfile = model.edgeEstimator == EdgeEstimator::ProfileFit;

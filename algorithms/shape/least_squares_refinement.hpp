@@ -58,9 +58,14 @@ struct Refined {
 // from there (with the scale free and at the model's scale).
 class LeastSquaresRefinement {
  public:
-  // `roi`: image pixels, clipped to the image.
+  // `roi`: image pixels, clipped to the image. `start`: the pose the refinements start from;
+  // `scaleFreedom`: the largest relative scale change they may make. Only the edges near the
+  // model's contour placed there get the profile fit (contourBand).
   LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model, cv::Rect roi,
-                         Polarity polarity);
+                         Polarity polarity, const Pose2D& start, double scaleFreedom);
+  // only the edges near the model's contour there get the profile fit (contourBand).
+  LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model, cv::Rect roi,
+                         Polarity polarity, const Pose2D& start);
 
   // `visible`: one entry per fine point, 0 for a point that takes no part; empty: every point.
   Refined refine(Pose2D start, bool withScale, const std::vector<std::uint8_t>& visible = {}) const;
@@ -76,6 +81,9 @@ class LeastSquaresRefinement {
   };
   // Each model point placed at `at` paired with the nearest direction-agreeing edge point within
   // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
+  // The roi's pixels near the model's contour placed at `start` (CV_8U, non-zero), see the .cpp;
+  // empty where that is most of the roi.
+  [[nodiscard]] cv::Mat contourBand(const Pose2D& start, double scaleFreedom) const;
   double correspond(const Pose2D& at, int radius, bool anySign, double sign,
                     std::vector<Pair>& pairs, const std::vector<std::uint8_t>& visible = {}) const;
   double support(const Pose2D& at, double sign, double cutoff) const;

@@ -189,6 +189,55 @@ TEST(SubpixelEdges, RoiAndMaskRestrictThePoints) {
   EXPECT_THROW(detectSubpixelEdges(image, badMask), std::invalid_argument);
 }
 
+// The fit mask chooses which points get the profile fit, not which are found: the same points,
+// those under the mask as fitted without it (the blur is estimated from all edges either way),
+// the others at their facet zero crossing.
+TEST(SubpixelEdges, FitMaskLeavesPointsOutsideItAtTheirFacetPosition) {
+  SceneSpec spec;
+  spec.size = {160, 120};
+  spec.blurSigma = 1.0;
+  spec.noiseSigma = 1.0;
+  Scene scene(spec);
+  scene.addDisc({50.3, 60.2}, 25, 160);
+  scene.addDisc({115.6, 58.9}, 25, 160);
+  const cv::Mat image = scene.render();
+  const cv::Rect box(10, 10, 140, 100);
+
+  EdgeParams fitted, facetOnly, half;
+  fitted.roi = facetOnly.roi = half.roi = box;
+  facetOnly.fitProfile = false;
+  half.fitMask = cv::Mat::zeros(box.size(), CV_8U);  // of the ROI's size: the left disc's side
+  half.fitMask(cv::Rect(0, 0, 70, 100)).setTo(255);
+  const EdgeContours all = detectSubpixelEdges(image, fitted);
+  const EdgeContours none = detectSubpixelEdges(image, facetOnly);
+  const EdgeContours mixed = detectSubpixelEdges(image, half);
+  EXPECT_EQ(mixed.blurSigma, all.blurSigma);
+  ASSERT_GT(mixed.points.size(), 200u);
+  // Points are matched by their pixel; a point's curvature correction reads 8 points along its
+  // contour, so the discs' points (each disc on one side of x = 80) are compared whole.
+  const auto at = [](const EdgeContours& e, cv::Point2d near) -> const EdgePoint* {
+    for (const auto& p : e.points)
+      if (cvRound(p.position.x) == cvRound(near.x) && cvRound(p.position.y) == cvRound(near.y))
+        return &p;
+    return nullptr;
+  };
+  int left = 0, right = 0;
+  for (const EdgePoint& p : mixed.points) {
+    const EdgePoint* reference = at(p.position.x < 80 ? all : none, p.position);
+    ASSERT_NE(reference, nullptr) << p.position;
+    EXPECT_EQ(p.position, reference->position);
+    ++(p.position.x < 80 ? left : right);
+  }
+  EXPECT_GT(left, 100);
+  EXPECT_GT(right, 100);
+
+  EdgeParams badMask;
+  badMask.fitMask = cv::Mat::zeros(10, 10, CV_8U);
+  EXPECT_THROW(detectSubpixelEdges(image, badMask), std::invalid_argument);
+  badMask.fitMask = cv::Mat::zeros(image.size(), CV_32F);
+  EXPECT_THROW(detectSubpixelEdges(image, badMask), std::invalid_argument);
+}
+
 TEST(AutoThresholds, ScaleWithContrastAndFindTheEdge) {
   double previousHigh = 0;
   for (double contrast : {30.0, 90.0, 180.0}) {
