@@ -63,9 +63,6 @@ class LeastSquaresRefinement {
   // model's contour placed there get the profile fit (contourBand).
   LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model, cv::Rect roi,
                          Polarity polarity, const Pose2D& start, double scaleFreedom);
-  // only the edges near the model's contour there get the profile fit (contourBand).
-  LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model, cv::Rect roi,
-                         Polarity polarity, const Pose2D& start);
 
   // `visible`: one entry per fine point, 0 for a point that takes no part; empty: every point.
   Refined refine(Pose2D start, bool withScale, const std::vector<std::uint8_t>& visible = {}) const;
@@ -79,11 +76,11 @@ class LeastSquaresRefinement {
     Eigen::Vector4d J;
     double r;
   };
-  // Each model point placed at `at` paired with the nearest direction-agreeing edge point within
-  // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
   // The roi's pixels near the model's contour placed at `start` (CV_8U, non-zero), see the .cpp;
   // empty where that is most of the roi.
   [[nodiscard]] cv::Mat contourBand(const Pose2D& start, double scaleFreedom) const;
+  // Each model point placed at `at` paired with the nearest direction-agreeing edge point within
+  // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
   double correspond(const Pose2D& at, int radius, bool anySign, double sign,
                     std::vector<Pair>& pairs, const std::vector<std::uint8_t>& visible = {}) const;
   double support(const Pose2D& at, double sign, double cutoff) const;
