@@ -4,6 +4,7 @@
 #include <cmath>
 #include <optional>
 #include <stdexcept>
+#include <string>
 
 #include "algorithms/edges/auto_thresholds.hpp"
 #include "algorithms/edges/canny.hpp"
@@ -44,6 +45,17 @@ void dropPointsOutsideTheirPixel(EdgeContours& result, const std::vector<cv::Poi
   std::erase_if(result.contours, [](const std::vector<int>& c) { return c.empty(); });
 }
 
+// Whether a mask is given for the ROI rather than for the whole image; refuses any other size
+// or type, naming the mask.
+bool maskCoversRoi(const cv::Mat& mask, const cv::Rect& roi, cv::Size imageSize, const char* name) {
+  if (mask.empty()) return false;
+  const bool ofRoi = !roi.empty() && mask.size() == roi.size() && mask.size() != imageSize;
+  if ((!ofRoi && mask.size() != imageSize) || mask.type() != CV_8UC1)
+    throw std::invalid_argument(std::string("detectSubpixelEdges: the ") + name +
+                                " must be CV_8UC1 of the image's or the ROI's size");
+  return ofRoi;
+}
+
 }  // namespace
 
 EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params) {
@@ -53,21 +65,8 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
     throw std::invalid_argument(
         "detectSubpixelEdges: expected an 8-bit or 16-bit single-channel image, got " +
         cv::typeToString(image.type()));
-  const bool maskOfRoi = !params.mask.empty() && !params.roi.empty() &&
-                         params.mask.size() == params.roi.size() &&
-                         params.mask.size() != image.size();
-  if (!params.mask.empty() &&
-      ((!maskOfRoi && params.mask.size() != image.size()) || params.mask.type() != CV_8UC1))
-    throw std::invalid_argument(
-        "detectSubpixelEdges: the mask must be CV_8UC1 of the image's or the ROI's size");
-
-  const bool fitMaskOfRoi = !params.fitMask.empty() && !params.roi.empty() &&
-                            params.fitMask.size() == params.roi.size() &&
-                            params.fitMask.size() != image.size();
-  if (!params.fitMask.empty() && ((!fitMaskOfRoi && params.fitMask.size() != image.size()) ||
-                                  params.fitMask.type() != CV_8UC1))
-    throw std::invalid_argument(
-        "detectSubpixelEdges: the fit mask must be CV_8UC1 of the image's or the ROI's size");
+  const bool maskOfRoi = maskCoversRoi(params.mask, params.roi, image.size(), "mask");
+  const bool fitMaskOfRoi = maskCoversRoi(params.fitMask, params.roi, image.size(), "fit mask");
   const cv::Point fitMaskOrigin = fitMaskOfRoi ? params.roi.tl() : cv::Point();
   const auto fitsAt = [&](cv::Point pixel) {
     if (params.fitMask.empty()) return true;
