@@ -81,7 +81,8 @@ struct Outcome {
   int matches = 0, correct = 0, inliers = 0;
   double cornerError = 1e9, ms = 0;
   bool ok = false;
-  std::string stage;  // facet: the stage whose result counts ("+" = after the plain one)
+  std::string stage;    // facet: the stage whose result counts ("+" = after the plain one)
+  std::string failure;  // facet: why no transform was found
 };
 
 Outcome runOurs(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth,
@@ -97,6 +98,8 @@ Outcome runOurs(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth,
   }
   o.ok = r.status.ok();
   o.stage = r.stage + (r.escalated ? "+" : "");
+  if (!r.status.ok())
+    o.failure = std::string(facet::toString(r.status.cause)) + ": " + r.status.message;
   if (r.status.ok()) {
     o.inliers = static_cast<int>(r.inliers.size());
     o.cornerError = cornerError(r.H, truth, a.size());
@@ -337,6 +340,7 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
                   name.c_str(), w.name, ours.correct, ours.inliers, ours.ok ? ours.cornerError : -1,
                   ours.ms, ours.stage.c_str(), sift.correct, sift.inliers,
                   sift.ok ? sift.cornerError : -1, sift.ms, good ? "met" : "MISSED");
+      if (!ours.ok) std::printf("  facet found no transform: %s\n", ours.failure.c_str());
     }
   }
   std::printf(
