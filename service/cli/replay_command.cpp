@@ -23,6 +23,7 @@
 #include "service/daemon/replay_report.hpp"
 #include "service/engine/inspect_part.hpp"
 #include "service/engine/overlay.hpp"
+#include "service/engine/warm_up.hpp"
 
 namespace facet::cli {
 namespace {
@@ -120,6 +121,8 @@ void runReplay(const ReplayOptions& opt, const config::StepKindRegistry& kinds) 
   report.imagesFolder = opt.imagesFolder;
   report.mmPerPixel = mmPerPixel;
   report.generatedAt = utcNow();
+  // The report's times are those of a running station, which warms up before its first part.
+  service::warmUp(*recipe);
   for (std::uint64_t partId = 1;; ++partId) {
     auto grab = camera->grab(std::chrono::milliseconds(5000));
     if (grab.status == GrabStatus::EndOfStream) break;

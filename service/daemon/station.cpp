@@ -7,6 +7,7 @@
 #include "camera/camera_factory.hpp"
 #include "service/daemon/part_origin.hpp"
 #include "service/daemon/recorded_scans.hpp"
+#include "service/engine/warm_up.hpp"
 
 namespace facet::service {
 
@@ -83,13 +84,14 @@ void Station::start() {
   if (plc_) {
     plc_->link().start();
     plc_->link().setActiveRecipe(recipes_.active()->recipe().id);
-    plc_->link().setReady(true);
   }
   const auto beat = nowTicks();
   acquisitionBeat_ = beat;
   inspectionBeat_ = beat;
-  acquisition_ = std::thread([this] { acquisitionLoop(); });
   inspection_ = std::thread([this] { inspectionLoop(); });
+  warmedUp_.wait();  // the PLC sees the station ready once the first part costs no more
+  if (plc_) plc_->link().setReady(true);
+  acquisition_ = std::thread([this] { acquisitionLoop(); });
   publishing_ = std::thread([this] { publishingLoop(); });
   spdlog::info("station {} running: camera {}, recipe {} '{}', PLC {}", config_.name,
                camera_->name(), recipes_.active()->recipe().id, recipes_.active()->recipe().name,
@@ -249,6 +251,14 @@ bool Station::acquireScan(Job& job) {
 }
 
 void Station::inspectionLoop() {
+  {
+    const auto recipe = recipes_.active();
+    const auto t0 = Clock::now();
+    if (const auto outcome = warmUp(*recipe))
+      spdlog::info("recipe {}: warmed up on its picture of the part in {:.1f} ms ({})",
+                   recipe->recipe().id, msSince(t0), verdictName(outcome->verdict));
+    warmedUp_.count_down();
+  }
   while (true) {
     inspectionBeat_ = nowTicks();
     auto job = inspectQueue_.pop(100ms);

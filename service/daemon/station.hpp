@@ -3,7 +3,9 @@
 //
 //   acquisition  waits for a trigger (PLC) or free-runs, grabs a frame, has the recipe selector
 //                choose the part's recipe (only here, so a switch happens between two parts)
-//   inspection   runs the recipe on the frame (inspectPart, service/engine/)
+//   inspection   runs the recipe on the frame (inspectPart, service/engine/); before the first
+//                part, once on the active recipe's picture of the part (warmUp), and only then
+//                does the PLC see the station ready
 //   publishing   PLC registers (PlcPublisher), results store, image archive, metrics, last
 //                result for HTTP (station_view.cpp)
 //
@@ -17,6 +19,7 @@
 #include <chrono>
 #include <deque>
 #include <functional>
+#include <latch>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -159,6 +162,8 @@ class Station : public StationView {
   std::atomic<std::uint64_t> partsTaken_{0};
   std::atomic<std::int64_t> acquisitionBeat_{0}, inspectionBeat_{0};
   std::thread acquisition_, inspection_, publishing_;
+  // The inspection thread has run the active recipe once (warmUp), before the first part.
+  std::latch warmedUp_{1};
 
   mutable std::mutex recentMutex_;
   std::deque<PartResult> recent_;

@@ -1,6 +1,6 @@
 // The inspection engine on generated parts, through a recipe file as the line writes it:
 // alignment by shape, holes measured relative to it, a distance between two holes; checks,
-// verdicts and failure causes. And what prepareRecipe() refuses.
+// verdicts and failure causes. What prepareRecipe() refuses, and the warm-up before a first part.
 #include <filesystem>
 #include <fstream>
 
@@ -13,6 +13,7 @@
 #include "config/recipe_loader.hpp"
 #include "service/engine/builtin_steps.hpp"
 #include "service/engine/inspect_part.hpp"
+#include "service/engine/warm_up.hpp"
 #include "tests/support/scene/parts.hpp"
 
 namespace facet::service {
@@ -169,6 +170,24 @@ TEST_F(InspectionTest, EmptyImageIsAnErrorNeverAPass) {
   const auto out = inspect(cv::Mat());
   EXPECT_EQ(out.verdict, Verdict::Error);
   EXPECT_NE(out.error.find("empty image"), std::string::npos);
+}
+
+// The warm-up inspects the align step's reference picture, bordered: the taught part, so every
+// step finds what it measures, relative steps included (the template is drawn without blur, so
+// a check may still fail). A recipe without a picture gets none.
+TEST_F(InspectionTest, WarmUpInspectsTheReferencePictureWithEveryStep) {
+  const auto out = warmUp(*recipe_);
+  ASSERT_TRUE(out.has_value());
+  ASSERT_NE(out->verdict, Verdict::Error) << out->error;
+  for (const auto& failed : out->failedChecks)
+    EXPECT_EQ(failed.find(": "), std::string::npos) << "a step failed: " << failed;
+  EXPECT_EQ(out->timings.size(), 4u);
+  EXPECT_NEAR(value(*out, "big_hole.diameter").value, 1.0, 0.03);
+  EXPECT_NEAR(value(*out, "small_hole.diameter").value, 0.7, 0.03);
+
+  PreparedRecipe none;
+  none.loaded = std::make_shared<const config::Recipe>();
+  EXPECT_FALSE(warmUp(none).has_value());
 }
 
 TEST_F(InspectionTest, MissingModelIsReportedWhenTheRecipeIsLoaded) {

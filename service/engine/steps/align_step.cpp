@@ -99,6 +99,13 @@ std::vector<config::TrainedModel> AlignStep::train(const config::Step& step) con
   return {trainShapeModel(step, trainingOf(a))};
 }
 
+cv::Mat AlignStep::pictureOfPart(const config::Step& step) const {
+  if (!step.resources) return {};
+  if (step.as<AlignParams>().method == AlignParams::Method::Shape)
+    return step.resourcesAs<ShapeModelResource>().templateGrey;
+  return step.resourcesAs<ReferenceImage>().grey;
+}
+
 StepResult AlignStep::run(const config::Step& step, StepContext& part) const {
   const auto& a = step.as<AlignParams>();
   const cv::Rect search = clampRect(a.searchRegion, part.grey.size());

@@ -29,6 +29,7 @@ class AlignStep : public TableStep<AlignParams> {
       const config::Step& step, config::StepReading& in) const override;
   [[nodiscard]] std::vector<config::TrainedModel> train(const config::Step& step) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
+  [[nodiscard]] cv::Mat pictureOfPart(const config::Step& step) const override;
 
  private:
   void crossCheck(const AlignParams& params, config::StepReading& in) const override;

@@ -81,6 +81,7 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
       training.region ? cv::Point2d(cvRound(training.region->x), cvRound(training.region->y))
                       : cv::Point2d();
   resource->home = resource->model.referencePoint + offset;
+  resource->templateGrey = toGrey(image);
   return resource;
 }
 

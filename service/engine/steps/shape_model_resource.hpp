@@ -21,7 +21,8 @@ namespace facet::service {
 
 struct ShapeModelResource : config::StepResources {
   ShapeModel model;
-  cv::Point2d home;  // the model's reference point in its template image: the nominal position
+  cv::Point2d home;      // the model's reference point in its template image: the nominal position
+  cv::Mat templateGrey;  // the template image, grey: a picture of the part (warmUp)
 };
 
 // What a shape model is trained from: the template image, the part of it, the angles searched.
