@@ -19,6 +19,8 @@
 //               and of the label (alignment, shape match; no rotation search), cv::HoughCircles
 //               in the two bore windows (circles)
 //
+//   first parts inspection time of the first 3 parts of a process, with and without the warm-up
+//               the station runs before its first part (service/engine/warm_up.hpp)
 //   frames      PNG as recorded (default), or binary PGM with --pgm (raw pixels, no decoding)
 //
 //   bench_daemon [--smoke] [--pgm] [--parts N] [--triggers N]
@@ -333,6 +335,47 @@ struct FreeRun {
   std::map<std::string, int> verdicts;  // written by the publishing thread only
 };
 
+// The first parts of a process: a station started in a new process (`bench_daemon --first-parts
+// DIR EXT warm|cold`, spawned by firstParts()) inspects kFirstParts frames and prints each
+// part's inspection time. A process is warm only once, so each run is a process of its own.
+constexpr int kFirstParts = 3;
+
+int firstPartsChild(const fs::path& dir, const std::string& extension, bool warmUp) {
+  auto station = loadStation(writeStation(dir, dir.parent_path() / "frames", 0, extension));
+  service::StationOptions options;
+  options.overflow = service::OverflowPolicy::Block;
+  options.maxParts = kFirstParts;
+  options.warmUp = warmUp;
+  std::vector<double> ms;
+  options.onPart = [&](const service::PartResult& p) { ms.push_back(p.inspectionMs); };
+  service::Station s(station, facetSteps(), options);
+  s.start();
+  s.join();
+  for (double m : ms) std::printf("%.3f\n", m);
+  return ms.size() == kFirstParts ? 0 : 1;
+}
+
+// Inspection ms of the first parts, one row per process.
+std::vector<std::vector<double>> firstParts(const std::string& self, const fs::path& dir,
+                                            const std::string& extension, bool warmUp,
+                                            int processes) {
+  std::vector<std::vector<double>> rows;
+  for (int i = 0; i < processes; ++i) {
+    const fs::path run = dir / ((warmUp ? "warm-" : "cold-") + std::to_string(i));
+    const std::string command = "'" + self + "' --first-parts '" + run.string() + "' " + extension +
+                                (warmUp ? " warm" : " cold");
+    FILE* out = ::popen(command.c_str(), "r");
+    if (!out) throw std::runtime_error("cannot run " + command);
+    std::vector<double> row;
+    double v = 0;
+    while (std::fscanf(out, "%lf", &v) == 1) row.push_back(v);
+    if (::pclose(out) != 0 || row.size() != kFirstParts)
+      throw std::runtime_error("first parts: " + command + " failed");
+    rows.push_back(row);
+  }
+  return rows;
+}
+
 FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, const std::string& extension,
                        int parts) {
   auto station = loadStation(writeStation(dir / "free", frames, 0, extension));
@@ -409,6 +452,10 @@ Baseline openCvBaseline(const std::vector<fs::path>& frames, int rounds) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (argc == 5 && std::string(argv[1]) == "--first-parts") {
+    spdlog::set_level(spdlog::level::err);
+    return firstPartsChild(argv[2], argv[3], std::string(argv[4]) == "warm");
+  }
   bool smoke = false, pgm = false;
   int parts = 20000, triggers = 500;
   for (int i = 1; i < argc; ++i) {
@@ -437,6 +484,10 @@ int main(int argc, char** argv) {
     const std::string loadBefore = loadAverage();
     const std::string extension = pgm ? ".pgm" : ".png";
     const auto frames = makeFrames(dir / "frames", extension);
+    const int processes = smoke ? 1 : 3;
+    const std::string self = fs::read_symlink("/proc/self/exe").string();
+    const auto cold = firstParts(self, dir, extension, false, processes);
+    const auto warm = firstParts(self, dir, extension, true, processes);
     const Latency latency = measureLatency(dir, dir / "frames", extension, triggers);
     FreeRun run = measureFreeRun(dir, dir / "frames", extension, parts);
     const Baseline cv = openCvBaseline(frames, smoke ? 1 : 5);
@@ -482,6 +533,21 @@ int main(int argc, char** argv) {
     // distance), so parts the sidecars call "fail" may pass here; errors must be 0.
     std::printf("  free-run verdicts: pass %d, fail %d, error %d\n\n", run.verdicts["pass"],
                 run.verdicts["fail"], run.verdicts["error"]);
+
+    std::printf(
+        "| first parts of a process, inspect ms (one process a row) | part 1 | part 2 | part 3 "
+        "|\n");
+    std::printf(
+        "| -------------------------------------------------------- | ------ | ------ | ------ "
+        "|\n");
+    for (const auto* rows : {&cold, &warm})
+      for (const auto& row : *rows)
+        std::printf("| %-56s | %6.2f | %6.2f | %6.2f |\n",
+                    rows == &cold ? "without warm-up (StationOptions::warmUp off)"
+                                  : "with warm-up (the default)",
+                    row[0], row[1], row[2]);
+    std::printf("(free-run mean inspect of the long run below: %.2f ms)\n\n",
+                run.split.stage("inspect"));
 
     const StageSplit& l = latency.split;
     const double lMean = mean(latency.ms);

@@ -254,7 +254,7 @@ void Station::inspectionLoop() {
   {
     const auto recipe = recipes_.active();
     const auto t0 = Clock::now();
-    if (const auto outcome = warmUp(*recipe))
+    if (const auto outcome = options_.warmUp ? warmUp(*recipe) : std::nullopt)
       spdlog::info("recipe {}: warmed up on its picture of the part in {:.1f} ms ({})",
                    recipe->recipe().id, msSince(t0), verdictName(outcome->verdict));
     warmedUp_.count_down();

@@ -53,6 +53,9 @@ struct StationOptions {
   std::uint64_t maxParts = 0;      // stop after this many parts (0 = run until stopped)
   bool stopAtEndOfStream = false;  // replay without loop: stop once every file was inspected
   bool usePlc = true;              // false: no PLC link even if configured (none if not)
+  // Run the active recipe once before the first part (service/engine/warm_up.hpp); off only to
+  // measure what that saves.
+  bool warmUp = true;
   std::function<void(const PartResult&)> onPart;  // called by the publishing stage, per part
 };
 

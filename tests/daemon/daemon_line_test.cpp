@@ -10,6 +10,7 @@
 #include <csignal>
 #include <filesystem>
 #include <sstream>
+#include <string>
 
 #include "tests/daemon/child_process.hpp"
 #include "tests/daemon/line_run.hpp"
@@ -148,10 +149,17 @@ TEST(DaemonLine, ReplayCameraAndPymodbusPlc) {
   PlcLine line;
   line.start("  backend: replay\n  replay:\n    folder: " + kDemo +
                  "\n    glob: \"*.png\"\n    loop: true\n    trigger: software\n    colour: mono\n",
-             kRecipe);
+             kRecipe, "info");
   constexpr int kParts = 36;
   ASSERT_NO_FATAL_FAILURE(line.runParts(kParts, 5000ms));
   ASSERT_NO_FATAL_FAILURE(line.stop());
+  // The recipe ran once on its picture of the part before the station reported itself running
+  // (and the PLC saw it ready).
+  std::string log;
+  for (const auto& l : line.facetd().lines()) log += l + "\n";
+  const auto warmed = log.find("warmed up on its picture of the part");
+  ASSERT_NE(warmed, std::string::npos) << log;
+  EXPECT_LT(warmed, log.find(" running: camera ")) << log;
   const auto parts = storedParts(line.database());
   const auto results = line.results();
   ASSERT_EQ(parts.size(), static_cast<std::size_t>(kParts));
