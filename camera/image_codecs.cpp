@@ -12,6 +12,7 @@
 #include "camera/image_file_reader.hpp"
 #include "camera/jpeg_file.hpp"
 #include "camera/module_file.hpp"
+#include "camera/pgm_file.hpp"
 #include "camera/png_file.hpp"
 #include "camera/tiff_file.hpp"
 
@@ -117,6 +118,14 @@ std::optional<cv::Mat> imreadOfPlainBmp(const fs::path& file, int flags) {
   return readPlainBmp(file, kImreadMaxPixels, storedAsRead(read, flags));
 }
 
+// cv::imread's result for a binary PGM: the stored samples, read as stored or as grey (8 bits, or
+// 16 when any depth is asked). A 16-bit file read as 8 bits follows OpenCV's rule: the module.
+std::optional<cv::Mat> imreadOfBinaryPgm(const fs::path& file, int flags) {
+  const PlainRead read = plainReadOf(flags);
+  if (read == PlainRead::Other) return std::nullopt;
+  return readBinaryPgm(file, kImreadMaxPixels, storedAsRead(read, flags));
+}
+
 // readImageFile's result for a plain PNG: what the module's decoder makes of it.
 std::optional<ImageFileContent> frameOfPlainPng(const fs::path& file, std::uint64_t max_pixels) {
   auto png = readPlainPng(file, max_pixels);
@@ -148,6 +157,13 @@ std::optional<ImageFileContent> frameOfPlainBmp(const fs::path& file, std::uint6
   return frameOfDecodedPixels(std::move(*bmp));
 }
 
+// readImageFile's result for a binary PGM: the module reads PNM pixels with OpenCV.
+std::optional<ImageFileContent> frameOfBinaryPgm(const fs::path& file, std::uint64_t max_pixels) {
+  auto pgm = readBinaryPgm(file, max_pixels);
+  if (!pgm) return std::nullopt;
+  return frameOfDecodedPixels(std::move(*pgm));
+}
+
 }  // namespace
 
 const std::string& imageCodecsProblem() {
@@ -159,6 +175,7 @@ cv::Mat readImage(const fs::path& file, int flags) {
   if (auto jpeg = imreadOfPlainJpeg(file, flags)) return *jpeg;
   if (auto tiff = imreadOfPlainTiff(file, flags)) return *tiff;
   if (auto bmp = imreadOfPlainBmp(file, flags)) return *bmp;
+  if (auto pgm = imreadOfBinaryPgm(file, flags)) return *pgm;
   const ImageCodecTable* table = loaded().table;
   return table ? table->read(file.string(), flags) : cv::Mat();
 }
@@ -184,6 +201,7 @@ ImageFileContent readImageFile(const fs::path& file, std::uint64_t max_pixels) {
   if (auto jpeg = frameOfPlainJpeg(file, max_pixels)) return std::move(*jpeg);
   if (auto tiff = frameOfPlainTiff(file, max_pixels)) return std::move(*tiff);
   if (auto bmp = frameOfPlainBmp(file, max_pixels)) return std::move(*bmp);
+  if (auto pgm = frameOfBinaryPgm(file, max_pixels)) return std::move(*pgm);
   const LoadedCodecs& codecs = loaded();
   if (codecs.table) return codecs.table->readFile(file, max_pixels);
   ImageFileContent content;

@@ -2,8 +2,9 @@
 // Image files and in-memory PNG/JPEG for production code, through a module loaded on first use
 // (libfacet_image_codecs.so: OpenImageIO and OpenCV's imgcodecs). Linking those two directly
 // made every start of `facet` and `facetd` take ~0.3 s and map ~200 more shared libraries,
-// also for the commands that never touch an image file. Plain PNG, JPEG and TIFF files are read
-// without the module (png_file.hpp, jpeg_file.hpp, tiff_file.hpp), with the same result.
+// also for the commands that never touch an image file. Plain PNG, JPEG, TIFF and BMP files and
+// binary PGMs are read without the module (png_file.hpp, jpeg_file.hpp, tiff_file.hpp,
+// bmp_file.hpp, pgm_file.hpp), with the same result.
 //
 // Each function behaves like its OpenCV namesake (flags are cv::ImreadModes, params
 // cv::ImwriteFlags; only the constants of <opencv2/imgcodecs.hpp> are used here). Thread-safe;

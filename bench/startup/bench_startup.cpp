@@ -1,6 +1,7 @@
 // Cold start (warm page cache) of the facet tool: wall time from exec to exit, median of N runs,
-// for `facet version` (no image: must stay <= 30 ms), `facet match` on a demo image as PNG and as
-// TIFF (both read without the image-codec module) and as PGM (which loads the module).
+// for `facet version` (no image: must stay <= 30 ms), `facet match` on a demo image as PNG, TIFF,
+// BMP and binary PGM (all read without the image-codec module) and as WebP (which loads
+// the module).
 // Baseline: the same tool linked with OpenImageIO and OpenCV's imgcodecs, as it was before the
 // codecs became a module.
 // --smoke: 3 runs per case, same table.
@@ -78,12 +79,14 @@ int main(int argc, char** argv) {
     }
     return copy;
   };
-  const std::string tiff = copyAs(".tif"), bmp = copyAs(".bmp"), pgm = copyAs(".pgm");
+  const std::string tiff = copyAs(".tif"), bmp = copyAs(".bmp"), pgm = copyAs(".pgm"),
+                    webp = copyAs(".webp");
   const std::string model = root + "/recipes/models/bracket.shape";
   const std::vector<std::string> match = {"match", "--model", model, "--image", png};
   const std::vector<std::string> matchTiff = {"match", "--model", model, "--image", tiff};
   const std::vector<std::string> matchBmp = {"match", "--model", model, "--image", bmp};
   const std::vector<std::string> matchPgm = {"match", "--model", model, "--image", pgm};
+  const std::vector<std::string> matchWebp = {"match", "--model", model, "--image", webp};
   std::printf("bench_startup%s: median wall time of %d runs (warm page cache)\n",
               smoke ? " --smoke" : "", runs);
   std::printf("%-18s %12s %22s %8s\n", "command", "facet ms", "linked codecs ms", "ratio");
@@ -91,7 +94,7 @@ int main(int argc, char** argv) {
   for (const auto& [name, args] :
        {std::pair{"version", version}, std::pair{"match png", match},
         std::pair{"match tiff", matchTiff}, std::pair{"match bmp", matchBmp},
-        std::pair{"match pgm (module)", matchPgm}}) {
+        std::pair{"match pgm", matchPgm}, std::pair{"match webp (module)", matchWebp}}) {
     std::vector<std::string> now = {FACET_TOOL}, old = {FACET_LINKED_CODECS_TOOL};
     now.insert(now.end(), args.begin(), args.end());
     old.insert(old.end(), args.begin(), args.end());
@@ -106,5 +109,6 @@ int main(int argc, char** argv) {
   std::filesystem::remove(tiff);
   std::filesystem::remove(bmp);
   std::filesystem::remove(pgm);
+  std::filesystem::remove(webp);
   return failed == 0 ? 0 : 1;
 }

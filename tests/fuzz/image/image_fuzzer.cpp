@@ -1,7 +1,8 @@
 // libFuzzer target: the replay backend's image decoders: the one inside the image-codec module
 // (camera/image_file_decoder.hpp: OpenImageIO and, for 16-bit PNM, OpenCV) and the plain-PNG
-// plain-JPEG, plain-TIFF and plain-BMP readers that run in the process before it
-// (camera/png_file.hpp, camera/jpeg_file.hpp, camera/tiff_file.hpp, camera/bmp_file.hpp). The first
+// plain-JPEG, plain-TIFF, plain-BMP and binary-PGM readers that run in the process before it
+// (camera/png_file.hpp, camera/jpeg_file.hpp, camera/tiff_file.hpp, camera/bmp_file.hpp,
+// camera/pgm_file.hpp). The first
 // byte picks the file extension the replay folder accepts, the rest is the file. Expected outcome
 // for bad input: an error naming the file (module) or no image (plain readers: the module then
 // decides). An image that reads must have the size its header announced and a frame format; where
@@ -16,9 +17,13 @@
 #include <cstdlib>
 #include <string>
 
+#include <opencv2/core.hpp>
+
 #include "camera/bmp_file.hpp"
+#include "camera/decoded_frame.hpp"
 #include "camera/image_file_decoder.hpp"
 #include "camera/jpeg_file.hpp"
+#include "camera/pgm_file.hpp"
 #include "camera/png_file.hpp"
 #include "camera/tiff_file.hpp"
 #include "tests/fuzz/fuzz_input_file.hpp"
@@ -68,6 +73,17 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
       std::abort();
     // Where the module reads it too, to the same size.
     if (content.ok() && content.image.size() != p.size()) std::abort();
+  }
+  if (const auto plain = facet::readBinaryPgm(file, kMaxPixels)) {
+    const cv::Mat& p = *plain;
+    if (p.empty() || p.total() > kMaxPixels || p.channels() != 1 ||
+        (p.depth() != CV_8U && p.depth() != CV_16U))
+      std::abort();
+    // The module takes PNM samples from OpenCV's reader, which this one matches sample for sample.
+    if (content.ok() &&
+        (content.image.size() != p.size() ||
+         cv::norm(content.image, facet::frameOfDecodedPixels(p).image, cv::NORM_INF) != 0))
+      std::abort();
   }
   return 0;
 }
