@@ -11,6 +11,7 @@
 #include "service/cli/batch_inspection.hpp"
 #include "service/cli/command_line.hpp"
 #include "service/daemon/results_store.hpp"
+#include "service/engine/warm_up.hpp"
 #include "service/sinks/postgres_batch_writer.hpp"
 
 namespace facet::cli {
@@ -58,6 +59,9 @@ void runShardedReplay(const ShardedReplayOptions& opt, const config::StepKindReg
   const auto sidecars = SidecarMetadata::loadFolder(opt.imagesFolder);
   std::map<std::string, int> counts{{"pass", 0}, {"fail", 0}, {"error", 0}};
   std::size_t skipped = 0;
+  // The stored inspection times are those of a running station, which warms up before its first
+  // part.
+  service::warmUp(*recipe);
   const auto t0 = std::chrono::steady_clock::now();
   try {
     for (const auto& part : share) {
