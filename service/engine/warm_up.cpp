@@ -1,6 +1,7 @@
 #include "service/engine/warm_up.hpp"
 
 #include <algorithm>
+#include <exception>
 
 #include <opencv2/core.hpp>
 
@@ -15,7 +16,11 @@ std::optional<InspectionOutcome> warmUp(const PreparedRecipe& recipe) {
     // past the picture's edges find image to measure on.
     const int border = std::max(picture.cols, picture.rows) / 4;
     cv::Mat frame;
-    cv::copyMakeBorder(picture, frame, border, border, border, border, cv::BORDER_REPLICATE);
+    try {
+      cv::copyMakeBorder(picture, frame, border, border, border, border, cv::BORDER_REPLICATE);
+    } catch (const std::exception&) {
+      return std::nullopt;  // no memory for it: the first part pays, as without a warm-up
+    }
     return inspectPart({.image = frame, .scan = std::nullopt}, recipe);
   }
   return std::nullopt;
