@@ -54,9 +54,10 @@ class StepUnit : public config::StepKind {
   [[nodiscard]] virtual StepResult run(const config::Step& step, StepContext& part) const = 0;
   // Whether the step measures on the camera image (false: on the range scan).
   [[nodiscard]] virtual bool needsImage() const { return true; }
-  // A picture of the part as the step was taught it (an align step's reference image), in the
-  // frame later steps place their positions in; empty when the step has none. warmUp() runs
-  // the recipe on it before the first part.
+  // A picture of the part as the step was taught it (an align step's reference image, a shape
+  // step's template unless the step is placed relative to another), in the frame later steps
+  // place their positions in; empty when the step has none. warmUp() runs the recipe on it
+  // before the first part.
   [[nodiscard]] virtual cv::Mat pictureOfPart(const config::Step& /*step*/) const { return {}; }
 };
 

@@ -6,8 +6,8 @@
 // kept search buffers. The first part of the bracket demo took 18-23 ms where the parts after it
 // took 4-5. Run on the thread that inspects, before the first part, the warm-up moves most of
 // that cost out of the part's cycle time. The picture is the first step's picture of the part
-// (StepUnit::pictureOfPart: an align step's reference image) with a border of its own edge
-// pixels, so that the steps placed relative to it find room.
+// (StepUnit::pictureOfPart: an align step's reference image, a shape step's template) with a
+// border of its own edge pixels, so that the steps placed relative to it find room.
 
 #include <optional>
 

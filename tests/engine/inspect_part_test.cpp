@@ -190,6 +190,33 @@ TEST_F(InspectionTest, WarmUpInspectsTheReferencePictureWithEveryStep) {
   EXPECT_FALSE(warmUp(none).has_value());
 }
 
+// A recipe that only counts parts by shape warms up on the shape step's template.
+TEST_F(InspectionTest, WarmUpOfAShapeOnlyRecipeFindsThePartInItsTemplate) {
+  std::ofstream(dir_ / "count.recipe.yaml") << R"(schema_version: 1
+id: 8
+name: count
+steps:
+  - id: brackets
+    kind: shape
+    template: bracket.png
+    model: bracket.model
+    min_score: 0.7
+    num_matches: 10
+    checks:
+      count: {nominal: 4, tol_minus: 0, tol_plus: 0}
+)";
+  const auto loaded = config::loadRecipe(dir_ / "count.recipe.yaml", kinds());
+  ASSERT_TRUE(loaded.recipe) << loaded.diagnostics.text();
+  config::Calibration calibration;
+  calibration.mmPerPixel = kMmPerPixel;
+  const auto recipe =
+      prepareRecipe(std::make_shared<const config::Recipe>(*loaded.recipe), calibration);
+  const auto out = warmUp(*recipe);
+  ASSERT_TRUE(out.has_value());
+  EXPECT_EQ(value(*out, "brackets.count").value, 1.0);  // one in the picture: the check fails
+  EXPECT_EQ(out->verdict, Verdict::Fail);
+}
+
 TEST_F(InspectionTest, MissingModelIsReportedWhenTheRecipeIsLoaded) {
   fs::remove(dir_ / "bracket.model");
   const auto loaded = config::loadRecipe(dir_ / "bracket.recipe.yaml", kinds());

@@ -63,6 +63,12 @@ std::vector<config::TrainedModel> ShapeStep::train(const config::Step& step) con
   return {trainShapeModel(step, trainingOf(step.as<ShapeParams>()))};
 }
 
+// A match placed relative to an earlier pose has no picture of the whole part.
+cv::Mat ShapeStep::pictureOfPart(const config::Step& step) const {
+  if (!step.resources || step.as<ShapeParams>().relativeTo) return {};
+  return step.resourcesAs<ShapeModelResource>().templateGrey;
+}
+
 StepResult ShapeStep::run(const config::Step& step, StepContext& part) const {
   const auto& s = step.as<ShapeParams>();
   cv::Rect search = clampRect(s.searchRegion, part.grey.size());

@@ -30,6 +30,7 @@ class ShapeStep : public TableStep<ShapeParams> {
       const config::Step& step, config::StepReading& in) const override;
   [[nodiscard]] std::vector<config::TrainedModel> train(const config::Step& step) const override;
   [[nodiscard]] StepResult run(const config::Step& step, StepContext& part) const override;
+  [[nodiscard]] cv::Mat pictureOfPart(const config::Step& step) const override;
 };
 
 }  // namespace facet::service
