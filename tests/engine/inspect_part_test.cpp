@@ -76,13 +76,21 @@ steps:
     checks:
       distance: {nominal: 4.0003, tol_minus: 0.01, tol_plus: 0.01}
 )";
-    const auto loaded = config::loadRecipe(dir_ / "bracket.recipe.yaml", kinds());
-    ASSERT_TRUE(loaded.recipe) << loaded.diagnostics.text();
-    config::Calibration calibration;
-    calibration.mmPerPixel = kMmPerPixel;
-    recipe_ = prepareRecipe(std::make_shared<const config::Recipe>(*loaded.recipe), calibration);
+    recipe_ = loadPrepared("bracket.recipe.yaml");
+    ASSERT_TRUE(recipe_);
   }
   void TearDown() override { fs::remove_all(dir_); }
+
+  // A recipe file of dir_, loaded and prepared with the test's calibration; null (and the
+  // loader's diagnostics as a failure) when it does not load.
+  [[nodiscard]] std::shared_ptr<const PreparedRecipe> loadPrepared(const std::string& file) const {
+    const auto loaded = config::loadRecipe(dir_ / file, kinds());
+    EXPECT_TRUE(loaded.recipe) << loaded.diagnostics.text();
+    if (!loaded.recipe) return nullptr;
+    config::Calibration calibration;
+    calibration.mmPerPixel = kMmPerPixel;
+    return prepareRecipe(std::make_shared<const config::Recipe>(*loaded.recipe), calibration);
+  }
 
   [[nodiscard]] InspectionOutcome inspect(const cv::Mat& image) const {
     return inspectPart({image, std::nullopt}, *recipe_);
@@ -205,12 +213,8 @@ steps:
     checks:
       count: {nominal: 4, tol_minus: 0, tol_plus: 0}
 )";
-  const auto loaded = config::loadRecipe(dir_ / "count.recipe.yaml", kinds());
-  ASSERT_TRUE(loaded.recipe) << loaded.diagnostics.text();
-  config::Calibration calibration;
-  calibration.mmPerPixel = kMmPerPixel;
-  const auto recipe =
-      prepareRecipe(std::make_shared<const config::Recipe>(*loaded.recipe), calibration);
+  const auto recipe = loadPrepared("count.recipe.yaml");
+  ASSERT_TRUE(recipe);
   const auto out = warmUp(*recipe);
   ASSERT_TRUE(out.has_value());
   EXPECT_EQ(value(*out, "brackets.count").value, 1.0);  // one in the picture: the check fails
