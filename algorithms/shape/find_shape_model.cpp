@@ -308,6 +308,132 @@ bool sameLevelPose(const Candidate& a, const Candidate& b, double angleStep) {
          std::abs(a.scale - b.scale) < 1e-9;
 }
 
+// The top-level candidates tracked first when a number of matches is asked for: the best
+// 20 + 10 per match (the others follow against the score to beat).
+constexpr std::size_t kFirstTracked = 20;
+constexpr std::size_t kFirstTrackedPerMatch = 10;
+
+// Each candidate's near-symmetric turns, appended: the top level sees the part coarsest, and where
+// the model is nearly symmetric there the turned pose may be the one it keeps and the right one
+// absent. The turns are tracked down the pyramid beside the candidates (the levels below tell
+// them apart); turns outside the searched angles are not.
+void addSymmetricTurns(std::vector<Candidate>& candidates, const ShapeModel& model,
+                       const Interval& angles, int top) {
+  if (model.symmetries.empty()) return;
+  const double f = std::ldexp(1.0, -top);
+  const std::size_t found = candidates.size();
+  for (std::size_t i = 0; i < found; ++i) {
+    const Candidate c = candidates[i];
+    for (ModelSymmetry sym : model.symmetries) {
+      sym.centre *= f;
+      const Pose2D turned = turnedBy({c.x, c.y, c.angle, c.scale}, sym);
+      double a = wrapAngle(turned.angle);
+      if (!angles.full) {
+        // The turn's angle taken to the first one at or after the range's start.
+        double past = std::fmod(a - angles.start, kTwoPi);
+        if (past < 0.0) past += kTwoPi;
+        if (past > angles.extent) continue;
+        a = angles.start + past;
+      }
+      candidates.push_back({std::round(turned.x), std::round(turned.y), a, c.scale, c.score});
+    }
+  }
+}
+
+// Candidates of the top level tracked down the pyramid to level 0.
+struct Tracker {
+  std::vector<DirectionField>& fields;
+  const ShapeModel& model;
+  const FindParams& params;
+  const LevelSearch& base;  // angles, scales, polarity, greediness
+  int top;
+
+  // The candidates that hold on every level: on the levels between the top and 0 a part scoring
+  // `minScore` at the end scores at least kMiddleFactor of it, on level 0 before refinement
+  // kFinalFactor. Called with FindParams::minScore, or with a higher score a candidate has to
+  // reach to be returned at all.
+  std::vector<Candidate> toLevelZero(std::vector<Candidate> candidates, double minScore) const {
+    const ShapeLevel& topLevel = model.levels[top];
+    LevelSearch search = base;
+    for (int l = top - 1; l >= 0; --l) {
+      search.field = &fields[l].directions();
+      search.level = &model.levels[l];
+      search.spread = spreadOnLevel(params.maxDeformation, l);
+      // Directions are needed only around the candidates.
+      double levelRadius = 0.0;
+      for (const auto& p : model.levels[l].points)
+        levelRadius = std::max(levelRadius, std::hypot(double(p.position.x), double(p.position.y)));
+      const int reach =
+          static_cast<int>(std::ceil(levelRadius * search.scaleMax)) + 16 + search.spread;
+      for (const Candidate& c : candidates)
+        fields[l].ensure(cv::Rect(cvRound(2 * c.x) - reach, cvRound(2 * c.y) - reach, 2 * reach + 1,
+                                  2 * reach + 1));
+      search.minScore = minScore * (l > 0                                   ? kMiddleFactor
+                                    : params.subpixel == SubpixelMode::None ? 1.0
+                                                                            : kFinalFactor);
+      // Each candidate is tracked on its own (the field is read-only here), in parallel when
+      // threads > 1; kept in their order, so the result is the same for any number of threads.
+      // Below the top, a candidate may also leave a second peak (see stepsBelowTop).
+      std::vector<std::array<Candidate, 2>> tracked(candidates.size());
+      const int wideSteps = l == top - 1 ? stepsBelowTop(topLevel, model.levels[l]) : 1;
+      auto track = [&](const cv::Range& r) {
+        for (int i = r.start; i < r.end; ++i) {
+          Candidate c = candidates[static_cast<std::size_t>(i)];
+          c.x *= 2.0;
+          c.y *= 2.0;
+          auto& out = tracked[static_cast<std::size_t>(i)];
+          out[0] = refineOnLevel(search, c, 2);
+          out[1].score = -1.0;
+          // Only around a candidate that holds on this level, and only for a peak that could
+          // still be chosen over the near one (as the finish does: within kClusterMargin).
+          if (wideSteps > 1 && out[0].score >= search.minScore) {
+            LevelSearch wideSearch = search;
+            wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);
+            const Candidate wide = refineOnLevel(wideSearch, c, 2, wideSteps);
+            if (wide.score >= wideSearch.minScore &&
+                !sameLevelPose(wide, out[0], search.level->angleStep))
+              out[1] = wide;
+          }
+        }
+      };
+      const cv::Range all(0, static_cast<int>(candidates.size()));
+      if (params.threads > 1 && candidates.size() > 1)
+        cv::parallel_for_(all, track, static_cast<double>(candidates.size()));
+      else
+        track(all);
+      std::vector<Candidate> next;
+      for (const auto& peaks : tracked)
+        for (const Candidate& r : peaks)
+          if (r.score >= search.minScore) next.push_back(r);
+      candidates.swap(next);
+    }
+    if (top == 0) {
+      const double keep = minScore * (params.subpixel == SubpixelMode::None ? 1.0 : kFinalFactor);
+      std::erase_if(candidates, [&](const Candidate& c) { return c.score < keep; });
+    }
+    return candidates;
+  }
+};
+
+// The level-0 score a later candidate has to reach to be returned: the score of the last of the
+// FindParams::numMatches best level-0 candidates that reach the minimum score and do not overlap
+// each other (as the finish picks them). FindParams::minScore while there are fewer.
+double scoreToBeat(std::vector<Candidate> candidates, const Box& box, const FindParams& params) {
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  std::vector<cv::RotatedRect> taken;
+  for (const Candidate& c : candidates) {
+    if (c.score < params.minScore) break;
+    const cv::RotatedRect here = placedBox(box, {c.x, c.y, c.angle, c.scale});
+    if (std::any_of(taken.begin(), taken.end(),
+                    [&](const cv::RotatedRect& t) { return overlap(here, t) > params.maxOverlap; }))
+      continue;
+    taken.push_back(here);
+    if (static_cast<int>(taken.size()) == params.numMatches) return c.score;
+  }
+  return params.minScore;
+}
+
 }  // namespace
 
 std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& model,
@@ -338,38 +464,28 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
 
   const int top = levels - 1;
   const ShapeLevel& topLevel = model.levels[top];
-  const int maxCandidates = params.numMatches == 0 ? 400 : 20 + 10 * params.numMatches;
   fields[top].ensureAll();
   std::vector<Candidate> candidates = shape_detail::searchTopLevel(
       fields[top].directions(), topLevel.points, angleSamples(*angles, topLevel.angleStep),
       scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params.polarity,
-      spreadOnLevel(params.maxDeformation, top), kTopFactor * params.minScore, params.threads,
-      maxCandidates);
+      spreadOnLevel(params.maxDeformation, top), kTopFactor * params.minScore, params.threads);
 
-  // The top level sees the part coarsest: where the model is nearly symmetric there, the turned
-  // pose may be the one it keeps and the right one absent. Each candidate's near-symmetric turns
-  // are tracked down the pyramid beside it (the levels below tell them apart); turns outside the
-  // searched angles are not.
-  if (!model.symmetries.empty()) {
-    const double f = std::ldexp(1.0, -top);
-    const std::size_t found = candidates.size();
-    for (std::size_t i = 0; i < found; ++i) {
-      const Candidate c = candidates[i];
-      for (ModelSymmetry sym : model.symmetries) {
-        sym.centre *= f;
-        const Pose2D turned = turnedBy({c.x, c.y, c.angle, c.scale}, sym);
-        double a = wrapAngle(turned.angle);
-        if (!angles->full) {
-          // The turn's angle taken to the first one at or after the range's start.
-          double past = std::fmod(a - angles->start, kTwoPi);
-          if (past < 0.0) past += kTwoPi;
-          if (past > angles->extent) continue;
-          a = angles->start + past;
-        }
-        candidates.push_back({std::round(turned.x), std::round(turned.y), a, c.scale, c.score});
-      }
+  // Every top-level candidate is tracked: the top level sees a small part coarsest, and on a
+  // busy photograph a part a third hidden ranked 100th-220th there behind clutter (a crystal on
+  // a circuit board, scoring 0.71-0.76 at level 0) and was dropped when only the first 30 were
+  // kept. When a number of matches is asked for, the best ones go first; the others are then
+  // tracked against the level-0 score they would have to beat to be returned (scoreToBeat), which
+  // lets the safe early termination abandon most of them sooner.
+  std::vector<Candidate> later;
+  if (params.numMatches > 0) {
+    const std::size_t first = kFirstTracked + kFirstTrackedPerMatch * params.numMatches;
+    if (candidates.size() > first) {
+      later.assign(candidates.begin() + static_cast<std::ptrdiff_t>(first), candidates.end());
+      candidates.resize(first);
     }
   }
+  addSymmetricTurns(candidates, model, *angles, top);
+  addSymmetricTurns(later, model, *angles, top);
 
   LevelSearch search;
   search.angles = *angles;
@@ -377,61 +493,13 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   search.scaleMax = scaleMax;
   search.polarity = params.polarity;
   search.greediness = params.greediness;
-  for (int l = top - 1; l >= 0; --l) {
-    search.field = &fields[l].directions();
-    search.level = &model.levels[l];
-    search.spread = spreadOnLevel(params.maxDeformation, l);
-    // Directions are needed only around the candidates.
-    double levelRadius = 0.0;
-    for (const auto& p : model.levels[l].points)
-      levelRadius = std::max(levelRadius, std::hypot(double(p.position.x), double(p.position.y)));
-    const int reach = static_cast<int>(std::ceil(levelRadius * scaleMax)) + 16 + search.spread;
-    for (const Candidate& c : candidates)
-      fields[l].ensure(cv::Rect(cvRound(2 * c.x) - reach, cvRound(2 * c.y) - reach, 2 * reach + 1,
-                                2 * reach + 1));
-    search.minScore = params.minScore * (l > 0                                   ? kMiddleFactor
-                                         : params.subpixel == SubpixelMode::None ? 1.0
-                                                                                 : kFinalFactor);
-    // Each candidate is tracked on its own (the field is read-only here), in parallel when
-    // threads > 1; kept in their order, so the result is the same for any number of threads.
-    // Below the top, a candidate may also leave a second peak (see stepsBelowTop).
-    std::vector<std::array<Candidate, 2>> tracked(candidates.size());
-    const int wideSteps = l == top - 1 ? stepsBelowTop(topLevel, model.levels[l]) : 1;
-    auto track = [&](const cv::Range& r) {
-      for (int i = r.start; i < r.end; ++i) {
-        Candidate c = candidates[static_cast<std::size_t>(i)];
-        c.x *= 2.0;
-        c.y *= 2.0;
-        auto& out = tracked[static_cast<std::size_t>(i)];
-        out[0] = refineOnLevel(search, c, 2);
-        out[1].score = -1.0;
-        // Only around a candidate that holds on this level, and only for a peak that could
-        // still be chosen over the near one (as the finish does: within kClusterMargin).
-        if (wideSteps > 1 && out[0].score >= search.minScore) {
-          LevelSearch wideSearch = search;
-          wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);
-          const Candidate wide = refineOnLevel(wideSearch, c, 2, wideSteps);
-          if (wide.score >= wideSearch.minScore &&
-              !sameLevelPose(wide, out[0], search.level->angleStep))
-            out[1] = wide;
-        }
-      }
-    };
-    const cv::Range all(0, static_cast<int>(candidates.size()));
-    if (params.threads > 1 && candidates.size() > 1)
-      cv::parallel_for_(all, track, static_cast<double>(candidates.size()));
-    else
-      track(all);
-    std::vector<Candidate> next;
-    for (const auto& peaks : tracked)
-      for (const Candidate& r : peaks)
-        if (r.score >= search.minScore) next.push_back(r);
-    candidates.swap(next);
-  }
-  if (top == 0) {
-    const double keep =
-        params.minScore * (params.subpixel == SubpixelMode::None ? 1.0 : kFinalFactor);
-    std::erase_if(candidates, [&](const Candidate& c) { return c.score < keep; });
+  const Box box = modelBox(model);
+  const Tracker tracker{fields, model, params, search, top};
+  candidates = tracker.toLevelZero(std::move(candidates), params.minScore);
+  if (!later.empty()) {
+    const double toBeat = scoreToBeat(candidates, box, params);
+    std::vector<Candidate> more = tracker.toLevelZero(std::move(later), toBeat);
+    candidates.insert(candidates.end(), more.begin(), more.end());
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
@@ -439,7 +507,6 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   // Best first: refine, check the refined score, suppress overlaps with the matches kept. Each
   // match is chosen among its alternatives (the model's near-symmetric turns and other candidates
   // on the same part), all refined, so that the coarse levels' pick does not decide.
-  const Box box = modelBox(model);
   search.field = &fields[0].directions();
   search.level = &model.levels[0];
   search.spread = spreadOnLevel(params.maxDeformation, 0);

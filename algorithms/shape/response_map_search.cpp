@@ -142,8 +142,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
                                       const std::vector<ShapePoint>& modelPoints,
                                       const std::vector<double>& angles,
                                       const std::vector<double>& scales, Polarity polarity,
-                                      int spread, double threshold, int threads,
-                                      int maxCandidates) {
+                                      int spread, double threshold, int threads) {
   std::vector<ShapePoint> points = modelPoints;
   if (points.size() > kMaxTopPoints) {
     std::vector<ShapePoint> kept;
@@ -338,7 +337,6 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   }
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-  if (static_cast<int>(candidates.size()) > maxCandidates) candidates.resize(maxCandidates);
   return candidates;
 }
 

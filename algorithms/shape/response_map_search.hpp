@@ -21,13 +21,14 @@ struct Candidate {
 };
 
 // Local maxima (over position, best template per pixel) scoring at least `threshold`, best first,
-// at most `maxCandidates`. `field` is the top level's DirectionField; the search splits its rows
-// over `threads` threads. With `spread` > 0 each point takes the best response within `spread`
-// pixels in x and y (a part whose contour differs from the model's by that much; not with
-// Polarity::IgnoreGlobal, whose sums would need the worst response as well).
+// all of them (the caller decides which to track first). `field` is the top level's
+// DirectionField; the search splits its rows over `threads` threads. With `spread` > 0 each point
+// takes the best response within `spread` pixels in x and y (a part whose contour differs from the
+// model's by that much; not with Polarity::IgnoreGlobal, whose sums would need the worst response
+// as well).
 std::vector<Candidate> searchTopLevel(const cv::Mat& field, const std::vector<ShapePoint>& points,
                                       const std::vector<double>& angles,
                                       const std::vector<double>& scales, Polarity polarity,
-                                      int spread, double threshold, int threads, int maxCandidates);
+                                      int spread, double threshold, int threads);
 
 }  // namespace facet::shape_detail

@@ -97,7 +97,7 @@ TEST_P(TopLevelSearchSpread, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
   for (int k = 0; k < 24; ++k) angles.push_back(k * kTwoPi / 24);
   const double threshold = 0.4;
   const auto candidates = shape_detail::searchTopLevel(field, points, angles, {1.0}, Polarity::Use,
-                                                       spread, threshold, 1, 100000);
+                                                       spread, threshold, 1);
   ASSERT_FALSE(candidates.empty());
 
   // Best sum and template per pixel, directly.
@@ -155,7 +155,7 @@ TEST(TopLevelSearch, AnAlignedDirectionLongerThan127DoesNotWrap) {
                           static_cast<float>(std::sin(kTwoPi / 16)));
   for (int k = -5; k <= 5; ++k) points.push_back({{static_cast<float>(k), 0.0f}, along});
   const auto candidates =
-      shape_detail::searchTopLevel(field, points, {0.0}, {1.0}, Polarity::Use, 0, 0.9, 1, 10);
+      shape_detail::searchTopLevel(field, points, {0.0}, {1.0}, Polarity::Use, 0, 0.9, 1);
   ASSERT_FALSE(candidates.empty());
   EXPECT_NEAR(candidates.front().score, 1.0, 1e-12);
 }
@@ -183,7 +183,7 @@ TEST(TopLevelSearch, ASearchSeesNothingOfTheThreadsEarlierSearches) {
   for (const int spread : {0, 2}) {
     const auto search = [&](const cv::Mat& field) {
       return shape_detail::searchTopLevel(field, points, angles, {1.0}, Polarity::Use, spread, 0.3,
-                                          1, 1000);
+                                          1);
     };
     std::vector<Candidate> fresh;
     std::thread([&] { fresh = search(other); }).join();
