@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -16,31 +17,80 @@ struct ScaleLevel {
   double sigma = 1;   // integration sigma at the octave's resolution
 };
 
-ScaleLevel computeLevel(const cv::Mat& img, double relScale, const HarrisParams& p) {
+// The images of a detection, kept by the thread from call to call in numbered slots, each a
+// view of a buffer that grows to the largest size asked for. A level of a 1280x1024 frame passes
+// through about twenty full-size float images; allocated afresh, each was handed back to the
+// system after the level and its pages faulted in again on the next use (a registration of such
+// a frame allocated 440 MB and spent most of its 470 ms in page faults on this machine). The
+// buffers stay with the thread: about 100 MB for a 1280x1024 frame, what one detection needs.
+class KeptImages {
+ public:
+  cv::Mat view(std::size_t slot, cv::Size size, int type) {
+    if (buffers_.size() <= slot) buffers_.resize(slot + 1);
+    cv::Mat& b = buffers_[slot];
+    if (b.type() != type || b.cols < size.width || b.rows < size.height)
+      b.create(std::max(b.rows, size.height), std::max(b.cols, size.width), type);
+    return b(cv::Rect(cv::Point(), size));
+  }
+
+ private:
+  std::vector<cv::Mat> buffers_;
+};
+
+KeptImages& keptImages() {
+  thread_local KeptImages kept;
+  return kept;
+}
+
+// Slots of keptImages(): a level's intermediates, then each level's outputs (harris, laplacian).
+enum Slot : std::size_t { kSmooth, kIx, kIy, kProducts, kBlurred, kFirstOutput };
+
+// `level`: which outputs' slots this level's harris and laplacian take (one per level that lives
+// at the same time as the others of a detection).
+ScaleLevel computeLevel(const cv::Mat& img, double relScale, const HarrisParams& p,
+                        std::size_t level) {
   const double sd = p.derivationSigma * relScale;
   const double si = p.integrationSigma * relScale;
-  cv::Mat smooth, ix, iy;
+  KeptImages& kept = keptImages();
+  const cv::Size size = img.size();
+  cv::Mat smooth = kept.view(kSmooth, size, CV_32F), ix = kept.view(kIx, size, CV_32F),
+          iy = kept.view(kIy, size, CV_32F), products = kept.view(kProducts, size, CV_32FC3),
+          blurred = kept.view(kBlurred, size, CV_32FC3);
+  // A kept view may lie inside a larger buffer: filters read it as an image of its own
+  // (BORDER_ISOLATED), not the pixels an earlier, larger image left beyond its edges.
+  constexpr int kOwnBorder = cv::BORDER_REFLECT | cv::BORDER_ISOLATED;
   cv::GaussianBlur(img, smooth, cv::Size(), sd, sd, cv::BORDER_REFLECT);
-  cv::Sobel(smooth, ix, CV_32F, 1, 0, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
-  cv::Sobel(smooth, iy, CV_32F, 0, 1, 3, 0.125 * sd, 0, cv::BORDER_REFLECT);
+  cv::Sobel(smooth, ix, CV_32F, 1, 0, 3, 0.125 * sd, 0, kOwnBorder);
+  cv::Sobel(smooth, iy, CV_32F, 0, 1, 3, 0.125 * sd, 0, kOwnBorder);
   // The three products are smoothed as one 3-channel image (one filter pass).
-  cv::Mat products;
-  cv::merge(std::vector<cv::Mat>{ix.mul(ix), iy.mul(iy), ix.mul(iy)}, products);
-  cv::GaussianBlur(products, products, cv::Size(), si, si, cv::BORDER_REFLECT);
-  std::vector<cv::Mat> m;
-  cv::split(products, m);
-  const cv::Mat &ixx = m[0], &iyy = m[1], &ixy = m[2];
-  ScaleLevel level;
-  level.sigma = si;
-  level.harris = ixx.mul(iyy) - ixy.mul(ixy) - p.k * (ixx + iyy).mul(ixx + iyy);
+  for (int y = 0; y < size.height; ++y) {
+    const float* gx = ix.ptr<float>(y);
+    const float* gy = iy.ptr<float>(y);
+    auto* out = products.ptr<cv::Vec3f>(y);
+    for (int x = 0; x < size.width; ++x) out[x] = {gx[x] * gx[x], gy[x] * gy[x], gx[x] * gy[x]};
+  }
+  cv::GaussianBlur(products, blurred, cv::Size(), si, si, kOwnBorder);
+  ScaleLevel out;
+  out.sigma = si;
+  out.harris = kept.view(kFirstOutput + 2 * level, size, CV_32F);
+  const auto k = static_cast<float>(p.k);
+  for (int y = 0; y < size.height; ++y) {
+    const auto* m = blurred.ptr<cv::Vec3f>(y);
+    auto* r = out.harris.ptr<float>(y);
+    for (int x = 0; x < size.width; ++x) {
+      const float ixx = m[x][0], iyy = m[x][1], ixy = m[x][2];
+      const float trace = ixx + iyy;
+      r[x] = ixx * iyy - ixy * ixy - k * (trace * trace);
+    }
+  }
   // The scale-normalised Laplacian at the integration scale picks the characteristic scale
   // (Harris-Laplace).
   if (p.selectScale) {
-    cv::Mat blurred;
-    cv::GaussianBlur(img, blurred, cv::Size(), si, si, cv::BORDER_REFLECT);
-    cv::Laplacian(blurred, level.laplacian, CV_32F, 3, si * si, 0, cv::BORDER_REFLECT);
+    cv::GaussianBlur(img, smooth, cv::Size(), si, si, cv::BORDER_REFLECT);
+    out.laplacian = kept.view(kFirstOutput + 2 * level + 1, size, CV_32F);
+    cv::Laplacian(smooth, out.laplacian, CV_32F, 3, si * si, 0, kOwnBorder);
   }
-  return level;
+  return out;
 }
 
 // Offset of the peak of a parabola through (-1, a), (0, b), (1, c).
@@ -144,7 +194,7 @@ std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
   CV_Assert(grey.type() == CV_32F && cell > 0);
   HarrisParams p = params;
   p.selectScale = false;
-  const ScaleLevel level = computeLevel(grey, 1.0, p);
+  const ScaleLevel level = computeLevel(grey, 1.0, p, 0);
   double maxResponse = 0;
   cv::minMaxLoc(level.harris, nullptr, &maxResponse);
   const double threshold = std::max(p.absoluteThreshold, p.relativeThreshold * maxResponse);
@@ -180,7 +230,8 @@ std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisP
   for (int o = 0; o < params.octaves; ++o) {
     if (std::min(octave.rows, octave.cols) < 2 * params.border + 8) break;
     std::vector<ScaleLevel> levels;
-    for (int j = 0; j < L; ++j) levels.push_back(computeLevel(octave, relScale(j), params));
+    for (int j = 0; j < L; ++j)
+      levels.push_back(computeLevel(octave, relScale(j), params, o * L + j));
     octaves.push_back(std::move(levels));
     if (o + 1 < params.octaves) {
       cv::Mat next;
@@ -191,14 +242,14 @@ std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisP
   if (octaves.empty()) return {};
   ScaleLevel finest, coarsest;
   if (params.selectScale) {
-    finest = computeLevel(grey, relScale(-1), params);
+    finest = computeLevel(grey, relScale(-1), params, octaves.size() * L);
     cv::Mat last = grey;
     for (std::size_t o = 1; o < octaves.size(); ++o) {
       cv::Mat next;
       cv::pyrDown(last, next);
       last = next;
     }
-    coarsest = computeLevel(last, relScale(L), params);
+    coarsest = computeLevel(last, relScale(L), params, octaves.size() * L + 1);
   }
   for (std::size_t o = 0; o < octaves.size(); ++o) {
     const double factor = std::ldexp(1.0, static_cast<int>(o));
