@@ -20,10 +20,11 @@
 //               in the two bore windows (circles)
 //
 //   first parts inspection time of the first 3 parts of a process, with and without the warm-up
-//               the station runs before its first part (service/engine/warm_up.hpp)
+//               the station runs before its first part (service/engine/warm_up.hpp); and of
+//               the parts around a changeover to a second recipe, with the switch's own time
 //   frames      PNG as recorded (default), or binary PGM with --pgm (raw pixels, no decoding)
 //
-//   bench_daemon [--smoke] [--pgm] [--parts N] [--triggers N]
+//   bench_daemon [--smoke] [--pgm] [--first-parts-only] [--parts N] [--triggers N]
 #include <time.h>
 
 #include <algorithm>
@@ -36,6 +37,7 @@
 #include <iostream>
 #include <map>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <thread>
 #include <vector>
@@ -338,42 +340,157 @@ struct FreeRun {
 // The first parts of a process: a station started in a new process (`bench_daemon --first-parts
 // DIR EXT warm|cold`, spawned by firstParts()) inspects kFirstParts frames and prints each
 // part's inspection time. A process is warm only once, so each run is a process of its own.
+//
+// A changeover (`--first-parts DIR EXT warm|cold changeover`): the station's folder holds a
+// second recipe (id 8: the bench recipe, its own models loaded, and three tools the first one does
+// not use, kSecondProductSteps), and the sidecars of the
+// frames from the third on name it, as a recording of a product change does. The child prints
+// the inspection time of kChangeoverParts parts, then how long the switch took on the
+// acquisition thread (facet_recipe_switch_ms: the recipe's preparation when it is prepared then).
 constexpr int kFirstParts = 3;
+constexpr int kChangeoverParts = 5;
+constexpr int kChangeoverAt = 2;  // parts of recipe 7 before the switch to recipe 8
 
-int firstPartsChild(const fs::path& dir, const std::string& extension, bool warmUp) {
-  auto station = loadStation(writeStation(dir, dir.parent_path() / "frames", 0, extension));
+// The second product's recipe measures with tools the first one does not use, as another
+// product's recipe does: the bench recipe and these steps (the bore's width by a caliper, a line
+// along the bracket's top edge, the bore as a dark blob).
+constexpr const char* kSecondProductSteps = R"(  - id: bore_width
+    kind: caliper
+    relative_to: part
+    centre: [37.5, 36.5]
+    length: 40
+    width: 8
+    angle: 0
+    measure: pairs
+    polarity: any
+    select: strongest
+  - id: top_edge
+    kind: line
+    relative_to: part
+    centre: [60, 12]
+    length: 60
+    width: 16
+    angle: 0
+    polarity: any
+  - id: bore_blob
+    kind: blob
+    relative_to: part
+    centre: [37.5, 36.5]
+    length: 30
+    width: 30
+    polarity: dark
+    min_area: 20
+)";
+
+// The frames of a changeover: the first kChangeoverParts frames, the ones from kChangeoverAt on
+// naming recipe 8 in their sidecars.
+fs::path changeoverFrames(const fs::path& dir, const fs::path& frames,
+                          const std::string& extension) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(frames))
+    if (e.path().extension() == extension) files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  if (files.size() < kChangeoverParts) throw std::runtime_error("too few frames for a changeover");
+  const fs::path out = dir / "changeover-frames";
+  fs::create_directories(out);
+  for (int i = 0; i < kChangeoverParts; ++i) {
+    const fs::path f = out / files[i].filename();
+    fs::copy_file(files[i], f, fs::copy_options::overwrite_existing);
+    std::ofstream(f.string() + ".json") << "{\"recipe\": " << (i < kChangeoverAt ? 7 : 8) << "}\n";
+  }
+  return out;
+}
+
+int firstPartsChild(const fs::path& dir, const std::string& extension, bool warmUp,
+                    bool changeover) {
+  const fs::path frames = changeover
+                              ? changeoverFrames(dir, dir.parent_path() / "frames", extension)
+                              : dir.parent_path() / "frames";
+  auto station = loadStation(writeStation(dir, frames, 0, extension));
+  if (changeover) {
+    std::string second = kRecipe;
+    second.replace(second.find("id: 7"), 5, "id: 8");
+    std::ofstream(dir / "recipes/second.recipe.yaml") << second << kSecondProductSteps;
+  }
+  const int parts = changeover ? kChangeoverParts : kFirstParts;
   service::StationOptions options;
   options.overflow = service::OverflowPolicy::Block;
-  options.maxParts = kFirstParts;
+  options.maxParts = static_cast<std::uint64_t>(parts);
   options.warmUp = warmUp;
+  options.recipe = 7;
   std::vector<double> ms;
   options.onPart = [&](const service::PartResult& p) { ms.push_back(p.inspectionMs); };
   service::Station s(station, facetSteps(), options);
   s.start();
   s.join();
   for (double m : ms) std::printf("%.3f\n", m);
-  return ms.size() == kFirstParts ? 0 : 1;
+  if (changeover)
+    std::printf(
+        "%.3f\n",
+        s.metrics().gauge("facet_recipe_switch_ms", "Duration of the last recipe switch").value());
+  return static_cast<int>(ms.size()) == parts ? 0 : 1;
 }
 
-// Inspection ms of the first parts, one row per process.
+// One row per process: the numbers its child printed (inspection ms of the first parts; for a
+// changeover also the switch's ms).
 std::vector<std::vector<double>> firstParts(const std::string& self, const fs::path& dir,
                                             const std::string& extension, bool warmUp,
-                                            int processes) {
+                                            bool changeover, int processes) {
   std::vector<std::vector<double>> rows;
+  const std::size_t expected = changeover ? kChangeoverParts + 1 : kFirstParts;
   for (int i = 0; i < processes; ++i) {
-    const fs::path run = dir / ((warmUp ? "warm-" : "cold-") + std::to_string(i));
+    const fs::path run = dir / ((warmUp ? "warm-" : "cold-") +
+                                std::string(changeover ? "changeover-" : "") + std::to_string(i));
     const std::string command = "'" + self + "' --first-parts '" + run.string() + "' " + extension +
-                                (warmUp ? " warm" : " cold");
+                                (warmUp ? " warm" : " cold") + (changeover ? " changeover" : "");
     FILE* out = ::popen(command.c_str(), "r");
     if (!out) throw std::runtime_error("cannot run " + command);
     std::vector<double> row;
     double v = 0;
     while (std::fscanf(out, "%lf", &v) == 1) row.push_back(v);
-    if (::pclose(out) != 0 || row.size() != kFirstParts)
+    if (::pclose(out) != 0 || row.size() != expected)
       throw std::runtime_error("first parts: " + command + " failed");
     rows.push_back(row);
   }
   return rows;
+}
+
+// The first parts of processes (firstParts() rows, without warm-up then with), and of processes
+// with a changeover; `freeRunInspect` (ms) for comparison, when the long run was made.
+struct FirstPartRows {
+  std::vector<std::vector<double>> cold, warm, coldChangeover, warmChangeover;
+};
+
+void printFirstParts(const FirstPartRows& r, std::optional<double> freeRunInspect) {
+  const auto& [cold, warm, coldChangeover, warmChangeover] = r;
+  std::printf(
+      "| first parts of a process, inspect ms (one process a row) | part 1 | part 2 | part 3 "
+      "|\n");
+  std::printf(
+      "| -------------------------------------------------------- | ------ | ------ | ------ "
+      "|\n");
+  for (const auto* rows : {&cold, &warm})
+    for (const auto& row : *rows)
+      std::printf("| %-56s | %6.2f | %6.2f | %6.2f |\n",
+                  rows == &cold ? "without warm-up (StationOptions::warmUp off)"
+                                : "with warm-up (the default)",
+                  row[0], row[1], row[2]);
+  if (freeRunInspect)
+    std::printf("(free-run mean inspect of the long run below: %.2f ms)\n", *freeRunInspect);
+  std::printf("\n");
+  std::printf(
+      "| a changeover: recipe 7, then 8 from part 3 (one process a row) | switch ms | part 1 "
+      "| part 2 | part 3 | part 4 | part 5 |\n");
+  std::printf(
+      "| -------------------------------------------------------------- | --------- | ------ "
+      "| ------ | ------ | ------ | ------ |\n");
+  for (const auto* rows : {&coldChangeover, &warmChangeover})
+    for (const auto& row : *rows)
+      std::printf("| %-62s | %9.2f | %6.2f | %6.2f | %6.2f | %6.2f | %6.2f |\n",
+                  rows == &coldChangeover ? "without warm-up (StationOptions::warmUp off)"
+                                          : "with warm-up (the default)",
+                  row[5], row[0], row[1], row[2], row[3], row[4]);
+  std::printf("(switch ms: the recipe selector's choice of part 3, on the acquisition thread)\n\n");
 }
 
 FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, const std::string& extension,
@@ -452,16 +569,19 @@ Baseline openCvBaseline(const std::vector<fs::path>& frames, int rounds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc == 5 && std::string(argv[1]) == "--first-parts") {
+  if ((argc == 5 || argc == 6) && std::string(argv[1]) == "--first-parts") {
     spdlog::set_level(spdlog::level::err);
-    return firstPartsChild(argv[2], argv[3], std::string(argv[4]) == "warm");
+    return firstPartsChild(argv[2], argv[3], std::string(argv[4]) == "warm",
+                           argc == 6 && std::string(argv[5]) == "changeover");
   }
-  bool smoke = false, pgm = false;
+  bool smoke = false, pgm = false, firstPartsOnly = false;
   int parts = 20000, triggers = 500;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--smoke")
       smoke = true;
+    else if (a == "--first-parts-only")
+      firstPartsOnly = true;
     else if (a == "--pgm")
       pgm = true;
     else if (a == "--parts" && i + 1 < argc)
@@ -469,7 +589,8 @@ int main(int argc, char** argv) {
     else if (a == "--triggers" && i + 1 < argc)
       triggers = std::stoi(argv[++i]);
     else {
-      std::cerr << "usage: bench_daemon [--smoke] [--pgm] [--parts N] [--triggers N]\n";
+      std::cerr << "usage: bench_daemon [--smoke] [--pgm] [--first-parts-only] [--parts N] "
+                   "[--triggers N]\n";
       return 1;
     }
   }
@@ -486,8 +607,15 @@ int main(int argc, char** argv) {
     const auto frames = makeFrames(dir / "frames", extension);
     const int processes = smoke ? 1 : 3;
     const std::string self = fs::read_symlink("/proc/self/exe").string();
-    const auto cold = firstParts(self, dir, extension, false, processes);
-    const auto warm = firstParts(self, dir, extension, true, processes);
+    const FirstPartRows firstRows{firstParts(self, dir, extension, false, false, processes),
+                                  firstParts(self, dir, extension, true, false, processes),
+                                  firstParts(self, dir, extension, false, true, processes),
+                                  firstParts(self, dir, extension, true, true, processes)};
+    if (firstPartsOnly) {
+      printFirstParts(firstRows, std::nullopt);
+      fs::remove_all(dir);
+      return 0;
+    }
     const Latency latency = measureLatency(dir, dir / "frames", extension, triggers);
     FreeRun run = measureFreeRun(dir, dir / "frames", extension, parts);
     const Baseline cv = openCvBaseline(frames, smoke ? 1 : 5);
@@ -534,20 +662,7 @@ int main(int argc, char** argv) {
     std::printf("  free-run verdicts: pass %d, fail %d, error %d\n\n", run.verdicts["pass"],
                 run.verdicts["fail"], run.verdicts["error"]);
 
-    std::printf(
-        "| first parts of a process, inspect ms (one process a row) | part 1 | part 2 | part 3 "
-        "|\n");
-    std::printf(
-        "| -------------------------------------------------------- | ------ | ------ | ------ "
-        "|\n");
-    for (const auto* rows : {&cold, &warm})
-      for (const auto& row : *rows)
-        std::printf("| %-56s | %6.2f | %6.2f | %6.2f |\n",
-                    rows == &cold ? "without warm-up (StationOptions::warmUp off)"
-                                  : "with warm-up (the default)",
-                    row[0], row[1], row[2]);
-    std::printf("(free-run mean inspect of the long run below: %.2f ms)\n\n",
-                run.split.stage("inspect"));
+    printFirstParts(firstRows, run.split.stage("inspect"));
 
     const StageSplit& l = latency.split;
     const double lMean = mean(latency.ms);
