@@ -417,7 +417,10 @@ struct Tracker {
 
 // The level-0 score a later candidate has to reach to be returned: the score of the last of the
 // FindParams::numMatches best level-0 candidates that reach the minimum score and do not overlap
-// each other (as the finish picks them). FindParams::minScore while there are fewer.
+// each other (as the finish picks them). FindParams::minScore while there are fewer. Such a
+// candidate is returned unless the finish scores it below the minimum: its score is then the
+// better of the refined and the interpolated pose's (refinement_choice.hpp), close to its
+// level-0 one.
 double scoreToBeat(std::vector<Candidate> candidates, const Box& box, const FindParams& params) {
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
