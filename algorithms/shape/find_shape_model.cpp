@@ -342,16 +342,37 @@ void addSymmetricTurns(std::vector<Candidate>& candidates, const ShapeModel& mod
 
 // Candidates of the top level tracked down the pyramid to level 0.
 struct Tracker {
+  Tracker(std::vector<DirectionField>& fields, const ShapeModel& model, const FindParams& params,
+          const LevelSearch& base, int top)
+      : fields(fields), model(model), params(params), base(base), top(top) {
+    // How far around a candidate each level's directions are needed: the model's reach there.
+    for (int l = 0; l < top; ++l) {
+      double radius = 0.0;
+      for (const auto& p : model.levels[l].points)
+        radius = std::max(radius, std::hypot(double(p.position.x), double(p.position.y)));
+      reach.push_back(static_cast<int>(std::ceil(radius * base.scaleMax)) + 16 +
+                      spreadOnLevel(params.maxDeformation, l));
+    }
+  }
+
   std::vector<DirectionField>& fields;
   const ShapeModel& model;
   const FindParams& params;
   const LevelSearch& base;  // angles, scales, polarity, greediness
   int top;
+  std::vector<int> reach;  // per level below the top, pixels of the level
 
-  // The candidates that hold on every level: on the levels between the top and 0 a part scoring
-  // `minScore` at the end scores at least kMiddleFactor of it, on level 0 before refinement
-  // kFinalFactor. Called with FindParams::minScore, or with a higher score a candidate has to
-  // reach to be returned at all.
+  // The score a candidate must keep on level l: on the levels between the top and 0 a part
+  // scoring `minScore` at the end scores at least kMiddleFactor of it, on level 0 before
+  // refinement kFinalFactor.
+  [[nodiscard]] double threshold(double minScore, int l) const {
+    return minScore * (l > 0                                   ? kMiddleFactor
+                       : params.subpixel == SubpixelMode::None ? 1.0
+                                                               : kFinalFactor);
+  }
+
+  // The candidates that hold on every level (threshold()). Called with FindParams::minScore, or
+  // with a higher score a candidate has to reach to be returned at all.
   std::vector<Candidate> toLevelZero(std::vector<Candidate> candidates, double minScore) const {
     const ShapeLevel& topLevel = model.levels[top];
     LevelSearch search = base;
@@ -360,17 +381,11 @@ struct Tracker {
       search.level = &model.levels[l];
       search.spread = spreadOnLevel(params.maxDeformation, l);
       // Directions are needed only around the candidates.
-      double levelRadius = 0.0;
-      for (const auto& p : model.levels[l].points)
-        levelRadius = std::max(levelRadius, std::hypot(double(p.position.x), double(p.position.y)));
-      const int reach =
-          static_cast<int>(std::ceil(levelRadius * search.scaleMax)) + 16 + search.spread;
+      const int around = reach[static_cast<std::size_t>(l)];
       for (const Candidate& c : candidates)
-        fields[l].ensure(cv::Rect(cvRound(2 * c.x) - reach, cvRound(2 * c.y) - reach, 2 * reach + 1,
-                                  2 * reach + 1));
-      search.minScore = minScore * (l > 0                                   ? kMiddleFactor
-                                    : params.subpixel == SubpixelMode::None ? 1.0
-                                                                            : kFinalFactor);
+        fields[l].ensure(cv::Rect(cvRound(2 * c.x) - around, cvRound(2 * c.y) - around,
+                                  2 * around + 1, 2 * around + 1));
+      search.minScore = threshold(minScore, l);
       // Each candidate is tracked on its own (the field is read-only here), in parallel when
       // threads > 1; kept in their order, so the result is the same for any number of threads.
       // Below the top, a candidate may also leave a second peak (see stepsBelowTop).
@@ -407,10 +422,9 @@ struct Tracker {
           if (r.score >= search.minScore) next.push_back(r);
       candidates.swap(next);
     }
-    if (top == 0) {
-      const double keep = minScore * (params.subpixel == SubpixelMode::None ? 1.0 : kFinalFactor);
-      std::erase_if(candidates, [&](const Candidate& c) { return c.score < keep; });
-    }
+    if (top == 0)
+      std::erase_if(candidates,
+                    [&](const Candidate& c) { return c.score < threshold(minScore, 0); });
     return candidates;
   }
 };
@@ -497,7 +511,7 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   search.polarity = params.polarity;
   search.greediness = params.greediness;
   const Box box = modelBox(model);
-  const Tracker tracker{fields, model, params, search, top};
+  const Tracker tracker(fields, model, params, search, top);
   candidates = tracker.toLevelZero(std::move(candidates), params.minScore);
   if (!later.empty()) {
     const double toBeat = scoreToBeat(candidates, box, params);

@@ -343,10 +343,9 @@ struct FreeRun {
 //
 // A changeover (`--first-parts DIR EXT warm|cold changeover`): the station's folder holds a
 // second recipe (id 8: the bench recipe, its own models loaded, and three tools the first one does
-// not use, kSecondProductSteps), and the sidecars of the
-// frames from the third on name it, as a recording of a product change does. The child prints
-// the inspection time of kChangeoverParts parts, then how long the switch took on the
-// acquisition thread (facet_recipe_switch_ms: the recipe's preparation when it is prepared then).
+// not use, kSecondProductSteps), and the sidecars of the frames from the third on name it, as a
+// recording of a product change does. The child prints how long the switch took on the
+// acquisition thread (facet_recipe_switch_ms), then the inspection time of kChangeoverParts parts.
 constexpr int kFirstParts = 3;
 constexpr int kChangeoverParts = 5;
 constexpr int kChangeoverAt = 2;  // parts of recipe 7 before the switch to recipe 8
@@ -423,16 +422,16 @@ int firstPartsChild(const fs::path& dir, const std::string& extension, bool warm
   service::Station s(station, facetSteps(), options);
   s.start();
   s.join();
-  for (double m : ms) std::printf("%.3f\n", m);
   if (changeover)
     std::printf(
         "%.3f\n",
         s.metrics().gauge("facet_recipe_switch_ms", "Duration of the last recipe switch").value());
+  for (double m : ms) std::printf("%.3f\n", m);
   return static_cast<int>(ms.size()) == parts ? 0 : 1;
 }
 
-// One row per process: the numbers its child printed (inspection ms of the first parts; for a
-// changeover also the switch's ms).
+// One row per process: the numbers its child printed (for a changeover the switch's ms, then the
+// inspection ms of the first parts).
 std::vector<std::vector<double>> firstParts(const std::string& self, const fs::path& dir,
                                             const std::string& extension, bool warmUp,
                                             bool changeover, int processes) {
@@ -461,20 +460,30 @@ struct FirstPartRows {
   std::vector<std::vector<double>> cold, warm, coldChangeover, warmChangeover;
 };
 
+// Rows of processes without the warm-up, then with it: their label, then the numbers in columns
+// of the given widths.
+void printProcessRows(const std::vector<std::vector<double>>& cold,
+                      const std::vector<std::vector<double>>& warm, int labelWidth,
+                      const std::vector<int>& widths) {
+  for (const auto* rows : {&cold, &warm})
+    for (const auto& row : *rows) {
+      std::printf("| %-*s |", labelWidth,
+                  rows == &cold ? "without warm-up (StationOptions::warmUp off)"
+                                : "with warm-up (the default)");
+      for (std::size_t i = 0; i < widths.size() && i < row.size(); ++i)
+        std::printf(" %*.2f |", widths[i], row[i]);
+      std::printf("\n");
+    }
+}
+
 void printFirstParts(const FirstPartRows& r, std::optional<double> freeRunInspect) {
-  const auto& [cold, warm, coldChangeover, warmChangeover] = r;
   std::printf(
       "| first parts of a process, inspect ms (one process a row) | part 1 | part 2 | part 3 "
       "|\n");
   std::printf(
       "| -------------------------------------------------------- | ------ | ------ | ------ "
       "|\n");
-  for (const auto* rows : {&cold, &warm})
-    for (const auto& row : *rows)
-      std::printf("| %-56s | %6.2f | %6.2f | %6.2f |\n",
-                  rows == &cold ? "without warm-up (StationOptions::warmUp off)"
-                                : "with warm-up (the default)",
-                  row[0], row[1], row[2]);
+  printProcessRows(r.cold, r.warm, 56, {6, 6, 6});
   if (freeRunInspect)
     std::printf("(free-run mean inspect of the long run below: %.2f ms)\n", *freeRunInspect);
   std::printf("\n");
@@ -484,12 +493,7 @@ void printFirstParts(const FirstPartRows& r, std::optional<double> freeRunInspec
   std::printf(
       "| -------------------------------------------------------------- | --------- | ------ "
       "| ------ | ------ | ------ | ------ |\n");
-  for (const auto* rows : {&coldChangeover, &warmChangeover})
-    for (const auto& row : *rows)
-      std::printf("| %-62s | %9.2f | %6.2f | %6.2f | %6.2f | %6.2f | %6.2f |\n",
-                  rows == &coldChangeover ? "without warm-up (StationOptions::warmUp off)"
-                                          : "with warm-up (the default)",
-                  row[5], row[0], row[1], row[2], row[3], row[4]);
+  printProcessRows(r.coldChangeover, r.warmChangeover, 62, {9, 6, 6, 6, 6, 6});
   std::printf("(switch ms: the recipe selector's choice of part 3, on the acquisition thread)\n\n");
 }
 
