@@ -65,8 +65,9 @@ struct RegistrationParams {
   // more global inliers is kept. false = plain Harris only.
   bool escalateToAffine = true;
   int affineBelowInliers = 20;
-  // Last step of registerImages for a homography after the re-matching: Levenberg-Marquardt on
-  // the transfer error of the re-matched pairs within finalThreshold (registration_stages.cpp).
+  // Last step of registerImages for a homography after the re-matching: the re-matched pairs
+  // within inlierThreshold fitted by the Cauchy loss of their transfer errors at their own noise
+  // scale (robust_homography.hpp, registration_stages.cpp).
   bool polishHomography = true;
 };
 

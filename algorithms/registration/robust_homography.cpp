@@ -1,0 +1,143 @@
+// Why an M-estimator and not least squares on the pairs within a fixed distance: no homography
+// fits a real lens's view exactly (distortion differs between zoom and focus settings), so
+// the pairs' errors about the best H are a smooth field of a pixel or so, plus the wrong pairs.
+// A fixed tight gate then keeps the part of the view the current H already fits and the fit
+// leans to it; a wide one lets wrong pairs pull. The Cauchy loss at the pairs' own scale weighs
+// every pair by its agreement, smoothly, and needs no threshold.
+#include "algorithms/registration/robust_homography.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+
+#include "algorithms/geometry/projective_map.hpp"
+
+namespace facet {
+namespace {
+
+// The Cauchy loss's scale in units of the noise: 95 % efficiency on Gaussian errors.
+constexpr double kCauchyScale = 2.385;
+constexpr int kReweightings = 6;
+constexpr int kStepsPerWeighting = 3;
+
+// Isotropic normalisation (Hartley): centroid to the origin, mean distance sqrt(2).
+cv::Matx33d normaliser(const std::vector<cv::Point2d>& pts) {
+  cv::Point2d c(0, 0);
+  for (const auto& p : pts) c += p;
+  c *= 1.0 / static_cast<double>(pts.size());
+  double d = 0;
+  for (const auto& p : pts) d += std::hypot(p.x - c.x, p.y - c.y);
+  d /= static_cast<double>(pts.size());
+  const double s = d > 1e-12 ? std::sqrt(2.0) / d : 1.0;
+  return {s, 0, -s * c.x, 0, s, -s * c.y, 0, 0, 1};
+}
+
+using Params = Eigen::Matrix<double, 8, 1>;
+
+cv::Matx33d toMatrix(const Params& h) {
+  return {h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), 1.0};
+}
+
+double weightedCost(const Params& h, const std::vector<cv::Point2d>& a,
+                    const std::vector<cv::Point2d>& b, const std::vector<double>& w) {
+  const cv::Matx33d H = toMatrix(h);
+  double cost = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const cv::Point2d q = mapPoint(H, a[i]) - b[i];
+    cost += w[i] * (q.x * q.x + q.y * q.y);
+  }
+  return std::isfinite(cost) ? cost : std::numeric_limits<double>::infinity();
+}
+
+// Levenberg-Marquardt steps on sum w_i |H a_i - b_i|^2 with the weights held.
+Params minimiseWeighted(Params h, const std::vector<cv::Point2d>& a,
+                        const std::vector<cv::Point2d>& b, const std::vector<double>& w) {
+  double lambda = 1e-3, cost = weightedCost(h, a, b, w);
+  for (int step = 0; step < kStepsPerWeighting; ++step) {
+    Eigen::Matrix<double, 8, 8> A = Eigen::Matrix<double, 8, 8>::Zero();
+    Params g = Params::Zero();
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const double x = a[i].x, y = a[i].y;
+      const double den = h(6) * x + h(7) * y + 1.0;
+      if (std::abs(den) < 1e-12) continue;
+      const double u = (h(0) * x + h(1) * y + h(2)) / den;
+      const double v = (h(3) * x + h(4) * y + h(5)) / den;
+      Eigen::Matrix<double, 2, 8> J;
+      J << x / den, y / den, 1 / den, 0, 0, 0, -u * x / den, -u * y / den,  //
+          0, 0, 0, x / den, y / den, 1 / den, -v * x / den, -v * y / den;
+      const Eigen::Vector2d r(u - b[i].x, v - b[i].y);
+      A.noalias() += w[i] * J.transpose() * J;
+      g.noalias() += w[i] * J.transpose() * r;
+    }
+    for (int tries = 0; tries < 8; ++tries) {
+      Eigen::Matrix<double, 8, 8> damped = A;
+      damped.diagonal() *= 1.0 + lambda;
+      const Params next = h - damped.ldlt().solve(g);
+      const double nextCost = weightedCost(next, a, b, w);
+      if (next.allFinite() && nextCost < cost) {
+        h = next;
+        cost = nextCost;
+        lambda = std::max(lambda / 10, 1e-9);
+        break;
+      }
+      lambda *= 10;
+    }
+  }
+  return h;
+}
+
+// The pairs' noise scale about H (normalised units): from the median transfer error.
+double noiseScale(const Params& h, const std::vector<cv::Point2d>& a,
+                  const std::vector<cv::Point2d>& b, std::vector<double>& errors) {
+  const cv::Matx33d H = toMatrix(h);
+  errors.resize(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const cv::Point2d q = mapPoint(H, a[i]) - b[i];
+    errors[i] = std::hypot(q.x, q.y);
+  }
+  std::vector<double> sorted = errors;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  return sorted[sorted.size() / 2] / std::sqrt(2 * std::log(2.0));
+}
+
+}  // namespace
+
+std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2d>& src,
+                                                    const std::vector<cv::Point2d>& dst,
+                                                    const cv::Matx33d& H0) {
+  if (src.size() < 8 || src.size() != dst.size()) return std::nullopt;
+  const cv::Matx33d Ts = normaliser(src), Td = normaliser(dst);
+  std::vector<cv::Point2d> a(src.size()), b(dst.size());
+  for (std::size_t i = 0; i < src.size(); ++i) {
+    a[i] = mapPoint(Ts, src[i]);
+    b[i] = mapPoint(Td, dst[i]);
+  }
+  const cv::Matx33d Hn0 = Td * H0 * Ts.inv();
+  if (!(std::abs(Hn0(2, 2)) > 1e-12)) return std::nullopt;
+  Params h;
+  for (int k = 0; k < 8; ++k) h(k) = Hn0(k / 3, k % 3) / Hn0(2, 2);
+
+  // A floor on the scale (1e-4 px) keeps exact pairs from giving every weight but one zero.
+  const double pixel = Td(0, 0), floor = 1e-4 * pixel;
+  std::vector<double> errors, w(a.size());
+  for (int round = 0; round < kReweightings; ++round) {
+    const double sigma = std::max(noiseScale(h, a, b, errors), floor);
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      const double t = errors[i] / (kCauchyScale * sigma);
+      w[i] = 1.0 / (1.0 + t * t);
+    }
+    h = minimiseWeighted(h, a, b, w);
+  }
+  if (!h.allFinite()) return std::nullopt;
+  cv::Matx33d H = Td.inv() * toMatrix(h) * Ts;
+  if (!(std::abs(H(2, 2)) > 1e-12)) return std::nullopt;
+  H *= 1.0 / H(2, 2);
+  RobustHomography out;
+  out.H = H;
+  out.noise = std::max(noiseScale(h, a, b, errors), floor) / pixel;
+  return out;
+}
+
+}  // namespace facet
