@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/image/grey_image.hpp"
+#include "algorithms/registration/correlation_peak.hpp"
 #include "algorithms/registration/harris_affine.hpp"
 
 namespace facet {
@@ -146,12 +147,6 @@ cv::Point2d centreOf(const cv::Mat& image) {
   return {(image.cols - 1) / 2.0, (image.rows - 1) / 2.0};
 }
 
-double parabolaPeak(float a, float b, float c) {
-  const double d = a - 2.0 * b + c;
-  if (d >= 0) return 0.0;
-  return std::clamp(0.5 * (a - c) / d, -0.5, 0.5);
-}
-
 // Warp-and-re-match: the reference warped by H is compared, patch by patch around each reference
 // corner's predicted position, with the image; the NCC peak (subpixel) gives the match.
 std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
@@ -195,15 +190,11 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
     cv::minMaxLoc(result, nullptr, &best, nullptr, &loc);
     if (!(best >= params.refineMinScore)) continue;
     if (loc.x <= 0 || loc.y <= 0 || loc.x >= result.cols - 1 || loc.y >= result.rows - 1) continue;
-    const double dx =
-        parabolaPeak(result.at<float>(loc.y, loc.x - 1), result.at<float>(loc.y, loc.x),
-                     result.at<float>(loc.y, loc.x + 1));
-    const double dy =
-        parabolaPeak(result.at<float>(loc.y - 1, loc.x), result.at<float>(loc.y, loc.x),
-                     result.at<float>(loc.y + 1, loc.x));
+    const CorrelationPeak peak = correlationPeak(result, loc);
     FeatureMatch m;
     m.ref = c.pt;
-    m.image = {q.x + (loc.x - R) + dx, q.y + (loc.y - R) + dy};
+    m.image = {q.x + (loc.x - R) + peak.offset.x, q.y + (loc.y - R) + peak.offset.y};
+    m.peakCurvature = peak.curvature;
     m.score = best;
     const cv::Matx22d J = jacobianAt(H, c.pt);
     m.rotationDeg = rotationDegOf(J);

@@ -78,6 +78,9 @@ struct FeatureMatch {
   double score = 0;        // NCC in [-1, 1]
   double rotationDeg = 0;  // rotation ref -> image estimated by this match alone (degrees)
   double scale = 1;        // scale ref -> image estimated by this match alone
+  // Re-matched pairs: minus the Hessian of the NCC surface at its peak (per image pixel^2), how
+  // sharply the pair is located in each direction; zero for the other matches.
+  cv::Matx22d peakCurvature = cv::Matx22d::zeros();
 };
 
 struct RegistrationResult {

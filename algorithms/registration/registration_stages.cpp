@@ -20,13 +20,19 @@ namespace {
 // error over the pairs within finalThreshold, which weights them unevenly across the image
 // and, on a real lens, keeps only the part of the view that fits best.
 void polishHomography(RegistrationResult& r, const RegistrationParams& params) {
+  // Each pair counts by how sharply its correlation peak locates it in each direction, as far
+  // as that and not an error all pairs share limits it (robust_homography.cpp); a pair whose
+  // surface is no peak (a ridge, a plateau) is left out.
   std::vector<cv::Point2d> src, dst;
+  std::vector<cv::Matx22d> sharpness;
   for (const FeatureMatch& m : r.matches)
-    if (transferError(r.H, m.ref, m.image) <= params.inlierThreshold) {
+    if (transferError(r.H, m.ref, m.image) <= params.inlierThreshold &&
+        cv::determinant(m.peakCurvature) > 0) {
       src.push_back(m.ref);
       dst.push_back(m.image);
+      sharpness.push_back(m.peakCurvature);
     }
-  const std::optional<RobustHomography> fit = fitHomographyCauchy(src, dst, r.H);
+  const std::optional<RobustHomography> fit = fitHomographyCauchy(src, dst, r.H, sharpness);
   if (!fit) return;
   std::vector<int> inliers;
   for (std::size_t i = 0; i < r.matches.size(); ++i)

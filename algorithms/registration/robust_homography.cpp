@@ -40,21 +40,26 @@ cv::Matx33d toMatrix(const Params& h) {
   return {h(0), h(1), h(2), h(3), h(4), h(5), h(6), h(7), 1.0};
 }
 
+// r' L r: the squared transfer error in the pair's own metric.
+double quadratic(const cv::Matx22d& L, cv::Point2d r) {
+  return L(0, 0) * r.x * r.x + 2 * L(0, 1) * r.x * r.y + L(1, 1) * r.y * r.y;
+}
+
 double weightedCost(const Params& h, const std::vector<cv::Point2d>& a,
-                    const std::vector<cv::Point2d>& b, const std::vector<double>& w) {
+                    const std::vector<cv::Point2d>& b, const std::vector<cv::Matx22d>& metric,
+                    const std::vector<double>& w) {
   const cv::Matx33d H = toMatrix(h);
   double cost = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const cv::Point2d q = mapPoint(H, a[i]) - b[i];
-    cost += w[i] * (q.x * q.x + q.y * q.y);
-  }
+  for (std::size_t i = 0; i < a.size(); ++i)
+    cost += w[i] * quadratic(metric[i], mapPoint(H, a[i]) - b[i]);
   return std::isfinite(cost) ? cost : std::numeric_limits<double>::infinity();
 }
 
-// Levenberg-Marquardt steps on sum w_i |H a_i - b_i|^2 with the weights held.
+// Levenberg-Marquardt steps on sum w_i r_i' M_i r_i (r_i = H a_i - b_i) with the weights held.
 Params minimiseWeighted(Params h, const std::vector<cv::Point2d>& a,
-                        const std::vector<cv::Point2d>& b, const std::vector<double>& w) {
-  double lambda = 1e-3, cost = weightedCost(h, a, b, w);
+                        const std::vector<cv::Point2d>& b, const std::vector<cv::Matx22d>& metric,
+                        const std::vector<double>& w) {
+  double lambda = 1e-3, cost = weightedCost(h, a, b, metric, w);
   for (int step = 0; step < kStepsPerWeighting; ++step) {
     Eigen::Matrix<double, 8, 8> A = Eigen::Matrix<double, 8, 8>::Zero();
     Params g = Params::Zero();
@@ -68,14 +73,16 @@ Params minimiseWeighted(Params h, const std::vector<cv::Point2d>& a,
       J << x / den, y / den, 1 / den, 0, 0, 0, -u * x / den, -u * y / den,  //
           0, 0, 0, x / den, y / den, 1 / den, -v * x / den, -v * y / den;
       const Eigen::Vector2d r(u - b[i].x, v - b[i].y);
-      A.noalias() += w[i] * J.transpose() * J;
-      g.noalias() += w[i] * J.transpose() * r;
+      Eigen::Matrix2d M;
+      M << metric[i](0, 0), metric[i](0, 1), metric[i](1, 0), metric[i](1, 1);
+      A.noalias() += w[i] * J.transpose() * M * J;
+      g.noalias() += w[i] * J.transpose() * M * r;
     }
     for (int tries = 0; tries < 8; ++tries) {
       Eigen::Matrix<double, 8, 8> damped = A;
       damped.diagonal() *= 1.0 + lambda;
       const Params next = h - damped.ldlt().solve(g);
-      const double nextCost = weightedCost(next, a, b, w);
+      const double nextCost = weightedCost(next, a, b, metric, w);
       if (next.allFinite() && nextCost < cost) {
         h = next;
         cost = nextCost;
@@ -88,26 +95,90 @@ Params minimiseWeighted(Params h, const std::vector<cv::Point2d>& a,
   return h;
 }
 
-// The pairs' noise scale about H (normalised units): from the median transfer error.
+// The pairs' noise scale about H: from the median transfer error in the pairs' metric.
 double noiseScale(const Params& h, const std::vector<cv::Point2d>& a,
-                  const std::vector<cv::Point2d>& b, std::vector<double>& errors) {
+                  const std::vector<cv::Point2d>& b, const std::vector<cv::Matx22d>& metric,
+                  std::vector<double>& errors) {
   const cv::Matx33d H = toMatrix(h);
   errors.resize(a.size());
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    const cv::Point2d q = mapPoint(H, a[i]) - b[i];
-    errors[i] = std::hypot(q.x, q.y);
-  }
+  for (std::size_t i = 0; i < a.size(); ++i)
+    errors[i] = std::sqrt(std::max(0.0, quadratic(metric[i], mapPoint(H, a[i]) - b[i])));
   std::vector<double> sorted = errors;
   std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
   return sorted[sorted.size() / 2] / std::sqrt(2 * std::log(2.0));
+}
+
+// Each pair's error has two parts: its location's noise, shaped by its correlation peak
+// (spread_i), and what no homography follows, the same for every pair (a lens's distortion, the
+// scene's relief): covariance a * spread_i + b * I. Which of the two dominates differs from view
+// to view (an exact warp has none of the second; a zoom lens much), so the ratio b / a is the
+// one of a grid that makes the pairs' errors about H most likely (Gaussian, the scale a at its
+// maximum-likelihood value), on the pairs within three noise scales. The metrics are the
+// inverse covariances.
+std::vector<cv::Matx22d> pairMetrics(const Params& h, const std::vector<cv::Point2d>& a,
+                                     const std::vector<cv::Point2d>& b,
+                                     const std::vector<cv::Matx22d>& spread) {
+  const cv::Matx33d H = toMatrix(h);
+  std::vector<cv::Point2d> r(a.size());
+  std::vector<double> length(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    r[i] = mapPoint(H, a[i]) - b[i];
+    length[i] = std::hypot(r[i].x, r[i].y);
+  }
+  std::vector<double> sorted = length;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double core = 3 * sorted[sorted.size() / 2] / std::sqrt(2 * std::log(2.0));
+  const auto covariance = [&](std::size_t i, double ratio) {
+    return std::isinf(ratio) ? cv::Matx22d::eye() : spread[i] + ratio * cv::Matx22d::eye();
+  };
+  double bestRatio = std::numeric_limits<double>::infinity(), best = -1e300;
+  for (int k = -7; k <= 7; ++k) {
+    const double ratio = k == 7 ? std::numeric_limits<double>::infinity() : std::pow(10.0, k / 2.0);
+    double mahalanobis = 0, logDet = 0;
+    int n = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      if (!(length[i] <= core)) continue;
+      const cv::Matx22d c = covariance(i, ratio);
+      mahalanobis += quadratic(c.inv(), r[i]);
+      logDet += std::log(cv::determinant(c));
+      ++n;
+    }
+    if (n < 8 || !(mahalanobis > 0)) continue;
+    const double scale = mahalanobis / (2 * n);
+    const double likelihood = -n * std::log(scale) - 0.5 * logDet;
+    if (likelihood > best) {
+      best = likelihood;
+      bestRatio = ratio;
+    }
+  }
+  std::vector<cv::Matx22d> metric(a.size());
+  for (std::size_t i = 0; i < a.size(); ++i) metric[i] = covariance(i, bestRatio).inv();
+  return metric;
 }
 
 }  // namespace
 
 std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2d>& src,
                                                     const std::vector<cv::Point2d>& dst,
-                                                    const cv::Matx33d& H0) {
+                                                    const cv::Matx33d& H0,
+                                                    const std::vector<cv::Matx22d>& sharpness) {
   if (src.size() < 8 || src.size() != dst.size()) return std::nullopt;
+  if (!sharpness.empty() && sharpness.size() != src.size()) return std::nullopt;
+  // Each pair's spread (the inverse of its sharpness), scaled so that the median pair's is 1 px^2
+  // a direction: the noise floor below then keeps its meaning.
+  std::vector<cv::Matx22d> spread;
+  if (!sharpness.empty()) {
+    std::vector<double> traces;
+    for (const cv::Matx22d& m : sharpness) {
+      if (!(cv::determinant(m) > 0)) return std::nullopt;
+      spread.push_back(m.inv());
+      traces.push_back(cv::trace(spread.back()) / 2);
+    }
+    std::nth_element(traces.begin(), traces.begin() + traces.size() / 2, traces.end());
+    const double typical = traces[traces.size() / 2];
+    for (cv::Matx22d& c : spread) c *= 1.0 / typical;
+  }
+  std::vector<cv::Matx22d> metric(src.size(), cv::Matx22d::eye());
   const cv::Matx33d Ts = normaliser(src), Td = normaliser(dst);
   std::vector<cv::Point2d> a(src.size()), b(dst.size());
   for (std::size_t i = 0; i < src.size(); ++i) {
@@ -123,12 +194,13 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
   const double pixel = Td(0, 0), floor = 1e-4 * pixel;
   std::vector<double> errors, w(a.size());
   for (int round = 0; round < kReweightings; ++round) {
-    const double sigma = std::max(noiseScale(h, a, b, errors), floor);
+    if (!spread.empty()) metric = pairMetrics(h, a, b, spread);
+    const double sigma = std::max(noiseScale(h, a, b, metric, errors), floor);
     for (std::size_t i = 0; i < a.size(); ++i) {
       const double t = errors[i] / (kCauchyScale * sigma);
       w[i] = 1.0 / (1.0 + t * t);
     }
-    h = minimiseWeighted(h, a, b, w);
+    h = minimiseWeighted(h, a, b, metric, w);
   }
   if (!h.allFinite()) return std::nullopt;
   cv::Matx33d H = Td.inv() * toMatrix(h) * Ts;
@@ -136,7 +208,7 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
   H *= 1.0 / H(2, 2);
   RobustHomography out;
   out.H = H;
-  out.noise = std::max(noiseScale(h, a, b, errors), floor) / pixel;
+  out.noise = std::max(noiseScale(h, a, b, metric, errors), floor) / pixel;
   return out;
 }
 

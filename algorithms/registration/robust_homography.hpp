@@ -10,15 +10,20 @@ namespace facet {
 
 struct RobustHomography {
   cv::Matx33d H = cv::Matx33d::eye();  // src -> dst, H(2,2) == 1
-  double noise = 0;                    // pixels: the pairs' scale about H (see below)
+  double noise = 0;  // pixels (about, for a typical pair with sharpness): the scale about H
 };
 
-// Minimises the Cauchy loss of the transfer errors |H src - dst| by iteratively re-weighted
+// Minimises the Cauchy loss of the transfer errors H src - dst by iteratively re-weighted
 // Levenberg-Marquardt from H0. The loss's scale is the pairs' own noise, re-estimated about each
 // new H from the median transfer error (that of a 2D Gaussian is sigma * sqrt(2 ln 2)).
-// nullopt when the pairs are too few (< 8) or the fit degenerates.
+// `sharpness`, when given (one positive definite 2x2 per pair, e.g. the curvature of its
+// correlation peak), measures each pair's error in its own metric (r' S r, scaled so that the
+// median pair's is about its squared length in pixels): a pair located sharply across an edge
+// and loosely along it counts across and hardly along. nullopt when the pairs are too few (< 8),
+// the sharpness does not fit them, or the fit degenerates.
 std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2d>& src,
                                                     const std::vector<cv::Point2d>& dst,
-                                                    const cv::Matx33d& H0);
+                                                    const cv::Matx33d& H0,
+                                                    const std::vector<cv::Matx22d>& sharpness = {});
 
 }  // namespace facet

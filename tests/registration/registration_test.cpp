@@ -87,6 +87,22 @@ TEST(RegisterImages, AMagnifiedImageIsReMatchedAtItsOwnDensity) {
   }
 }
 
+// A view magnified 1.6 times and turned 70 degrees: the re-matched correlation peaks are broad
+// and their axes turned, where a parabola along x and one along y miss the peak
+// (correlation_peak.hpp). Over six scenes the corner error was 0.037 px with those parabolas.
+TEST(RegisterImages, AMagnifiedTurnedViewIsLocatedToAFewHundredthsOfAPixel) {
+  double sum = 0;
+  for (int seed = 1; seed <= 6; ++seed) {
+    const cv::Mat ref = texturedScene({400, 400}, 20 + seed);
+    const cv::Matx33d truth = similarity(70.0, 1.6, {199.5, 199.5}, {199.5, 199.5});
+    const cv::Mat image = warp(ref, truth, {400, 400});
+    const RegistrationResult r = registerImages(ref, image, {});
+    ASSERT_TRUE(r.status.ok()) << "scene " << seed << ": " << r.status.message;
+    sum += cornerError(r.H, truth, ref.size());
+  }
+  EXPECT_LT(sum / 6, 0.03);
+}
+
 // The corner detection keeps its images with the thread from call to call (harris_corners.cpp);
 // a smaller image then lies inside buffers a larger one filled. The result must be the one a
 // thread that never registered anything gets. Filtered as part of the larger buffer, a faint

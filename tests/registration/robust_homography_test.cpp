@@ -92,6 +92,55 @@ TEST(FitHomographyCauchy, ALensTheHomographyCannotFollowIsFittedOverTheWholeView
   EXPECT_LT(cornerError(fit->H, whole), 0.5 * cornerError(part, whole));
 }
 
+// Pairs located sharply in one direction and loosely in the other (edges at random angles):
+// 0.02 px across, 0.5 px along.
+void edgePairs(std::vector<cv::Point2d>& src, std::vector<cv::Point2d>& dst,
+               std::vector<cv::Matx22d>& sharpness, std::mt19937& rng) {
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::uniform_real_distribution<double> turn(0, CV_PI);
+  const double across = 0.02, along = 0.5;
+  for (int y = 10; y < kView.height; y += 20)
+    for (int x = 10; x < kView.width; x += 20) {
+      const double a = turn(rng);
+      const cv::Point2d u(std::cos(a), std::sin(a)), n(-u.y, u.x);
+      src.emplace_back(x, y);
+      dst.push_back(mapPoint(kTruth, {double(x), double(y)}) + u * (along * unit(rng)) +
+                    n * (across * unit(rng)));
+      const cv::Matx21d U(u.x, u.y), N(n.x, n.y);
+      sharpness.push_back(U * U.t() * (1 / (along * along)) + N * N.t() * (1 / (across * across)));
+    }
+}
+
+TEST(FitHomographyCauchy, EachPairCountsInTheDirectionItIsLocatedIn) {
+  std::mt19937 rng(7);
+  std::vector<cv::Point2d> src, dst;
+  std::vector<cv::Matx22d> sharpness;
+  edgePairs(src, dst, sharpness, rng);
+  const auto plain = fitHomographyCauchy(src, dst, kTruth);
+  const auto shaped = fitHomographyCauchy(src, dst, kTruth, sharpness);
+  ASSERT_TRUE(plain && shaped);
+  EXPECT_LT(cornerError(shaped->H, kTruth), cornerError(plain->H, kTruth) / 3);
+}
+
+TEST(FitHomographyCauchy, AnErrorAllPairsShareOutweighsTheirSharpness) {
+  // The bent lens again, the pairs now with sharpness, sharp on the left third of the view
+  // (where the texture is) and loose elsewhere: what no homography follows is the same for all
+  // of them and much larger than their location's noise, so they must count about equally, as
+  // without sharpness, and not by how sharp their peaks are (the fit would lean to the left).
+  std::mt19937 rng(5);
+  std::vector<cv::Point2d> src, dst;
+  gridPairs(1.5, 0.05, src, dst, rng);
+  std::vector<cv::Matx22d> sharpness;
+  for (const cv::Point2d& p : src)
+    sharpness.push_back(cv::Matx22d::eye() * (p.x < kView.width / 3 ? 400.0 : 1.0));
+  std::vector<cv::Point2f> s(src.begin(), src.end()), d(dst.begin(), dst.end());
+  const cv::Matx33d whole(cv::findHomography(s, d, 0));
+  const auto plain = fitHomographyCauchy(src, dst, kTruth);
+  const auto shaped = fitHomographyCauchy(src, dst, kTruth, sharpness);
+  ASSERT_TRUE(plain && shaped);
+  EXPECT_LT(cornerError(shaped->H, whole), 1.2 * cornerError(plain->H, whole) + 0.01);
+}
+
 TEST(FitHomographyCauchy, TooFewPairsGiveNoFit) {
   std::vector<cv::Point2d> src{{0, 0}, {10, 0}, {0, 10}, {10, 10}, {5, 5}};
   EXPECT_FALSE(fitHomographyCauchy(src, src, cv::Matx33d::eye()));
