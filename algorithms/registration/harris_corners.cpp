@@ -23,18 +23,30 @@ struct ScaleLevel {
 // system after the level and its pages faulted in again on the next use (a registration of such
 // a frame allocated 440 MB and spent most of its 470 ms in page faults on this machine). The
 // buffers stay with the thread: about 100 MB for a 1280x1024 frame, what one detection needs.
+// A thread keeps at most kKeptImageBytes; an image that would take it beyond is the caller's
+// own, allocated afresh (a 4096x3000 frame would keep about 1 GB a thread, and a daemon's
+// stations each have one).
 class KeptImages {
  public:
   cv::Mat view(std::size_t slot, cv::Size size, int type) {
     if (buffers_.size() <= slot) buffers_.resize(slot + 1);
     cv::Mat& b = buffers_[slot];
-    if (b.type() != type || b.cols < size.width || b.rows < size.height)
-      b.create(std::max(b.rows, size.height), std::max(b.cols, size.width), type);
+    if (b.type() == type && b.cols >= size.width && b.rows >= size.height)
+      return b(cv::Rect(cv::Point(), size));
+    const cv::Size grown(std::max(b.cols, size.width), std::max(b.rows, size.height));
+    const std::size_t bytes = static_cast<std::size_t>(grown.area()) * CV_ELEM_SIZE(type);
+    if (bytes > kKeptImageBytes - (total_ - bytesOf(b))) return cv::Mat(size, type);
+    total_ -= bytesOf(b);
+    b.create(grown, type);
+    total_ += bytes;
     return b(cv::Rect(cv::Point(), size));
   }
+  std::size_t bytes() const { return total_; }
 
  private:
+  static std::size_t bytesOf(const cv::Mat& m) { return m.empty() ? 0 : m.total() * m.elemSize(); }
   std::vector<cv::Mat> buffers_;
+  std::size_t total_ = 0;
 };
 
 KeptImages& keptImages() {
@@ -156,6 +168,10 @@ void detectAtLevel(const Neighbour& below, const ScaleLevel& level, const Neighb
 }
 
 }  // namespace
+
+std::size_t keptCornerImageBytes() {
+  return keptImages().bytes();
+}
 
 std::vector<HarrisCorner> spreadCorners(const std::vector<HarrisCorner>& corners, int count,
                                         double robustness) {

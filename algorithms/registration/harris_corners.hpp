@@ -9,6 +9,7 @@
 // stronger corner, and the `maxCorners` with the largest radii are kept, which spreads them
 // over the image instead of clustering them on the most textured part.
 
+#include <cstddef>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -49,6 +50,12 @@ std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisP
 // and border of `params`.
 std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
                                            const HarrisParams& params = {});
+
+// The corner detection keeps its images with the calling thread from call to call (a large
+// frame's pages are then not faulted in afresh each time), up to kKeptImageBytes; larger
+// detections allocate what goes beyond. What the calling thread keeps now, in bytes.
+inline constexpr std::size_t kKeptImageBytes = std::size_t{256} << 20;
+std::size_t keptCornerImageBytes();
 
 // Adaptive non-maximal suppression: keeps `count` corners with the largest suppression radii.
 std::vector<HarrisCorner> spreadCorners(const std::vector<HarrisCorner>& corners, int count,

@@ -1,6 +1,8 @@
 // Log-polar windows and their NCC: shifts mean rotation/scale, accelerations change nothing.
 #include <cmath>
 
+#include <thread>
+
 #include <gtest/gtest.h>
 
 #include "algorithms/registration/harris_corners.hpp"
@@ -132,6 +134,24 @@ TEST(HarrisCorners, BudgetAndSpreading) {
   for (int q : quadrant) EXPECT_GE(q, 10);
   // A flat image has none.
   EXPECT_TRUE(detectHarrisCorners(cv::Mat(100, 100, CV_32F, cv::Scalar(0.5)), hp).empty());
+}
+
+// A 3000x2000 detection passes through more full-size images than a thread keeps: it keeps up to
+// its limit, allocates the rest, and finds the same corners the next time, partly in kept
+// buffers, as the first.
+TEST(HarrisCorners, AThreadKeepsNoMoreThanItsLimitForALargeFrame) {
+  const cv::Mat f = toFloat(testing::texturedScene({3000, 2000}, 4, 2000));
+  std::size_t kept = 0;
+  std::vector<HarrisCorner> first, second;
+  std::thread([&] {
+    first = detectHarrisCorners(f);
+    kept = keptCornerImageBytes();
+    second = detectHarrisCorners(f);
+  }).join();
+  EXPECT_GT(kept, kKeptImageBytes / 2);
+  EXPECT_LE(kept, kKeptImageBytes);
+  ASSERT_EQ(first.size(), second.size());
+  for (std::size_t i = 0; i < first.size(); ++i) EXPECT_EQ(first[i].pt, second[i].pt);
 }
 
 }  // namespace
