@@ -9,9 +9,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <Eigen/Dense>
 
+#include "algorithms/geometry/levenberg_marquardt.hpp"
+#include "algorithms/geometry/point_normaliser.hpp"
 #include "algorithms/geometry/projective_map.hpp"
 
 namespace facet {
@@ -19,20 +22,7 @@ namespace {
 
 // The Cauchy loss's scale in units of the noise: 95 % efficiency on Gaussian errors.
 constexpr double kCauchyScale = 2.385;
-constexpr int kReweightings = 6;
-constexpr int kStepsPerWeighting = 3;
-
-// Isotropic normalisation (Hartley): centroid to the origin, mean distance sqrt(2).
-cv::Matx33d normaliser(const std::vector<cv::Point2d>& pts) {
-  cv::Point2d c(0, 0);
-  for (const auto& p : pts) c += p;
-  c *= 1.0 / static_cast<double>(pts.size());
-  double d = 0;
-  for (const auto& p : pts) d += std::hypot(p.x - c.x, p.y - c.y);
-  d /= static_cast<double>(pts.size());
-  const double s = d > 1e-12 ? std::sqrt(2.0) / d : 1.0;
-  return {s, 0, -s * c.x, 0, s, -s * c.y, 0, 0, 1};
-}
+constexpr int kMaxSteps = 20;
 
 using Params = Eigen::Matrix<double, 8, 1>;
 
@@ -55,44 +45,27 @@ double weightedCost(const Params& h, const std::vector<cv::Point2d>& a,
   return std::isfinite(cost) ? cost : std::numeric_limits<double>::infinity();
 }
 
-// Levenberg-Marquardt steps on sum w_i r_i' M_i r_i (r_i = H a_i - b_i) with the weights held.
-Params minimiseWeighted(Params h, const std::vector<cv::Point2d>& a,
-                        const std::vector<cv::Point2d>& b, const std::vector<cv::Matx22d>& metric,
-                        const std::vector<double>& w) {
-  double lambda = 1e-3, cost = weightedCost(h, a, b, metric, w);
-  for (int step = 0; step < kStepsPerWeighting; ++step) {
-    Eigen::Matrix<double, 8, 8> A = Eigen::Matrix<double, 8, 8>::Zero();
-    Params g = Params::Zero();
-    for (std::size_t i = 0; i < a.size(); ++i) {
-      const double x = a[i].x, y = a[i].y;
-      const double den = h(6) * x + h(7) * y + 1.0;
-      if (std::abs(den) < 1e-12) continue;
-      const double u = (h(0) * x + h(1) * y + h(2)) / den;
-      const double v = (h(3) * x + h(4) * y + h(5)) / den;
-      Eigen::Matrix<double, 2, 8> J;
-      J << x / den, y / den, 1 / den, 0, 0, 0, -u * x / den, -u * y / den,  //
-          0, 0, 0, x / den, y / den, 1 / den, -v * x / den, -v * y / den;
-      const Eigen::Vector2d r(u - b[i].x, v - b[i].y);
-      Eigen::Matrix2d M;
-      M << metric[i](0, 0), metric[i](0, 1), metric[i](1, 0), metric[i](1, 1);
-      A.noalias() += w[i] * J.transpose() * M * J;
-      g.noalias() += w[i] * J.transpose() * M * r;
-    }
-    for (int tries = 0; tries < 8; ++tries) {
-      Eigen::Matrix<double, 8, 8> damped = A;
-      damped.diagonal() *= 1.0 + lambda;
-      const Params next = h - damped.ldlt().solve(g);
-      const double nextCost = weightedCost(next, a, b, metric, w);
-      if (next.allFinite() && nextCost < cost) {
-        h = next;
-        cost = nextCost;
-        lambda = std::max(lambda / 10, 1e-9);
-        break;
-      }
-      lambda *= 10;
-    }
+// J' W J and J' W r of sum w_i r_i' M_i r_i (r_i = H a_i - b_i) at h.
+void normalEquations(const Params& h, const std::vector<cv::Point2d>& a,
+                     const std::vector<cv::Point2d>& b, const std::vector<cv::Matx22d>& metric,
+                     const std::vector<double>& w, Eigen::Matrix<double, 8, 8>& jtj, Params& jtr) {
+  jtj.setZero();
+  jtr.setZero();
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const double x = a[i].x, y = a[i].y;
+    const double den = h(6) * x + h(7) * y + 1.0;
+    if (std::abs(den) < 1e-12) continue;
+    const double u = (h(0) * x + h(1) * y + h(2)) / den;
+    const double v = (h(3) * x + h(4) * y + h(5)) / den;
+    Eigen::Matrix<double, 2, 8> J;
+    J << x / den, y / den, 1 / den, 0, 0, 0, -u * x / den, -u * y / den,  //
+        0, 0, 0, x / den, y / den, 1 / den, -v * x / den, -v * y / den;
+    const Eigen::Vector2d r(u - b[i].x, v - b[i].y);
+    Eigen::Matrix2d M;
+    M << metric[i](0, 0), metric[i](0, 1), metric[i](1, 0), metric[i](1, 1);
+    jtj.noalias() += w[i] * J.transpose() * M * J;
+    jtr.noalias() += w[i] * J.transpose() * M * r;
   }
-  return h;
 }
 
 // The pairs' noise scale about H: from the median transfer error in the pairs' metric.
@@ -179,7 +152,7 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
     for (cv::Matx22d& c : spread) c *= 1.0 / typical;
   }
   std::vector<cv::Matx22d> metric(src.size(), cv::Matx22d::eye());
-  const cv::Matx33d Ts = normaliser(src), Td = normaliser(dst);
+  const cv::Matx33d Ts = pointNormaliser(src), Td = pointNormaliser(dst);
   std::vector<cv::Point2d> a(src.size()), b(dst.size());
   for (std::size_t i = 0; i < src.size(); ++i) {
     a[i] = mapPoint(Ts, src[i]);
@@ -193,15 +166,36 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
   // A floor on the scale (1e-4 px) keeps exact pairs from giving every weight but one zero.
   const double pixel = Td(0, 0), floor = 1e-4 * pixel;
   std::vector<double> errors, w(a.size());
-  for (int round = 0; round < kReweightings; ++round) {
-    if (!spread.empty()) metric = pairMetrics(h, a, b, spread);
-    const double sigma = std::max(noiseScale(h, a, b, metric, errors), floor);
+  // Iteratively re-weighted: each Levenberg-Marquardt step starts from the metrics and Cauchy
+  // weights of the pairs about the current H; the fit stops where no step lowers the cost
+  // under the weights of its own H.
+  const auto reweight = [&](const Params& x) {
+    if (!spread.empty()) metric = pairMetrics(x, a, b, spread);
+    const double sigma = std::max(noiseScale(x, a, b, metric, errors), floor);
     for (std::size_t i = 0; i < a.size(); ++i) {
       const double t = errors[i] / (kCauchyScale * sigma);
       w[i] = 1.0 / (1.0 + t * t);
     }
-    h = minimiseWeighted(h, a, b, metric, w);
-  }
+  };
+  const auto cost = [&](const Params& x) { return weightedCost(x, a, b, metric, w); };
+  LevenbergMarquardtCallbacks problem{
+      cost,
+      [&](int, const Params& x, Eigen::Matrix<double, 8, 8>& jtj, Params& jtr, double& current) {
+        reweight(x);
+        current = cost(x);
+        normalEquations(x, a, b, metric, w, jtj, jtr);
+      },
+      [&](const Params& x) -> std::optional<double> {
+        const double c = cost(x);
+        if (!std::isfinite(c)) return std::nullopt;
+        return c;
+      },
+      [] {}, [](int, const Params&) { return false; }};
+  LevenbergMarquardtSettings settings;
+  settings.maxIterations = kMaxSteps;
+  reweight(h);
+  if (levenbergMarquardt<8>(problem, h, settings) == LevenbergMarquardtStop::NonFiniteStep)
+    return std::nullopt;
   if (!h.allFinite()) return std::nullopt;
   cv::Matx33d H = Td.inv() * toMatrix(h) * Ts;
   if (!(std::abs(H(2, 2)) > 1e-12)) return std::nullopt;

@@ -7,6 +7,7 @@
 
 #include <Eigen/Dense>
 
+#include "algorithms/geometry/point_normaliser.hpp"
 #include "algorithms/geometry/projective_map.hpp"
 #include "algorithms/geometry/ransac.hpp"
 #include "algorithms/geometry/similarity_fit.hpp"
@@ -26,23 +27,11 @@ int minimalSample(TransformModel model) {
   return 4;
 }
 
-// Isotropic normalisation (Hartley): centroid to the origin, mean distance sqrt(2).
-cv::Matx33d normaliser(const std::vector<cv::Point2d>& pts) {
-  cv::Point2d c(0, 0);
-  for (const auto& p : pts) c += p;
-  c *= 1.0 / static_cast<double>(pts.size());
-  double d = 0;
-  for (const auto& p : pts) d += std::hypot(p.x - c.x, p.y - c.y);
-  d /= static_cast<double>(pts.size());
-  const double s = d > 1e-12 ? std::sqrt(2.0) / d : 1.0;
-  return {s, 0, -s * c.x, 0, s, -s * c.y, 0, 0, 1};
-}
-
 std::optional<cv::Matx33d> fitNormalised(const std::vector<cv::Point2d>& src,
                                          const std::vector<cv::Point2d>& dst,
                                          TransformModel model) {
   const int n = static_cast<int>(src.size());
-  const cv::Matx33d Ts = normaliser(src), Td = normaliser(dst);
+  const cv::Matx33d Ts = pointNormaliser(src), Td = pointNormaliser(dst);
   std::vector<cv::Point2d> a(n), b(n);
   for (int i = 0; i < n; ++i) {
     a[i] = mapPoint(Ts, src[i]);
