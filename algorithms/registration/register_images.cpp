@@ -10,6 +10,7 @@
 #include "algorithms/image/grey_image.hpp"
 #include "algorithms/registration/correlation_peak.hpp"
 #include "algorithms/registration/harris_affine.hpp"
+#include "algorithms/registration/rotation_scale_vote.hpp"
 
 namespace facet {
 namespace {
@@ -86,48 +87,6 @@ cv::Matx22d localMap(const AffineRegion& ref, const AffineRegion& img, const Win
   const double a = 2.0 * std::numbers::pi * s.angleShift / lp.angles;
   const cv::Matx22d rot(std::cos(a), -std::sin(a), std::sin(a), std::cos(a));
   return std::pow(lp.ringRatio, s.ringShift) * img.shape * rot * ref.shape.inv();
-}
-
-// Keeps the matches whose own rotation and scale agree with the dominant ones.
-std::vector<int> pruneByRotationScale(const std::vector<FeatureMatch>& m,
-                                      const RegistrationParams& params) {
-  std::vector<int> keep(m.size());
-  for (std::size_t i = 0; i < m.size(); ++i) keep[i] = static_cast<int>(i);
-  if (params.pruneRotationDeg <= 0 || m.size() < 8) return keep;
-  constexpr int kBins = 36;
-  std::vector<int> hist(kBins, 0);
-  auto binOf = [](double deg) {
-    const int b = static_cast<int>(std::floor((deg + 180.0) / 10.0));
-    return ((b % kBins) + kBins) % kBins;
-  };
-  for (const auto& x : m) ++hist[binOf(x.rotationDeg)];
-  int peak = 0, peakVotes = -1;
-  for (int b = 0; b < kBins; ++b) {
-    const int votes = hist[(b + kBins - 1) % kBins] + hist[b] + hist[(b + 1) % kBins];
-    if (votes > peakVotes) {
-      peakVotes = votes;
-      peak = b;
-    }
-  }
-  const double peakDeg = peak * 10.0 - 175.0;
-  std::vector<double> logScales;
-  std::vector<int> rotKept;
-  for (std::size_t i = 0; i < m.size(); ++i) {
-    const double d = std::abs(std::remainder(m[i].rotationDeg - peakDeg, 360.0));
-    if (d <= params.pruneRotationDeg) {
-      rotKept.push_back(static_cast<int>(i));
-      logScales.push_back(std::log2(m[i].scale));
-    }
-  }
-  if (rotKept.empty()) return keep;
-  std::vector<double> sorted = logScales;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double median = sorted[sorted.size() / 2];
-  keep.clear();
-  for (std::size_t k = 0; k < rotKept.size(); ++k)
-    if (params.pruneLog2Scale <= 0 || std::abs(logScales[k] - median) <= params.pruneLog2Scale)
-      keep.push_back(rotKept[k]);
-  return keep;
 }
 
 cv::Matx22d jacobianAt(const cv::Matx33d& H, cv::Point2d p) {
@@ -250,7 +209,8 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
         {ra.pt, rb.pt, w.best.score, rotationDegOf(L), std::sqrt(std::abs(cv::determinant(L)))});
     maps.push_back(L);
   }
-  const std::vector<int> kept = pruneByRotationScale(g.matches, params);
+  const std::vector<int> kept =
+      agreeingRotationScale(g.matches, params.pruneRotationDeg, params.pruneLog2Scale);
   std::vector<cv::Point2d> src, dst;
   std::vector<cv::Matx22d> keptMaps;
   for (int k : kept) {
@@ -418,6 +378,7 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
       s.gridCell = cell;
     }
     const std::vector<HarrisCorner>& dense = *s.grid;
+    std::size_t rematched = 0;  // pairs the last accepted re-matching found
     for (int it = 0; it < params.refineIterations; ++it) {
       // Once H rests on the dense pairs, the prediction is within a pixel or two.
       const int radius =
@@ -438,17 +399,25 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
           inliers.push_back(static_cast<int>(i));
       if (inliers.size() < result.inliers.size()) break;
       result.H = refit->H;
+      rematched = rm.size();
       result.matches = std::move(rm);
       result.inliers = std::move(inliers);
     }
-    // A transform resting on very few global matches must be confirmed by the re-matching.
+    // A transform resting on very few global matches must be confirmed by the re-matching: at
+    // least confirmInliers pairs, and most of those it found. Around the right transform nearly
+    // every re-matched pair agrees with it; around a wrong one the pairs are chance hits of
+    // the correlation (a fine repetitive texture gives many), of which one homography explains
+    // a few dozen among a hundred and more.
+    const std::size_t confirmed = result.inliers.size();
     if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
-        static_cast<int>(result.inliers.size()) < params.confirmInliers)
+        (static_cast<int>(confirmed) < params.confirmInliers || 2 * confirmed < rematched))
       result.status = Status<RegistrationFailure>::failed(
           RegistrationFailure::TooFewInliers,
           std::to_string(globalInliers) + " global inliers, not confirmed by re-matching (" +
-              std::to_string(result.inliers.size()) + " inliers, " +
-              std::to_string(params.confirmInliers) + " needed)");
+              (rematched > 0 ? std::to_string(confirmed) + " inliers of " +
+                                   std::to_string(rematched) + " re-matched pairs; "
+                             : "no re-matched fit; ") +
+              std::to_string(params.confirmInliers) + " inliers and most pairs needed)");
   }
 }
 

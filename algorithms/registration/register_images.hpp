@@ -34,11 +34,13 @@ struct RegistrationParams {
   double inlierThreshold = 3.0;  // pixels; RANSAC reprojection threshold in the image
   int minInliers = 5;            // fewer global inliers than this -> failure "too_few_inliers"
   // A global fit with fewer than `confirmBelowInliers` inliers is accepted only when the
-  // re-matching (refineIterations > 0) then finds at least `confirmInliers` inliers.
+  // re-matching (refineIterations > 0) then finds at least `confirmInliers` inliers, and they
+  // are most of the pairs it re-matched.
   int confirmBelowInliers = 10;
   int confirmInliers = 20;
-  // Per-match rotation/scale estimates prune matches that disagree with the dominant rotation
-  // (degrees) and log2-scale before RANSAC. <= 0 disables the pruning.
+  // Per-match rotation/scale estimates prune matches that disagree with the dominant pair of
+  // rotation (degrees) and log2-scale before RANSAC (rotation_scale_vote.hpp). <= 0 disables
+  // the pruning.
   double pruneRotationDeg = 40.0;
   double pruneLog2Scale = 1.0;
   // Escalation for hard pairs (large viewpoint change): when the first global matching gives
