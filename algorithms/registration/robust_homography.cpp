@@ -202,7 +202,8 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
   H *= 1.0 / H(2, 2);
   RobustHomography out;
   out.H = H;
-  out.noise = std::max(noiseScale(h, a, b, metric, errors), floor) / pixel;
+  const std::vector<cv::Matx22d> plain(a.size(), cv::Matx22d::eye());
+  out.noise = noiseScale(h, a, b, plain, errors) / pixel;
   return out;
 }
 

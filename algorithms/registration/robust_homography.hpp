@@ -10,7 +10,7 @@ namespace facet {
 
 struct RobustHomography {
   cv::Matx33d H = cv::Matx33d::eye();  // src -> dst, H(2,2) == 1
-  double noise = 0;  // pixels (about, for a typical pair with sharpness): the scale about H
+  double noise = 0;  // pixels: the transfer errors' scale about H (a 2D Gaussian's sigma)
 };
 
 // Minimises the Cauchy loss of the transfer errors H src - dst by iteratively re-weighted

@@ -120,6 +120,8 @@ TEST(FitHomographyCauchy, EachPairCountsInTheDirectionItIsLocatedIn) {
   const auto shaped = fitHomographyCauchy(src, dst, kTruth, sharpness);
   ASSERT_TRUE(plain && shaped);
   EXPECT_LT(cornerError(shaped->H, kTruth), cornerError(plain->H, kTruth) / 3);
+  // The noise is reported in pixels whatever the metric the pairs were weighed in.
+  EXPECT_NEAR(shaped->noise, plain->noise, 0.2 * plain->noise);
 }
 
 TEST(FitHomographyCauchy, AnErrorAllPairsShareOutweighsTheirSharpness) {
