@@ -18,8 +18,16 @@ std::vector<int> agreeingRotationScale(const std::vector<FeatureMatch>& m, doubl
   auto scaleOf = [](double log2Scale) {
     return std::clamp(static_cast<int>(std::floor((log2Scale + 5.0) * 2.0)), 0, kScales - 1);
   };
+  // Each match's bins and log2 scale, once.
+  std::vector<int> turns(m.size()), scales(m.size());
+  std::vector<double> log2Scales(m.size());
   std::vector<int> hist(kTurns * kScales, 0);
-  for (const auto& x : m) ++hist[turnOf(x.rotationDeg) * kScales + scaleOf(std::log2(x.scale))];
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    log2Scales[i] = std::log2(m[i].scale);
+    turns[i] = turnOf(m[i].rotationDeg);
+    scales[i] = scaleOf(log2Scales[i]);
+    ++hist[turns[i] * kScales + scales[i]];
+  }
   int peakTurn = 0, peakScale = 0, peakVotes = -1;
   for (int t = 0; t < kTurns; ++t)
     for (int c = 0; c < kScales; ++c) {
@@ -35,10 +43,10 @@ std::vector<int> agreeingRotationScale(const std::vector<FeatureMatch>& m, doubl
     }
   const double peakDeg = peakTurn * 10.0 - 175.0;
   std::vector<double> peakLogScales;
-  for (const auto& x : m) {
-    const int dt = std::abs(turnOf(x.rotationDeg) - peakTurn);
-    if (std::min(dt, kTurns - dt) <= 1 && std::abs(scaleOf(std::log2(x.scale)) - peakScale) <= 1)
-      peakLogScales.push_back(std::log2(x.scale));
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    const int dt = std::abs(turns[i] - peakTurn);
+    if (std::min(dt, kTurns - dt) <= 1 && std::abs(scales[i] - peakScale) <= 1)
+      peakLogScales.push_back(log2Scales[i]);
   }
   std::nth_element(peakLogScales.begin(), peakLogScales.begin() + peakLogScales.size() / 2,
                    peakLogScales.end());
@@ -47,7 +55,7 @@ std::vector<int> agreeingRotationScale(const std::vector<FeatureMatch>& m, doubl
   for (std::size_t i = 0; i < m.size(); ++i) {
     const double d = std::abs(std::remainder(m[i].rotationDeg - peakDeg, 360.0));
     if (d <= maxRotationDeg &&
-        (maxLog2Scale <= 0 || std::abs(std::log2(m[i].scale) - peakLog2Scale) <= maxLog2Scale))
+        (maxLog2Scale <= 0 || std::abs(log2Scales[i] - peakLog2Scale) <= maxLog2Scale))
       keep.push_back(static_cast<int>(i));
   }
   return keep;
