@@ -21,22 +21,26 @@ constexpr double kMinCos = 0.8;  // direction agreement of a correspondence (abo
 constexpr int kBandPixels = 16;
 }  // namespace
 
-cv::Mat LeastSquaresRefinement::contourBand(const Pose2D& start, double scaleFreedom) const {
-  double reach = 0.0;
+cv::Mat LeastSquaresRefinement::contourBand(const std::vector<Pose2D>& starts,
+                                            double scaleFreedom) const {
+  double reach = 0.0, scale = 0.0;
   for (const auto& mp : model_.finePoints)
     reach = std::max(reach, std::hypot(double(mp.position.x), double(mp.position.y)));
-  const int r = kBandPixels + static_cast<int>(std::ceil(scaleFreedom * reach * start.scale));
+  for (const Pose2D& start : starts) scale = std::max(scale, start.scale);
+  const int r = kBandPixels + static_cast<int>(std::ceil(scaleFreedom * reach * scale));
   // Cells of r x r pixels: a pixel within r of a point lies in the point's cell or a neighbour,
   // so the cells next to those holding points cover the band (and a little more), at the cost
   // of marking them (a dilation of the region by 2r + 1 cost a refinement 3%).
   const cv::Size cells((roi_.width + r - 1) / r, (roi_.height + r - 1) / r);
   cv::Mat held(cells, CV_8U, cv::Scalar(0));
-  const Pose2D::Map toImage = start.map();
-  for (const auto& mp : model_.finePoints) {
-    const cv::Point2d q = toImage({mp.position.x, mp.position.y});
-    const int cx = static_cast<int>(std::floor((q.x - roi_.x) / r));
-    const int cy = static_cast<int>(std::floor((q.y - roi_.y) / r));
-    if (cx >= 0 && cy >= 0 && cx < cells.width && cy < cells.height) held.at<uchar>(cy, cx) = 1;
+  for (const Pose2D& start : starts) {
+    const Pose2D::Map toImage = start.map();
+    for (const auto& mp : model_.finePoints) {
+      const cv::Point2d q = toImage({mp.position.x, mp.position.y});
+      const int cx = static_cast<int>(std::floor((q.x - roi_.x) / r));
+      const int cy = static_cast<int>(std::floor((q.y - roi_.y) / r));
+      if (cx >= 0 && cy >= 0 && cx < cells.width && cy < cells.height) held.at<uchar>(cy, cx) = 1;
+    }
   }
   cv::dilate(held, held, cv::Mat());  // and their neighbours (3x3)
   // Where the band is most of the region (a bracket's), the mask would save less than it costs.
@@ -50,13 +54,14 @@ cv::Mat LeastSquaresRefinement::contourBand(const Pose2D& start, double scaleFre
 }
 
 LeastSquaresRefinement::LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model,
-                                               cv::Rect roi, Polarity polarity, const Pose2D& start,
+                                               cv::Rect roi, Polarity polarity,
+                                               const std::vector<Pose2D>& starts,
                                                double scaleFreedom)
     : model_(model), polarity_(polarity), roi_(roi & cv::Rect(0, 0, image.cols, image.rows)) {
   if (roi_.width < 3 || roi_.height < 3) return;
   EdgeParams edgeParams;
   edgeParams.roi = roi_;
-  edgeParams.fitMask = contourBand(start, scaleFreedom);
+  edgeParams.fitMask = contourBand(starts, scaleFreedom);
   edgeParams.low = model.minContrast;
   edgeParams.high = std::max(2.0 * model.minContrast, 0.5 * model.contrastHigh);
   edgeParams.fitProfile = model.edgeEstimator == EdgeEstimator::ProfileFit;

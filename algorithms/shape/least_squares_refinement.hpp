@@ -54,15 +54,17 @@ struct Refined {
   [[nodiscard]] bool exact() const { return status.ok() && cutoff <= kExactFitCutoff; }
 };
 
-// The image's subpixel edges inside one match's region, detected once for the refinements tried
-// from there (with the scale free and at the model's scale).
+// The image's subpixel edges inside one part's region, detected once for the refinements tried
+// there: from each of the part's alternative poses (near-symmetric turns, other candidates on it),
+// with the scale free and at the model's scale. One detection for all of them also lets them be
+// compared on the same edges.
 class LeastSquaresRefinement {
  public:
-  // `roi`: image pixels, clipped to the image. `start`: the pose the refinements start from;
+  // `roi`: image pixels, clipped to the image. `starts`: the poses the refinements start from;
   // `scaleFreedom`: the largest relative scale change they may make. Only the edges near the
-  // model's contour placed there get the profile fit (contourBand).
+  // model's contour placed at one of the starts get the profile fit (contourBand).
   LeastSquaresRefinement(const cv::Mat& image, const ShapeModel& model, cv::Rect roi,
-                         Polarity polarity, const Pose2D& start, double scaleFreedom);
+                         Polarity polarity, const std::vector<Pose2D>& starts, double scaleFreedom);
 
   // `visible`: one entry per fine point, 0 for a point that takes no part; empty: every point.
   Refined refine(Pose2D start, bool withScale, const std::vector<std::uint8_t>& visible = {}) const;
@@ -76,9 +78,9 @@ class LeastSquaresRefinement {
     Eigen::Vector4d J;
     double r;
   };
-  // The roi's pixels near the model's contour placed at `start` (CV_8U, non-zero), see the .cpp;
-  // empty where that is most of the roi.
-  [[nodiscard]] cv::Mat contourBand(const Pose2D& start, double scaleFreedom) const;
+  // The roi's pixels near the model's contour placed at any of `starts` (CV_8U, non-zero), see
+  // the .cpp; empty where that is most of the roi.
+  [[nodiscard]] cv::Mat contourBand(const std::vector<Pose2D>& starts, double scaleFreedom) const;
   // Each model point placed at `at` paired with the nearest direction-agreeing edge point within
   // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
   double correspond(const Pose2D& at, int radius, bool anySign, double sign,
