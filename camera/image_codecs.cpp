@@ -1,6 +1,8 @@
 #include "camera/image_codecs.hpp"
 
+#include <cctype>
 #include <cstdio>
+#include <fstream>
 #include <optional>
 
 #include <opencv2/imgproc.hpp>
@@ -14,6 +16,7 @@
 #include "camera/module_file.hpp"
 #include "camera/pgm_file.hpp"
 #include "camera/png_file.hpp"
+#include "camera/png_writer.hpp"
 #include "camera/tiff_file.hpp"
 
 // Baked in by camera/CMakeLists.txt.
@@ -164,6 +167,22 @@ std::optional<ImageFileContent> frameOfBinaryPgm(const fs::path& file, std::uint
   return frameOfDecodedPixels(std::move(*pgm));
 }
 
+// ".png" in any case: the format cv::imwrite and cv::imencode take the name to mean.
+bool isPngName(const std::string& ext) {
+  static constexpr char kPng[] = ".png";
+  if (ext.size() != 4) return false;
+  for (std::size_t i = 0; i < 4; ++i)
+    if (std::tolower(static_cast<unsigned char>(ext[i])) != kPng[i]) return false;
+  return true;
+}
+
+bool writeBytes(const fs::path& file, const std::vector<unsigned char>& bytes) {
+  std::ofstream out(file, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(bytes.data()),
+            static_cast<std::streamsize>(bytes.size()));
+  return static_cast<bool>(out.flush());
+}
+
 }  // namespace
 
 const std::string& imageCodecsProblem() {
@@ -181,12 +200,21 @@ cv::Mat readImage(const fs::path& file, int flags) {
 }
 
 bool writeImage(const fs::path& file, const cv::Mat& image, const std::vector<int>& params) {
+  if (params.empty() && isPngName(file.extension().string())) {
+    if (auto png = encodePlainPng(image)) return writeBytes(file, *png);
+  }
   const ImageCodecTable* table = loaded().table;
   return table && table->write(file.string(), image, params);
 }
 
 bool encodeImage(const std::string& ext, const cv::Mat& image, std::vector<unsigned char>& bytes,
                  const std::vector<int>& params) {
+  if (params.empty() && isPngName(ext)) {
+    if (auto png = encodePlainPng(image)) {
+      bytes = std::move(*png);
+      return true;
+    }
+  }
   const ImageCodecTable* table = loaded().table;
   return table && table->encode(ext, image, bytes, params);
 }

@@ -4,7 +4,8 @@
 // made every start of `facet` and `facetd` take ~0.3 s and map ~200 more shared libraries,
 // also for the commands that never touch an image file. Plain PNG, JPEG, TIFF and BMP files and
 // binary PGMs are read without the module (png_file.hpp, jpeg_file.hpp, tiff_file.hpp,
-// bmp_file.hpp, pgm_file.hpp), with the same result.
+// bmp_file.hpp, pgm_file.hpp), with the same result, and PNGs of 8- or 16-bit grey, BGR and BGRA
+// images are written and encoded without it when no parameters are given (png_writer.hpp).
 //
 // Each function behaves like its OpenCV namesake (flags are cv::ImreadModes, params
 // cv::ImwriteFlags; only the constants of <opencv2/imgcodecs.hpp> are used here). Thread-safe;

@@ -1,5 +1,6 @@
 #include <filesystem>
 #include <fstream>
+#include <string>
 
 #include <gtest/gtest.h>
 #include <opencv2/imgcodecs.hpp>
@@ -64,6 +65,41 @@ TEST(ImageArchive, KeepsFailedPartsAndSampleOfGoodOnesUnderQuota) {
   // A restarted archive counts the files already there.
   ImageArchive again({.folder = dir, .quotaBytes = 200'000});
   EXPECT_EQ(again.bytesUsed(), onDisk);
+  fs::remove_all(dir);
+}
+
+// Whether this process has mapped the image-codec module (camera/image_codecs.hpp).
+bool codecModuleLoaded() {
+  std::ifstream maps("/proc/self/maps");
+  std::string line;
+  while (std::getline(maps, line))
+    if (line.find("libfacet_image_codecs") != std::string::npos) return true;
+  return false;
+}
+
+// The archive's PNGs are encoded in the process (camera/png_writer.hpp): loading the codec module
+// for the first failed part took 0.4 s on the publishing thread, and the PLC results of the parts
+// behind it waited (bench_daemon's changeover rows, "longest wait between results").
+TEST(ImageArchive, WritesItsPngsWithoutLoadingTheCodecModule) {
+  if (codecModuleLoaded())
+    GTEST_SKIP()
+        << "an earlier test of this process loaded the module (ctest runs each test alone)";
+  const fs::path dir =
+      fs::temp_directory_path() / ("facet-archive-png-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  cv::Mat frame(48, 64, CV_8U), overlay(48, 64, CV_8UC3);
+  cv::randu(frame, 0, 255);
+  cv::randu(overlay, 0, 255);
+  ImageArchive archive({.folder = dir});
+  const auto saved = archive.archive(partWith(3, Verdict::Fail), frame, overlay);
+  ASSERT_TRUE(saved);
+  EXPECT_FALSE(codecModuleLoaded());
+  // OpenCV reads back the very pixels (cv::imread here is the test's own, linked directly).
+  EXPECT_EQ(cv::norm(cv::imread(saved->raw.string(), cv::IMREAD_UNCHANGED), frame, cv::NORM_INF),
+            0);
+  EXPECT_EQ(
+      cv::norm(cv::imread(saved->overlay.string(), cv::IMREAD_UNCHANGED), overlay, cv::NORM_INF),
+      0);
   fs::remove_all(dir);
 }
 
