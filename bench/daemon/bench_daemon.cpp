@@ -432,7 +432,7 @@ int firstPartsChild(const fs::path& dir, const std::string& extension, bool warm
         s.metrics().gauge("facet_recipe_switch_ms", "Duration of the last recipe switch").value());
   for (double m : ms) std::printf("%.3f\n", m);
   // The longest wait between two results: what the PLC waits beyond the inspection when the
-  // publishing thread is held up (the first failed part's PNGs for the image archive).
+  // publishing thread is held up (as it was by the first failed part's PNGs for the archive).
   double longestWait = 0.0;
   for (std::size_t i = 1; i < published.size(); ++i)
     longestWait = std::max(
@@ -508,8 +508,8 @@ void printFirstParts(const FirstPartRows& r, std::optional<double> freeRunInspec
   printProcessRows(r.coldChangeover, r.warmChangeover, 62, {9, 6, 6, 6, 6, 6, 31});
   std::printf(
       "(switch ms: the recipe selector's choice of part 3, on the acquisition thread; part 4 "
-      "fails,\n its frame and overlay go to the image archive as PNGs on the publishing "
-      "thread)\n\n");
+      "fails,\n its frame and overlay go to the image archive as PNGs, written on the "
+      "archive's own thread)\n\n");
 }
 
 FreeRun measureFreeRun(const fs::path& dir, const fs::path& frames, const std::string& extension,

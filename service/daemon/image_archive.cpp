@@ -70,7 +70,8 @@ ImageArchive::ImageArchive(ArchivePolicy policy) : policy_(std::move(policy)) {
   }
 }
 
-bool ImageArchive::wanted(const PartResult& part) {
+bool ImageArchive::wants(const PartResult& part) {
+  std::lock_guard lock(mutex_);
   if (part.verdict != Verdict::Pass) return policy_.failed;
   ++goodSeen_;
   return policy_.goodEvery > 0 && goodSeen_ % static_cast<std::uint64_t>(policy_.goodEvery) == 0;
@@ -89,6 +90,7 @@ void ImageArchive::writeFile(const fs::path& file, const cv::Mat& image) {
     fs::remove(partial, ignore);
     throw;
   }
+  std::lock_guard lock(mutex_);
   files_.push_back({file, png.size()});
   bytes_ += png.size();
 }
@@ -111,8 +113,15 @@ std::optional<ArchivedPart> ImageArchive::archive(const PartResult& part, const 
 
 std::optional<ArchivedPart> ImageArchive::archive(const PartResult& part, const cv::Mat& raw,
                                                   const std::function<cv::Mat()>& drawOverlay) {
-  std::lock_guard lock(mutex_);
-  if (!wanted(part) || raw.empty()) return std::nullopt;
+  if (!wants(part)) return std::nullopt;
+  return store(part, raw, drawOverlay);
+}
+
+std::optional<ArchivedPart> ImageArchive::store(const PartResult& part, const cv::Mat& raw,
+                                                const std::function<cv::Mat()>& drawOverlay) {
+  if (raw.empty()) return std::nullopt;
+  // The lock is taken for the bookkeeping only (writeFile, below): encoding and writing take tens
+  // of milliseconds, and wants() and the health readers must not wait for them.
   try {
     const std::time_t secs = std::chrono::system_clock::to_time_t(part.time);
     std::tm tm{};
@@ -126,10 +135,12 @@ std::optional<ArchivedPart> ImageArchive::archive(const PartResult& part, const 
     ArchivedPart out{dir / (stem + ".png"), dir / (stem + "-overlay.png")};
     writeFile(out.raw, raw);
     if (const cv::Mat overlay = drawOverlay(); !overlay.empty()) writeFile(out.overlay, overlay);
+    std::lock_guard lock(mutex_);
     enforceQuota();
     degraded_ = false;
     return out;
   } catch (const std::exception& e) {
+    std::lock_guard lock(mutex_);
     ++writeFailures_;
     degraded_ = true;
     lastError_ = e.what();

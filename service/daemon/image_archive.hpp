@@ -34,14 +34,22 @@ class ImageArchive {
   // Scans the folder for files written by earlier runs so the quota covers them too.
   explicit ImageArchive(ArchivePolicy policy);
 
-  // Archives the part when the policy asks for it. Never throws: on failure the archive turns
-  // degraded (see degraded()) and nothing is returned.
+  // Archives the part when the policy asks for it (wants(), then store()). Never throws: on
+  // failure the archive turns degraded (see degraded()) and nothing is returned.
   std::optional<ArchivedPart> archive(const PartResult& part, const cv::Mat& raw,
                                       const cv::Mat& overlay);
   // The same, drawing the overlay picture only when the part is archived (drawing a large
   // frame costs milliseconds that good, unarchived parts need not pay).
   std::optional<ArchivedPart> archive(const PartResult& part, const cv::Mat& raw,
                                       const std::function<cv::Mat()>& drawOverlay);
+
+  // Whether the policy keeps the part: a failed or error part, or every N-th good one (the good
+  // parts it is asked about are counted for that).
+  bool wants(const PartResult& part);
+  // Writes the part's pictures, whatever the policy (asked before: wants()). Never throws, as
+  // archive().
+  std::optional<ArchivedPart> store(const PartResult& part, const cv::Mat& raw,
+                                    const std::function<cv::Mat()>& drawOverlay);
 
   [[nodiscard]] bool degraded() const;
   [[nodiscard]] std::string lastError() const;
@@ -50,9 +58,9 @@ class ImageArchive {
   [[nodiscard]] std::uint64_t filesRemoved() const;
 
  private:
-  bool wanted(const PartResult& part);
+  // Encodes and writes without the lock, then records the file under it.
   void writeFile(const std::filesystem::path& file, const cv::Mat& image);
-  void enforceQuota();
+  void enforceQuota();  // under the lock
 
   ArchivePolicy policy_;
   mutable std::mutex mutex_;

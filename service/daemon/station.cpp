@@ -58,8 +58,10 @@ Station::Station(config::StationConfig config, const config::StepKindRegistry& k
   applyRetention(0);  // a large first clean-up happens here, before READY, not between parts
   nextPartId_ = store_->lastPartId() + 1;
   firstPartId_ = nextPartId_;
-  if (!config_.archive.folder.empty())
+  if (!config_.archive.folder.empty()) {
     archive_ = std::make_unique<ImageArchive>(archivePolicy(config_.archive));
+    archiveWriter_ = std::make_unique<ArchiveWriter>(*archive_, metrics_, kArchiveQueue);
+  }
   // Every recorded file is a part: one the replay cannot read is answered "not inspected".
   config_.camera.replay.report_unreadable = true;
   camera_ = makeCamera(config_.camera);
@@ -106,6 +108,7 @@ void Station::join() {
   if (acquisition_.joinable()) acquisition_.join();
   if (inspection_.joinable()) inspection_.join();
   if (publishing_.joinable()) publishing_.join();
+  if (archiveWriter_) archiveWriter_->flush();  // the last parts' pictures are on disk
   if (plc_) {
     // The last parts were published a moment ago: let a connected PLC take them before the
     // link goes (what is still queued after this is logged part by part as undelivered).

@@ -31,6 +31,7 @@
 #include "camera/camera.hpp"
 #include "camera/scan_source.hpp"
 #include "config/station_config.hpp"
+#include "service/daemon/archive_writer.hpp"
 #include "service/daemon/bounded_queue.hpp"
 #include "service/daemon/image_archive.hpp"
 #include "service/daemon/metrics.hpp"
@@ -141,6 +142,9 @@ class Station : public StationView {
   static constexpr std::chrono::seconds kRetentionPeriod{60};
   // About 10 ms of deleting here: a result waiting behind it is not held up longer than that.
   static constexpr std::int64_t kRetentionSlice = 500;
+  // Parts the image archive may fall behind by before the oldest waiting one's pictures are
+  // dropped (archive_writer.hpp): eight failed 1280x1024 parts, 0.6 s of writing.
+  static constexpr std::size_t kArchiveQueue = 8;
 
   config::StationConfig config_;
   StationOptions options_;
@@ -148,6 +152,7 @@ class Station : public StationView {
   std::unique_ptr<ResultsStore> store_;
   mutable std::mutex storeMutex_;  // SQLite connection shared by publishing and HTTP readers
   std::unique_ptr<ImageArchive> archive_;
+  std::unique_ptr<ArchiveWriter> archiveWriter_;  // archive_'s writes, off the publishing thread
   RecipeSelector recipes_;
   std::unique_ptr<Camera> camera_;
   std::unique_ptr<ScanSource> scans_;  // recorded range scans for scan recipes (may be null)

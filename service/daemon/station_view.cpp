@@ -15,7 +15,7 @@ void Station::showPart(PartResult part, const cv::Mat& image, const Overlay& ove
     last.overlay = overlay;
     last.banner = partBanner(part, "part " + std::to_string(part.partId));
     last.pass = part.verdict == Verdict::Pass;
-    if (archive_) archive_->archive(part, image, [&last] { return last.draw(); });
+    if (archiveWriter_) archiveWriter_->submit(part, image, [last] { return last.draw(); });
   }
   const bool archiveDegraded = archive_ && archive_->degraded();
   metrics_.gauge("facet_archive_degraded", "1 while the image archive cannot write")
