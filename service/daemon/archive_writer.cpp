@@ -8,7 +8,14 @@ ArchiveWriter::ArchiveWriter(ImageArchive& archive, MetricsRegistry& metrics, st
     : archive_(archive),
       metrics_(metrics),
       queue_(capacity, OverflowPolicy::DropOldest),
-      thread_([this] { run(); }) {}
+      thread_([this] { run(); }) {
+  droppedParts();  // exported from the start, at 0
+}
+
+Counter& ArchiveWriter::droppedParts() {
+  return metrics_.counter("facet_archive_dropped_total",
+                          "Parts whose pictures the archive had no time for");
+}
 
 ArchiveWriter::~ArchiveWriter() {
   queue_.close();  // the thread drains what is queued, then ends
@@ -24,9 +31,7 @@ void ArchiveWriter::submit(const PartResult& part, cv::Mat frame,
   }
   std::optional<Job> dropped = queue_.push({part, std::move(frame), std::move(drawOverlay)});
   if (!dropped) return;
-  metrics_
-      .counter("facet_archive_dropped_total", "Parts whose pictures the archive had no time for")
-      .increment();
+  droppedParts().increment();
   spdlog::warn("archive: part {} not archived: the archive is {} parts behind",
                dropped->part.partId, queue_.size());
   std::lock_guard lock(doneMutex_);

@@ -44,6 +44,7 @@ class ArchiveWriter {
     std::function<cv::Mat()> drawOverlay;
   };
   void run();
+  Counter& droppedParts();  // facet_archive_dropped_total
 
   ImageArchive& archive_;
   MetricsRegistry& metrics_;

@@ -12,18 +12,12 @@
 #include <future>
 #include <thread>
 
+#include "tests/service/archived_parts.hpp"
+
 namespace facet::service {
 namespace {
 
 namespace fs = std::filesystem;
-
-PartResult part(std::uint64_t id, Verdict v) {
-  PartResult p;
-  p.partId = id;
-  p.verdict = v;
-  p.time = std::chrono::system_clock::now();
-  return p;
-}
 
 int pngsOfPart(const fs::path& dir, std::uint64_t id) {
   int n = 0;
@@ -50,11 +44,11 @@ TEST(ArchiveWriter, WritesWhatThePolicyKeepsOffTheCallersThread) {
   ArchiveWriter writer(archive, metrics, 4);
   const cv::Mat frame(32, 48, CV_8U, cv::Scalar(90));
   std::atomic<std::thread::id> drawnOn;
-  writer.submit(part(1, Verdict::Fail), frame, [&] {
+  writer.submit(test::partWith(1, Verdict::Fail), frame, [&] {
     drawnOn = std::this_thread::get_id();
     return cv::Mat(32, 48, CV_8UC3, cv::Scalar(1, 2, 3));
   });
-  writer.submit(part(2, Verdict::Pass), frame, [] { return cv::Mat(); });  // not kept
+  writer.submit(test::partWith(2, Verdict::Pass), frame, [] { return cv::Mat(); });  // not kept
   writer.flush();
   EXPECT_EQ(pngsOfPart(dir.path, 1), 2) << "the frame and its overlay";
   EXPECT_EQ(pngsOfPart(dir.path, 2), 0);
@@ -71,7 +65,7 @@ TEST(ArchiveWriter, ABurstBeyondTheQueueDropsTheOldestWaitingPartAndCountsIt) {
   std::promise<void> release;
   std::shared_future<void> released = release.get_future().share();
   std::promise<void> started;
-  writer.submit(part(1, Verdict::Fail), frame, [&] {
+  writer.submit(test::partWith(1, Verdict::Fail), frame, [&] {
     started.set_value();
     released.wait();
     return cv::Mat();
@@ -79,7 +73,7 @@ TEST(ArchiveWriter, ABurstBeyondTheQueueDropsTheOldestWaitingPartAndCountsIt) {
   started.get_future().wait();
   const auto t0 = std::chrono::steady_clock::now();
   for (std::uint64_t id = 2; id <= 5; ++id)
-    writer.submit(part(id, Verdict::Fail), frame, [] { return cv::Mat(); });
+    writer.submit(test::partWith(id, Verdict::Fail), frame, [] { return cv::Mat(); });
   EXPECT_LT(std::chrono::steady_clock::now() - t0, std::chrono::seconds(1))
       << "submitting waited for the stalled writer";
   release.set_value();
@@ -101,8 +95,8 @@ TEST(ArchiveWriter, WritesWhatIsQueuedBeforeItStops) {
   {
     ArchiveWriter writer(archive, metrics, 8);
     for (std::uint64_t id = 1; id <= 6; ++id)
-      writer.submit(part(id, Verdict::Fail), cv::Mat(64, 64, CV_8U, cv::Scalar(double(id))),
-                    [] { return cv::Mat(); });
+      writer.submit(test::partWith(id, Verdict::Fail),
+                    cv::Mat(64, 64, CV_8U, cv::Scalar(double(id))), [] { return cv::Mat(); });
   }
   for (std::uint64_t id = 1; id <= 6; ++id) EXPECT_EQ(pngsOfPart(dir.path, id), 1) << id;
 }

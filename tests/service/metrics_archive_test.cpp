@@ -7,6 +7,7 @@
 
 #include "service/daemon/image_archive.hpp"
 #include "service/daemon/metrics.hpp"
+#include "tests/service/archived_parts.hpp"
 
 namespace facet::service {
 namespace {
@@ -33,13 +34,7 @@ TEST(Metrics, ExpositionFormat) {
   EXPECT_THROW(m.gauge("facet_parts_total", "x"), std::logic_error);
 }
 
-PartResult partWith(std::uint64_t id, Verdict v) {
-  PartResult p;
-  p.partId = id;
-  p.verdict = v;
-  p.time = std::chrono::system_clock::now();
-  return p;
-}
+using test::partWith;
 
 TEST(ImageArchive, KeepsFailedPartsAndSampleOfGoodOnesUnderQuota) {
   const fs::path dir = fs::temp_directory_path() / ("facet-archive-" + std::to_string(::getpid()));
