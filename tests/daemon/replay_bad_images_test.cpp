@@ -13,6 +13,8 @@
 #include <fstream>
 #include <sstream>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "tests/daemon/child_process.hpp"
 #include "tests/daemon/line_run.hpp"
 #include "tests/hardening/bad_image_files.hpp"
@@ -87,12 +89,24 @@ TEST(ReplayBadImages, EachBadFileIsAnErrorPartNamedByItsFileAndGoodOnesAreInspec
   for (const auto& d : {good, bad, dir / "good-run", dir / "bad-run"}) fs::create_directories(d);
   const auto sidecars = expectedParts(kDemo);
 
-  // Both folders hold the same six recorded parts (pass and fail); `bad` has the bad files
+  // Both folders hold the same seven recorded parts (pass and fail); `bad` has the bad files
   // between them. Names sort naturally in the order listed.
   std::vector<RecordedFile> files;
   auto addGood = [&](const std::string& name, const std::string& demo) {
     for (const auto& folder : {good, bad}) {
       fs::copy_file(kDemo + "/" + demo, folder + "/" + name);
+      fs::copy_file(kDemo + "/" + demo + ".json", folder + "/" + name + ".json");
+    }
+    files.push_back({name, sidecars.at(demo).verdict});
+  };
+  // A recorded part the in-process readers leave to the image-codec module (an ASCII PGM,
+  // camera/pgm_file.hpp): both runs load the module, so that the baseline holds its memory too.
+  // (facetd writes its PNGs without it, and the bad files are what made the other run load it:
+  // the difference then measured the module, not the bad files.)
+  auto addGoodThroughModule = [&](const std::string& name, const std::string& demo) {
+    const cv::Mat pixels = cv::imread(kDemo + "/" + demo, cv::IMREAD_UNCHANGED);
+    for (const auto& folder : {good, bad}) {
+      ASSERT_TRUE(cv::imwrite(folder + "/" + name, pixels, {cv::IMWRITE_PXM_BINARY, 0}));
       fs::copy_file(kDemo + "/" + demo + ".json", folder + "/" + name + ".json");
     }
     files.push_back({name, sidecars.at(demo).verdict});
@@ -117,7 +131,8 @@ TEST(ReplayBadImages, EachBadFileIsAnErrorPartNamedByItsFileAndGoodOnesAreInspec
   addBad("p11_tiff_named_bmp.bmp", std::string("II*\0garbage", 11));
   addGood("p12.png", "part_008.png");
   addGood("p13.png", "part_011.png");
-  constexpr std::size_t kBad = 7, kGood = 6;
+  addGoodThroughModule("p14_ascii.pgm", "part_002.png");
+  constexpr std::size_t kBad = 7, kGood = 7;
   ASSERT_EQ(files.size(), kBad + kGood);
 
   // The good folder alone first: the memory facetd needs anyway, as the baseline.
