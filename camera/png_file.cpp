@@ -7,15 +7,10 @@
 #include <memory>
 #include <vector>
 
+#include "camera/png_errors.hpp"
+
 namespace facet {
 namespace {
-
-// libpng reports errors by longjmp to the last setjmp. The functions that set it hold nothing
-// with a destructor, so a jump skips no C++ cleanup; the caller owns every resource.
-[[noreturn]] void onError(png_structp png, png_const_charp) {
-  png_longjmp(png, 1);
-}
-void onWarning(png_structp, png_const_charp) {}  // the module words problems, not libpng
 
 struct Header {
   png_uint_32 width = 0, height = 0;
@@ -76,7 +71,8 @@ std::optional<PlainPng> readPlainPng(const std::filesystem::path& file, std::uin
     return std::nullopt;
 
   ReadStructs s;
-  s.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, onError, onWarning);
+  s.png = png_create_read_struct(PNG_LIBPNG_VER_STRING, nullptr, png_errors::jumpBack,
+                                 png_errors::ignore);
   if (!s.png) return std::nullopt;
   s.info = png_create_info_struct(s.png);
   if (!s.info) return std::nullopt;

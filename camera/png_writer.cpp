@@ -5,15 +5,10 @@
 
 #include <bit>
 
+#include "camera/png_errors.hpp"
+
 namespace facet {
 namespace {
-
-// libpng reports errors by longjmp to the last setjmp; writeRows holds nothing with a
-// destructor across it.
-[[noreturn]] void onError(png_structp png, png_const_charp) {
-  png_longjmp(png, 1);
-}
-void onWarning(png_structp, png_const_charp) {}
 
 void append(png_structp png, png_bytep data, png_size_t length) {
   auto* out = static_cast<std::vector<unsigned char>*>(png_get_io_ptr(png));
@@ -75,7 +70,8 @@ std::optional<std::vector<unsigned char>> encodePlainPng(const cv::Mat& image) {
 
   std::vector<unsigned char> out;
   WriteStructs s;
-  s.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, onError, onWarning);
+  s.png = png_create_write_struct(PNG_LIBPNG_VER_STRING, nullptr, png_errors::jumpBack,
+                                  png_errors::ignore);
   if (!s.png) return std::nullopt;
   s.info = png_create_info_struct(s.png);
   if (!s.info) return std::nullopt;

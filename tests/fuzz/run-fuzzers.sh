@@ -41,7 +41,10 @@ run_one() {
     printf '%-14s ok      %ss  execs %-10s %s %s\n' "$t" "$seconds" "${execs:-?}" "$cov" "$ft" >"$out.summary"
   else
     printf '%-14s FINDING (exit %s) artifacts in %s\n' "$t" "$rc" "$artifacts" >"$out.summary"
-    grep -m1 -A25 'ERROR:\|runtime error\|deadly signal\|timeout\|out-of-memory' "$out" >>"$out.summary"
+    # -a: the target's own messages may carry the input's bytes (NULs make grep call the log
+    # binary and print nothing); without a sanitizer's report, the log's end says why it stopped.
+    { grep -a -m1 -A25 'ERROR:\|runtime error\|deadly signal\|timeout\|out-of-memory' "$out" ||
+        tail -n 25 "$out"; } | cat -v >>"$out.summary"
   fi
   return $rc
 }
