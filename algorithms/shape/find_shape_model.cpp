@@ -205,7 +205,7 @@ struct Finisher {
   // A candidate's pose before the least-squares refinement: after a wider look, interpolated
   // unless no subpixel pose is asked for.
   struct Started {
-    Finished pose;
+    Finished start;
     bool refine = false;  // the least-squares refinement is tried from it
   };
 
@@ -278,9 +278,9 @@ struct Finisher {
       if (!s) continue;
       started.push_back(*s);
       if (!s->refine) continue;
-      const cv::Rect here = refinementRegion(s->pose.pose);
+      const cv::Rect here = refinementRegion(s->start.pose);
       region = starts.empty() ? here : (region | here);
-      starts.push_back(s->pose.pose);
+      starts.push_back(s->start.pose);
     }
     std::optional<shape_detail::LeastSquaresRefinement> refinement;
     if (!starts.empty()) {
@@ -292,7 +292,7 @@ struct Finisher {
     }
     std::optional<Finished> bestSoFar;
     for (const Started& s : started) {
-      const Finished f = s.refine ? refined(*refinement, s.pose) : s.pose;
+      const Finished f = s.refine ? refined(*refinement, s.start) : s.start;
       if (!bestSoFar || f.score > bestSoFar->score) bestSoFar = f;
     }
     return bestSoFar;
