@@ -152,8 +152,11 @@ class Validator {
         break;
       case FieldType::String:
       case FieldType::Path:
-        if (!v.IsScalar() || v.Scalar().empty())
+        if (!v.IsScalar())
           error(at(v, key), what + " must be text, not " + describe(v));
+        else if (v.Scalar().empty())
+          error(at(v, key), what + " is empty: " +
+                                (f.type == FieldType::Path ? "name a file" : "write some text"));
         break;
       case FieldType::Identifier:
       case FieldType::StepRef:

@@ -137,5 +137,45 @@ steps:
   EXPECT_EQ(r.diagnostics.text().find("stale"), std::string::npos) << r.diagnostics.text();
 }
 
+// An empty file name is one error, said as such: it was also "not text" and, a second error for
+// the same key, "file '' cannot be read as an image" (and OpenCV warned on the daemon's log).
+TEST_F(RecipeErrorWording, EmptyFileNameIsOneErrorSayingSo) {
+  for (const char* method : {"shape", "registration"}) {
+    const auto r = load(std::string(R"(schema_version: 1
+id: 7
+name: Test
+steps:
+  - id: part
+    kind: align
+    method: )") + method +
+                        R"(
+    reference: ""
+    model: models/part.shape
+)");
+    EXPECT_FALSE(r.recipe.has_value()) << method;
+    EXPECT_TRUE(hasDiagnostic(r.diagnostics, 8, 16, "'reference' is empty: name a file"))
+        << method << "\n"
+        << r.diagnostics.text();
+    EXPECT_EQ(r.diagnostics.errorCount(), 1u) << method << "\n" << r.diagnostics.text();
+  }
+}
+
+// A file that is not there: one error, at the key; the model is not looked for.
+TEST_F(RecipeErrorWording, MissingTemplateIsOneError) {
+  const auto r = load(R"(schema_version: 1
+id: 7
+name: Test
+steps:
+  - id: part
+    kind: align
+    method: shape
+    reference: nothere.png
+    model: models/part.shape
+)");
+  EXPECT_FALSE(r.recipe.has_value());
+  EXPECT_TRUE(hasDiagnostic(r.diagnostics, 8, 16, "does not exist")) << r.diagnostics.text();
+  EXPECT_EQ(r.diagnostics.errorCount(), 1u) << r.diagnostics.text();
+}
+
 }  // namespace
 }  // namespace facet::config::test

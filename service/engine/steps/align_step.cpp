@@ -72,7 +72,8 @@ void AlignStep::crossCheck(const AlignParams& a, config::StepReading& in) const 
 std::shared_ptr<const config::StepResources> AlignStep::prepare(const config::Step& step,
                                                                 config::StepReading& in) const {
   const auto& a = step.as<AlignParams>();
-  if (!in["reference"]) return nullptr;  // reported by the validator
+  // Reported by the validator, or by the reading (an empty path: a file that is not there).
+  if (!in["reference"] || a.reference.empty()) return nullptr;
   if (a.method == AlignParams::Method::Shape)
     return prepareShapeModel(trainingOf(a), in, "reference");
   auto reference = std::make_shared<ReferenceImage>();

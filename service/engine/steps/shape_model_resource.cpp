@@ -30,8 +30,9 @@ std::string parametersText(const ShapeTraining& t) {
 std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining& training,
                                                             config::StepReading& in,
                                                             const std::string& templateKey) {
-  // A missing key was reported by the validator: nothing to load.
-  if (!in[templateKey] || !in["model"]) return nullptr;
+  // A missing or empty key, or a file that is not there, was reported by the validator or the
+  // reading (the path is then empty): nothing to load, and no second error for it.
+  if (!in[templateKey] || !in["model"] || training.templateImage.empty()) return nullptr;
   const cv::Mat image = readImage(training.templateImage, cv::IMREAD_UNCHANGED);
   if (image.empty()) {
     in.error(in[templateKey], "'" + templateKey + "' file '" + in[templateKey].Scalar() +
@@ -45,6 +46,7 @@ std::shared_ptr<const ShapeModelResource> prepareShapeModel(const ShapeTraining&
                                " pixels)");
     return nullptr;
   }
+  if (training.model.empty()) return nullptr;  // reported, as above
   in.addDependency(config::trainingRecordPath(training.model));
   if (!in.options().requireTrainedModels) return nullptr;
 
