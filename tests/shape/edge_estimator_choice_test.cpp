@@ -1,10 +1,12 @@
 // The edge estimator a model's refinement uses, chosen at training by finding the template's own
 // pose again on turned copies of it (algorithms/shape/edge_estimator_choice.hpp). Each choice is
 // checked against scenes rendered at known poses, which the training test never saw.
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/core/utility.hpp>
 
 #include "algorithms/shape/edge_estimator_choice.hpp"
 #include "algorithms/shape/find_shape_model.hpp"
@@ -82,6 +84,25 @@ TEST(EdgeEstimatorChoice, AGivenEstimatorIsUsedWithoutTheTest) {
   const ShapeModel model = createShapeModel(bracketTemplate(scene::BlurModel::Lens), params);
   EXPECT_EQ(model.edgeEstimator, EdgeEstimator::FacetZeroCrossing);
   EXPECT_TRUE(model.edgeEstimatorTrials.empty());
+}
+
+// The turned copies are tried in parallel: the trials' errors, and so the choice, are the same
+// on one thread as on several.
+TEST(EdgeEstimatorChoice, TrialsAreTheSameOnOneThreadAndOnSeveral) {
+  const cv::Mat templ = bracketTemplate(scene::BlurModel::Lens);
+  const int threads = cv::getNumThreads();
+  cv::setNumThreads(1);
+  const ShapeModel serial = createShapeModel(templ);
+  cv::setNumThreads(std::max(threads, 2));
+  const ShapeModel parallel = createShapeModel(templ);
+  cv::setNumThreads(threads);
+  ASSERT_EQ(serial.edgeEstimatorTrials.size(), 2u);
+  ASSERT_EQ(parallel.edgeEstimatorTrials.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(serial.edgeEstimatorTrials[i].estimator, parallel.edgeEstimatorTrials[i].estimator);
+    EXPECT_EQ(serial.edgeEstimatorTrials[i].poseError, parallel.edgeEstimatorTrials[i].poseError);
+  }
+  EXPECT_EQ(serial.edgeEstimator, parallel.edgeEstimator);
 }
 
 }  // namespace
