@@ -25,6 +25,7 @@ run_one() {
   local t=$1 exe="$bin/fuzz_$1" out="$work/$1.log" artifacts="$bin/artifacts/$1"
   if [ ! -x "$exe" ]; then echo "$t: no executable $exe" >"$out.summary"; return 1; fi
   mkdir -p "$work/$t.corpus" "$artifacts"
+  touch "$work/$t.start"
   # OpenImageIO's leak is only recognised with full allocation stacks (libstdc++ has no frame
   # pointers for the fast unwinder); that costs speed, so only for the image target.
   local asan=${ASAN_OPTIONS:-}
@@ -45,6 +46,13 @@ run_one() {
     # binary and print nothing); without a sanitizer's report, the log's end says why it stopped.
     { grep -a -m1 -A25 'ERROR:\|runtime error\|deadly signal\|timeout\|out-of-memory' "$out" ||
         tail -n 25 "$out"; } | cat -v >>"$out.summary"
+    # The input itself, so that a finding on a machine whose build folder is gone (CI) can be
+    # replayed: base64 -d > input; fuzz_<target> input.
+    find "$artifacts" -type f -newer "$work/$t.start" | while read -r f; do
+      printf 'input %s, base64:\n' "$(basename "$f")"
+      base64 -w 0 "$f" | head -c 8000
+      echo
+    done >>"$out.summary"
   fi
   return $rc
 }
