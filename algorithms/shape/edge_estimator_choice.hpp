@@ -25,7 +25,8 @@ struct EdgeEstimatorChoice {
 // each model's edgeEstimator says which) on turned copies of `templateImage` (the trained region
 // only, the model's reference point in its pixels) and returns the estimator that reproduces the
 // poses best. The profile fit is kept unless the zero crossing is better beyond the copies' own
-// scatter (a paired test of their errors, copy by copy).
+// scatter (a paired test of their errors, copy by copy). Candidates whose reference points differ
+// are refused (std::invalid_argument): each turned copy serves them all.
 EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
                                         const std::vector<const ShapeModel*>& candidates);
 
