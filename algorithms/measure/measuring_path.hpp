@@ -37,6 +37,7 @@ class MeasuringPath {
   explicit MeasuringPath(const MeasuringRect& rect);
   explicit MeasuringPath(const MeasuringArc& arc);
 
+  [[nodiscard]] bool isArc() const { return arc_; }
   [[nodiscard]] double length() const { return length_; }
   [[nodiscard]] double width() const { return width_; }
   // The image point at axis position s and cross offset t. (A rectangle's is inline: profile

@@ -3,10 +3,12 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <optional>
 
 #include "algorithms/measure/blob_analysis.hpp"
 #include "service/cli/command_line.hpp"
 #include "service/cli/measuring_options.hpp"
+#include "service/cli/measuring_plane.hpp"
 
 namespace facet::cli {
 namespace {
@@ -17,7 +19,9 @@ struct BlobOptions {
   std::string polarity = "light";
   double minArea = 0;
   double maxArea = std::numeric_limits<double>::infinity();
+  double minRoundness = 0;
   bool pixelArea = false;
+  std::string calibration;  // calibration file: adds centroids and areas in the plane, mm
   bool json = false;
 };
 
@@ -63,6 +67,9 @@ void run(const BlobOptions& o) {
     throw InputError("--min-area must be >= 0 and below --max-area");
   p.minArea = o.minArea;
   p.maxArea = o.maxArea;
+  if (!(o.minRoundness >= 0 && o.minRoundness <= 1))
+    throw InputError("--min-roundness must be between 0 and 1");
+  p.minRoundness = o.minRoundness;
   p.greyArea = !o.pixelArea;
   if (!o.roi.empty()) {
     p.roi = parseRegion(o.roi, "--roi");
@@ -70,6 +77,8 @@ void run(const BlobOptions& o) {
       throw MeasurementFailure("zero_size", o.image + ": the --roi region has zero size");
   }
   const cv::Mat image = readGreyImage(o.image);
+  std::optional<MeasuringPlane> plane;
+  if (!o.calibration.empty()) plane.emplace(o.calibration, image.size());
 
   const auto t0 = std::chrono::steady_clock::now();
   const BlobResult r = analyseBlobs(image, p);
@@ -81,26 +90,46 @@ void run(const BlobOptions& o) {
 
   if (o.json) {
     nlohmann::json blobs = nlohmann::json::array();
-    for (const Blob& b : r.blobs)
-      blobs.push_back(
-          {{"x", b.centroid.x},
-           {"y", b.centroid.y},
-           {"area", b.area},
-           {"pixels", b.pixels},
-           {"bbox", {b.bbox.x, b.bbox.y, b.bbox.width, b.bbox.height}},
-           {"ellipse",
-            {{"major_radius", b.majorRadius}, {"minor_radius", b.minorRadius}, {"angle", b.angle}}},
-           {"touches_border", b.touchesBorder}});
-    printJson(
-        {{"blobs", blobs}, {"threshold", r.threshold}, {"partial", r.partial}, {"time_ms", ms}});
+    for (const Blob& b : r.blobs) {
+      nlohmann::json j{
+          {"x", b.centroid.x},
+          {"y", b.centroid.y},
+          {"area", b.area},
+          {"pixels", b.pixels},
+          {"bbox", {b.bbox.x, b.bbox.y, b.bbox.width, b.bbox.height}},
+          {"ellipse",
+           {{"major_radius", b.majorRadius}, {"minor_radius", b.minorRadius}, {"angle", b.angle}}},
+          {"touches_border", b.touchesBorder}};
+      if (plane) {
+        // The plane's scale at the centroid, as facetd's blob step: a blob is small beside the
+        // distances over which the lens and the tilt change the scale.
+        const cv::Point2d q = plane->toPlane(b.centroid);
+        const double s = plane->mmPerPixelAt(b.centroid);
+        j["x_mm"] = q.x;
+        j["y_mm"] = q.y;
+        j["area_mm2"] = b.area * s * s;
+      }
+      blobs.push_back(j);
+    }
+    nlohmann::json out{
+        {"blobs", blobs}, {"threshold", r.threshold}, {"partial", r.partial}, {"time_ms", ms}};
+    if (plane) out["calibration"] = plane->kind();
+    printJson(out);
     return;
   }
   if (r.partial) std::cout << "note: the region was clipped to the image\n";
   std::cout << r.blobs.size() << " blobs (threshold " << r.threshold << ")\n";
-  for (const Blob& b : r.blobs)
+  for (const Blob& b : r.blobs) {
     std::cout << "  (" << b.centroid.x << ", " << b.centroid.y << ") area " << b.area
               << " px^2, bbox " << b.bbox.x << "," << b.bbox.y << "," << b.bbox.width << ","
-              << b.bbox.height << "\n";
+              << b.bbox.height;
+    if (plane) {
+      const double s = plane->mmPerPixelAt(b.centroid);
+      std::cout << "; area " << b.area * s * s << " mm^2";
+    }
+    std::cout << "\n";
+  }
+  if (plane) std::cout << "in the measuring plane: " << plane->kind() << "\n";
   std::cout << ms << " ms\n";
 }
 
@@ -118,8 +147,13 @@ void addBlobCommand(CLI::App& app) {
   cmd->add_option("--polarity", o->polarity, "light (default) or dark blobs");
   cmd->add_option("--min-area", o->minArea, "smallest blob area in pixels^2 (default 0)");
   cmd->add_option("--max-area", o->maxArea, "largest blob area in pixels^2 (default none)");
+  cmd->add_option("--min-roundness", o->minRoundness,
+                  "smallest minor / major axis ratio of a blob's ellipse kept, 0..1 (default 0)");
   cmd->add_flag("--pixel-area", o->pixelArea,
                 "areas as thresholded pixel counts instead of the subpixel grey-value area");
+  cmd->add_option("--calibration", o->calibration,
+                  "calibration file (facet calibrate): adds centroids and areas in the measuring "
+                  "plane, mm");
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o] { run(*o); });
 }

@@ -1,16 +1,19 @@
 // facet caliper: edges and edge pairs along a rotated rectangle (or an arc).
 #include <chrono>
 #include <iostream>
+#include <optional>
 
 #include "algorithms/measure/caliper.hpp"
 #include "service/cli/command_line.hpp"
 #include "service/cli/measuring_options.hpp"
+#include "service/cli/measuring_plane.hpp"
 
 namespace facet::cli {
 namespace {
 
 struct CaliperOptions {
   std::string image, rect, arc;
+  std::string calibration;  // calibration file: adds positions and widths in the plane, mm
   std::string polarity = "any";
   std::string select = "all";
   bool pairs = false;
@@ -18,8 +21,18 @@ struct CaliperOptions {
   bool json = false;
 };
 
-nlohmann::json edgeJson(const CaliperEdge& e) {
-  return {{"x", e.point.x}, {"y", e.point.y}, {"position", e.position}, {"amplitude", e.amplitude}};
+// `plane`: also the edge's place and position in the measuring plane, mm.
+nlohmann::json edgeJson(const CaliperEdge& e, const MeasuringPath& path,
+                        const MeasuringPlane* plane) {
+  nlohmann::json j{
+      {"x", e.point.x}, {"y", e.point.y}, {"position", e.position}, {"amplitude", e.amplitude}};
+  if (plane) {
+    const cv::Point2d q = plane->toPlane(e.point);
+    j["x_mm"] = q.x;
+    j["y_mm"] = q.y;
+    j["position_mm"] = plane->span(path, 0.0, e.position);
+  }
+  return j;
 }
 
 void run(const CaliperOptions& o) {
@@ -33,6 +46,9 @@ void run(const CaliperOptions& o) {
   const MeasuringPath path = o.rect.empty() ? MeasuringPath(parseMeasuringArc(o.arc, "--arc"))
                                             : MeasuringPath(parseMeasuringRect(o.rect, "--rect"));
   const cv::Mat image = readGreyImage(o.image);
+  std::optional<MeasuringPlane> plane;
+  if (!o.calibration.empty()) plane.emplace(o.calibration, image.size());
+  const MeasuringPlane* inPlane = plane ? &*plane : nullptr;
 
   const auto t0 = std::chrono::steady_clock::now();
   const CaliperResult r = measureCaliper(image, path, p);
@@ -44,25 +60,44 @@ void run(const CaliperOptions& o) {
 
   if (o.json) {
     nlohmann::json edges = nlohmann::json::array(), pairs = nlohmann::json::array();
-    for (const CaliperEdge& e : r.edges) edges.push_back(edgeJson(e));
-    for (const CaliperPair& pr : r.pairs)
-      pairs.push_back({{"x", pr.centre.x},
+    for (const CaliperEdge& e : r.edges) edges.push_back(edgeJson(e, path, inPlane));
+    for (const CaliperPair& pr : r.pairs) {
+      nlohmann::json j{{"x", pr.centre.x},
                        {"y", pr.centre.y},
                        {"position", pr.position},
                        {"width", pr.width},
-                       {"first", edgeJson(pr.first)},
-                       {"second", edgeJson(pr.second)}});
+                       {"first", edgeJson(pr.first, path, inPlane)},
+                       {"second", edgeJson(pr.second, path, inPlane)}};
+      if (plane) {
+        const cv::Point2d q = plane->toPlane(pr.centre);
+        j["x_mm"] = q.x;
+        j["y_mm"] = q.y;
+        j["position_mm"] = plane->span(path, 0.0, pr.position);
+        j["width_mm"] = plane->span(path, pr.first.position, pr.second.position);
+      }
+      pairs.push_back(j);
+    }
     // "partial": part of the caliper lay outside the image and only the inside was measured.
-    printJson({{"edges", edges}, {"pairs", pairs}, {"partial", r.partial}, {"time_ms", ms}});
+    nlohmann::json out{{"edges", edges}, {"pairs", pairs}, {"partial", r.partial}, {"time_ms", ms}};
+    if (plane) out["calibration"] = plane->kind();
+    printJson(out);
     return;
   }
   if (r.partial) std::cout << "note: part of the caliper lies outside the image\n";
-  for (const CaliperEdge& e : r.edges)
+  for (const CaliperEdge& e : r.edges) {
     std::cout << "edge at (" << e.point.x << ", " << e.point.y << ") px, position " << e.position
-              << " px, amplitude " << e.amplitude << "\n";
-  for (const CaliperPair& pr : r.pairs)
+              << " px, amplitude " << e.amplitude;
+    if (plane) std::cout << "; position " << plane->span(path, 0.0, e.position) << " mm";
+    std::cout << "\n";
+  }
+  for (const CaliperPair& pr : r.pairs) {
     std::cout << "pair at (" << pr.centre.x << ", " << pr.centre.y << ") px, width " << pr.width
-              << " px\n";
+              << " px";
+    if (plane)
+      std::cout << "; width " << plane->span(path, pr.first.position, pr.second.position) << " mm";
+    std::cout << "\n";
+  }
+  if (plane) std::cout << "lengths in the measuring plane: " << plane->kind() << "\n";
   std::cout << ms << " ms\n";
 }
 
@@ -86,6 +121,9 @@ void addCaliperCommand(CLI::App& app) {
                 "--polarity then gives the first edge's");
   cmd->add_option("--min-amplitude", o->minAmplitude,
                   "smallest grey step of an edge, 8-bit grey levels (default 20)");
+  cmd->add_option("--calibration", o->calibration,
+                  "calibration file (facet calibrate): adds places, positions and widths in the "
+                  "measuring plane, mm");
   cmd->add_flag("--json", o->json, "Print one JSON object");
   cmd->callback([o] { run(*o); });
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "algorithms/circle/circle_measure.hpp"
@@ -48,7 +49,8 @@ void run(const CircleOptions& o) {
   p.polarity = parsePolarity(o.polarity);
   p.minCoverageDeg = o.minCoverage;
   const cv::Mat image = readGreyImage(o.image);
-  if (!o.calibration.empty()) checkCalibrationFor(o.calibration, image.size());
+  std::optional<MeasuringPlane> plane;
+  if (!o.calibration.empty()) plane.emplace(o.calibration, image.size());
 
   const auto t0 = std::chrono::steady_clock::now();
   const CircleMeasurement m = measureCircle(image, p);
@@ -60,8 +62,7 @@ void run(const CircleOptions& o) {
     throw MeasurementFailure(std::string(toString(m.status.cause)),
                              o.image + ": " + m.status.message);
 
-  const nlohmann::json world =
-      o.calibration.empty() ? nlohmann::json() : worldCircle(o.calibration, image.size(), m);
+  const nlohmann::json world = plane ? worldCircle(*plane, m) : nlohmann::json();
   if (o.json) {
     nlohmann::json out{{"x", m.centre.x},
                        {"y", m.centre.y},

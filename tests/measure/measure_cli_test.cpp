@@ -104,6 +104,19 @@ TEST_F(MeasureCli, BlobPrintsEachBlob) {
   const CliRun big1 = facet("blob --image " + image_ + " --roi 0,0,200,70 --min-area 400 --json");
   ASSERT_EQ(big1.exitCode, 0) << big1.err;
   EXPECT_EQ(nlohmann::json::parse(big1.out).at("blobs").size(), 1u);
+  // The slot, a dark blob 6.4 px wide and 30 long in this region, is not round.
+  const std::string slot = "blob --image " + image_ + " --roi 50,90,30,30 --polarity dark";
+  const CliRun any = facet(slot + " --json");
+  ASSERT_EQ(any.exitCode, 0) << any.err;
+  const auto a = nlohmann::json::parse(any.out);
+  ASSERT_EQ(a.at("blobs").size(), 1u) << any.out;
+  EXPECT_LT(a["blobs"][0]["ellipse"]["minor_radius"].get<double>(),
+            0.5 * a["blobs"][0]["ellipse"]["major_radius"].get<double>());
+  const CliRun round = facet(slot + " --min-roundness 0.5 --json");
+  EXPECT_EQ(round.exitCode, 2) << round.out;
+  const CliRun bad = facet(slot + " --min-roundness 2");
+  EXPECT_EQ(bad.exitCode, 1);
+  EXPECT_NE(bad.err.find("--min-roundness"), std::string::npos) << bad.err;
 }
 
 TEST_F(MeasureCli, MeasurementFailuresAreJsonErrorsWithTheirCause) {

@@ -1,8 +1,6 @@
 #include "service/engine/steps/caliper_step.hpp"
 
-#include <algorithm>
-#include <cmath>
-
+#include "algorithms/calibration/plane_measures.hpp"
 #include "config/recipe_format.hpp"
 #include "service/engine/steps/edge_polarity_names.hpp"
 #include "service/engine/steps/placed_rect.hpp"
@@ -132,27 +130,11 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
       points.push_back(e.point);
     }
   }
-  // Lengths along the axis, from its middle. With a lens model and a measuring plane they are
-  // measured in the plane, in mm: the axis as the plane sees it (a rectangle), or the arc's
-  // points carried into the plane and their path summed (an arc; its image is not a circle
-  // there under perspective).
+  // Lengths along the axis, from its middle: in the measuring plane, in mm, when the station has
+  // a lens model and a plane (plane_measures.hpp).
   const auto plane = part.calibration.worldMapping();
-  const auto where = [&](cv::Point2d q) { return plane ? plane->toPlane(q) : q; };
-  const auto span = [&](double s0, double s1) {  // signed length from s0 to s1
-    if (!plane) return s1 - s0;
-    if (rect) {
-      const cv::Point2d centre(rect->cx, rect->cy);
-      cv::Point2d axis = where(centre + path.axisAt(0)) - where(centre);
-      axis /= cv::norm(axis);
-      return (where(path.at(s1, 0)) - where(path.at(s0, 0))).dot(axis);
-    }
-    const int steps = std::max(1, static_cast<int>(std::ceil(std::abs(s1 - s0))));
-    double sum = 0.0;
-    for (int i = 0; i < steps; ++i)
-      sum += cv::norm(where(path.at(s0 + (s1 - s0) * (i + 1) / steps, 0)) -
-                      where(path.at(s0 + (s1 - s0) * i / steps, 0)));
-    return s1 >= s0 ? sum : -sum;
-  };
+  const WorldMapping* mapping = plane ? &*plane : nullptr;
+  const auto span = [&](double s0, double s1) { return spanInPlane(path, mapping, s0, s1); };
 
   StepResult r;
   r.lengthsInMm = plane.has_value();

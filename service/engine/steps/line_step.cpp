@@ -1,8 +1,6 @@
 #include "service/engine/steps/line_step.hpp"
 
-#include <cmath>
-
-#include "algorithms/geometry/pose2d.hpp"
+#include "algorithms/calibration/plane_measures.hpp"
 #include "algorithms/measure/line_measure.hpp"
 #include "config/recipe_format.hpp"
 #include "service/engine/steps/edge_polarity_names.hpp"
@@ -50,31 +48,17 @@ StepResult LineStep::run(const config::Step& step, StepContext& part) const {
   if (!m.status.ok()) return StepResult::failed("line not measured: " + m.status.message);
 
   // With a lens model and a measuring plane, the angle is taken between the line and the axis as
-  // the plane sees them, and deviations use the plane's scale at the line's middle.
+  // the plane sees them, and lengths are the plane's (plane_measures.hpp).
   const auto plane = part.calibration.worldMapping();
-  const auto where = [&](cv::Point2d q) { return plane ? plane->toPlane(q) : q; };
-  const cv::Point2d centre(rect.cx, rect.cy);
+  const LineInPlane seen = lineInPlane(rect, m, plane ? &*plane : nullptr);
   const cv::Point2d mid = (m.p1 + m.p2) * 0.5;
-  const MeasuringPath path(rect);
-  const cv::Point2d axis = where(centre + path.axisAt(0)) - where(centre);
-  const cv::Point2d along = where(m.p2) - where(m.p1);
-  const double turn = std::atan2(axis.x * along.y - axis.y * along.x, axis.dot(along));
-  cv::Point2d across = where(centre + path.acrossAt(0)) - where(centre);
-  across /= cv::norm(across);
-  // Offset across the axis of the line's crossing with the rectangle's centre line.
-  const cv::Point2d u = along / cv::norm(along);
-  const cv::Point2d v = where(centre) - where(mid);
-  const double cross = u.x * across.y - u.y * across.x;
-  const double offset = std::abs(cross) > 1e-9 ? (v.x * u.y - v.y * u.x) / cross : 0.0;
 
   StepResult r;
   r.lengthsInMm = plane.has_value();
-  const double scale = plane ? plane->mmPerPixelAt(mid) : 1.0;
-  // The plane's y axis points down the image as pixels do: a turn towards it is clockwise.
-  r.values["angle"] = l.angle - degrees(turn);
-  r.values["position"] = offset;
-  r.values["straightness"] = m.straightness * scale;
-  r.values["rms"] = m.rms * scale;
+  r.values["angle"] = l.angle + seen.angleFromAxis;
+  r.values["position"] = seen.offset;
+  r.values["straightness"] = seen.straightness;
+  r.values["rms"] = seen.rms;
   r.point = mid;
   r.angleDeg = m.angle;
   if (m.partial) r.note = "part of the line rectangle lies outside the image: measured inside only";

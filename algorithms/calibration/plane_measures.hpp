@@ -1,0 +1,37 @@
+#pragma once
+// The caliper's and the line's results as the measuring plane sees them, in mm: lengths along a
+// caliper's axis and a fitted line's angle, offset and deviations. The image of the plane is
+// stretched unevenly by the lens and the view's tilt, so a length in pixels times one scale is
+// not the part's length; the points are carried into the plane and measured there.
+//
+// `plane` null: the image is the plane (results in pixels), so a recipe step and a command give
+// the same numbers with and without a lens model.
+
+#include <opencv2/core.hpp>
+
+#include "algorithms/calibration/world_mapping.hpp"
+#include "algorithms/measure/line_measure.hpp"
+#include "algorithms/measure/measuring_path.hpp"
+
+namespace facet {
+
+// Signed length from axis position s0 to s1: a rectangle's along its axis as the plane sees it
+// (an edge's distance from the centre, a pair's width); an arc's by summing its path carried
+// into the plane in steps of about a pixel (its image is no circle under perspective).
+double spanInPlane(const MeasuringPath& path, const WorldMapping* plane, double s0, double s1);
+
+struct LineInPlane {
+  cv::Point2d p1, p2;  // the segment's ends in the plane
+  // The line's angle from the rectangle's axis, degrees counter-clockwise on screen (the plane's
+  // y axis points down the image as pixels do).
+  double angleFromAxis = 0;
+  // Where the line crosses the rectangle's centre line across the axis, signed along the
+  // rectangle's across direction (the axis turned clockwise on screen).
+  double offset = 0;
+  double straightness = 0, rms = 0;  // scaled by the plane at the line's middle
+};
+
+LineInPlane lineInPlane(const MeasuringRect& rect, const LineMeasurement& line,
+                        const WorldMapping* plane);
+
+}  // namespace facet
