@@ -43,8 +43,12 @@ LineInPlane lineInPlane(const MeasuringRect& rect, const LineMeasurement& line,
   // Positive turns towards the plane's y, which is clockwise on screen.
   const double turn = std::atan2(axis.x * along.y - axis.y * along.x, axis.dot(along));
   out.angleFromAxis = -turn * 180.0 / CV_PI;
-  cv::Point2d across = inPlane(plane, centre + path.acrossAt(0)) - inPlane(plane, centre);
+  // Across the axis in the plane: square to it there (the image's square to the axis is not,
+  // on a tilted view), on the side of the rectangle's across direction.
+  cv::Point2d across(-axis.y, axis.x);
   across /= cv::norm(across);
+  if (across.dot(inPlane(plane, centre + path.acrossAt(0)) - inPlane(plane, centre)) < 0)
+    across = -across;
   // The line p(k) = mid + k u meets the centre line c + m across where their difference vanishes.
   const cv::Point2d u = along / cv::norm(along);
   const cv::Point2d mid = (out.p1 + out.p2) * 0.5;

@@ -25,8 +25,9 @@ struct LineInPlane {
   // The line's angle from the rectangle's axis, degrees counter-clockwise on screen (the plane's
   // y axis points down the image as pixels do).
   double angleFromAxis = 0;
-  // Where the line crosses the rectangle's centre line across the axis, signed along the
-  // rectangle's across direction (the axis turned clockwise on screen).
+  // Where the line crosses the line through the rectangle's centre square to its axis (both as
+  // the plane sees them), signed towards the rectangle's across direction (the axis turned
+  // clockwise on screen).
   double offset = 0;
   double straightness = 0, rms = 0;  // scaled by the plane at the line's middle
 };
