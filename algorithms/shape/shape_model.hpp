@@ -121,8 +121,8 @@ struct ShapeModel {
   double contrastLow = 0.0;  // thresholds actually used for the template, grey levels per pixel
   double contrastHigh = 0.0;
   // Rotations that map the model almost onto itself, on level 0 or on the top level
-  // (findSearchSymmetries, model_symmetry.hpp; derived from the points when the
-  // model is created or loaded; not stored in model files).
+  // (findSearchSymmetries, model_symmetry.hpp; derived from the points when the model is
+  // created, and kept in its file).
   std::vector<ModelSymmetry> symmetries;
 
   [[nodiscard]] bool empty() const { return levels.empty(); }

@@ -17,9 +17,10 @@ constexpr std::array<char, 8> kMagic = {'F', 'A', 'C', 'E', 'T', 'S', 'H', 'M'};
 constexpr std::size_t kHeaderSize = kMagic.size() + sizeof(std::uint32_t) + sizeof(std::uint64_t);
 constexpr std::uint32_t kMaxPoints = 10'000'000;  // far above any real model: guards bad counts
 constexpr std::uint32_t kMaxLevels = 16;
-constexpr int kMaxTemplateSide = 1 << 14;  // pixels
-constexpr double kMaxScale = 10.0;         // the search's border grows with radius * scale
-constexpr double kMaxSearchSamples = 1e6;  // angle or scale steps per search range
+constexpr int kMaxTemplateSide = 1 << 14;     // pixels
+constexpr double kMaxScale = 10.0;            // the search's border grows with radius * scale
+constexpr double kMaxSearchSamples = 1e6;     // angle or scale steps per search range
+constexpr std::uint32_t kMaxSymmetries = 64;  // a search tries each: far above any real model's
 
 std::uint64_t fnv1a(const char* data, std::size_t size) {
   std::uint64_t h = 14695981039346656037ull;
@@ -128,6 +129,13 @@ std::string implausibility(const ShapeModel& m) {
     if (!finitePoints(level.points, extent)) return "point coordinates";
   }
   if (!finitePoints(m.finePoints, extent)) return "point coordinates";
+  // A turn's centre may lie off the template (a few degrees' turn with a shift), never far off.
+  for (const ModelSymmetry& sym : m.symmetries)
+    if (!std::isfinite(sym.angle) || std::abs(sym.angle) > kTwoPi ||
+        !(std::abs(sym.centre.x) <= 4.0 * kMaxTemplateSide) ||
+        !(std::abs(sym.centre.y) <= 4.0 * kMaxTemplateSide) ||
+        !(sym.score >= 0.0 && sym.score <= 1.0 + 1e-6))
+      return "symmetry";
   return "";
 }
 
@@ -150,6 +158,9 @@ void saveShapeModel(const ShapeModel& model, const std::filesystem::path& path) 
   }
   w.putPoints(model.finePoints);
   w.put(static_cast<std::uint8_t>(model.edgeEstimator == EdgeEstimator::ProfileFit ? 0 : 1));
+  w.put(static_cast<std::uint32_t>(model.symmetries.size()));
+  for (const ModelSymmetry& sym : model.symmetries)
+    w.put(sym.angle), w.put(sym.centre.x), w.put(sym.centre.y), w.put(sym.score);
 
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw ShapeModelFileError(path.string() + ": cannot open for writing");
@@ -178,10 +189,10 @@ ShapeModel loadShapeModel(const std::filesystem::path& path) {
   std::uint64_t size = 0;
   std::memcpy(&version, file.data() + kMagic.size(), sizeof(version));
   std::memcpy(&size, file.data() + kMagic.size() + sizeof(version), sizeof(size));
-  if (version != kShapeModelFileVersion && version != 1)
+  if (version < 1 || version > kShapeModelFileVersion)
     throw ShapeModelFileError(name + ": unsupported shape model file version " +
-                              std::to_string(version) + " (this build reads version " +
-                              std::to_string(kShapeModelFileVersion) + " and 1)");
+                              std::to_string(version) + " (this build reads versions 1 to " +
+                              std::to_string(kShapeModelFileVersion) + ")");
   if (file.size() - kHeaderSize < sizeof(std::uint64_t) ||
       size > file.size() - kHeaderSize - sizeof(std::uint64_t))
     throw ShapeModelFileError(name + ": truncated shape model file (" +
@@ -220,12 +231,22 @@ ShapeModel loadShapeModel(const std::filesystem::path& path) {
     model.edgeEstimator =
         estimator == 0 ? EdgeEstimator::ProfileFit : EdgeEstimator::FacetZeroCrossing;
   }
+  if (version >= 3) {
+    const auto count = r.get<std::uint32_t>();
+    if (count > kMaxSymmetries) r.fail("corrupt symmetry count");
+    model.symmetries.resize(count);
+    for (ModelSymmetry& sym : model.symmetries) {
+      sym.angle = r.get<double>();
+      sym.centre.x = r.get<double>(), sym.centre.y = r.get<double>();
+      sym.score = r.get<double>();
+    }
+  }
   if (!r.atEnd()) r.fail("corrupt shape model file (unexpected data after the model)");
   if (model.levels.front().points.empty() || model.finePoints.empty())
     r.fail("corrupt shape model file (invalid values)");
   if (const std::string why = implausibility(model); !why.empty())
     r.fail("corrupt shape model file (invalid values: " + why + ")");
-  model.symmetries = findSearchSymmetries(model.levels);
+  if (version < 3) model.symmetries = findSearchSymmetries(model.levels);
   return model;
 }
 

@@ -1,4 +1,5 @@
 // Shape model files: round trip, and every way a file can be bad.
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgproc.hpp>
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
@@ -116,6 +118,62 @@ std::vector<char> rewritten(const std::vector<char>& file, std::uint32_t version
   return out;
 }
 
+// The bytes a model's near-symmetries take at the end of a version 3 payload.
+std::size_t symmetryBlockSize(const ShapeModel& model) {
+  return sizeof(std::uint32_t) + model.symmetries.size() * 4 * sizeof(double);
+}
+
+// A cross whose arms differ by a few pixels: its quarter turns are near-symmetries.
+cv::Mat crossTemplate() {
+  cv::Mat image(134, 140, CV_8UC1, cv::Scalar(40));
+  const std::vector<cv::Point> cross = {{81, 9},  {81, 56},  {130, 56}, {130, 78},
+                                        {81, 78}, {81, 122}, {59, 122}, {59, 78},
+                                        {13, 78}, {13, 56},  {59, 56},  {59, 12}};
+  cv::fillPoly(image, std::vector<std::vector<cv::Point>>{cross}, cv::Scalar(200), cv::LINE_AA);
+  cv::GaussianBlur(image, image, {0, 0}, 1.0);
+  return image;
+}
+
+TEST_F(ShapeModelFile, SymmetriesAreKeptAndFilesWithoutThemFindThemAtLoad) {
+  const ShapeModel model = createShapeModel(crossTemplate());
+  ASSERT_GE(model.symmetries.size(), 2u);  // the quarter turns at least
+  const fs::path file = dir_ / "cross.model";
+  saveShapeModel(model, file);
+  const auto same = [&](const ShapeModel& loaded, const char* what) {
+    ASSERT_EQ(loaded.symmetries.size(), model.symmetries.size()) << what;
+    for (std::size_t i = 0; i < model.symmetries.size(); ++i) {
+      EXPECT_EQ(loaded.symmetries[i].angle, model.symmetries[i].angle) << what;
+      EXPECT_EQ(loaded.symmetries[i].centre, model.symmetries[i].centre) << what;
+      EXPECT_EQ(loaded.symmetries[i].score, model.symmetries[i].score) << what;
+    }
+  };
+  same(loadShapeModel(file), "version 3");
+  // Version 2 ended after the estimator byte: the same symmetries, found at load.
+  const fs::path v2 = dir_ / "version2.model";
+  write(v2, rewritten(bytesOf(file), 2, [&](std::vector<char>& p) {
+          p.resize(p.size() - symmetryBlockSize(model));
+        }));
+  same(loadShapeModel(v2), "version 2");
+
+  // Values no search can use behind a valid checksum: a turn that is not a number, more turns
+  // than any model has.
+  const fs::path nan = dir_ / "nan_symmetry.model";
+  write(nan, rewritten(bytesOf(file), kShapeModelFileVersion, [&](std::vector<char>& p) {
+          const double bad = std::numeric_limits<double>::quiet_NaN();
+          std::memcpy(p.data() + p.size() - symmetryBlockSize(model) + sizeof(std::uint32_t), &bad,
+                      sizeof bad);
+        }));
+  std::string e = loadError(nan);
+  EXPECT_NE(e.find("symmetry"), std::string::npos) << e;
+  const fs::path many = dir_ / "many_symmetries.model";
+  write(many, rewritten(bytesOf(file), kShapeModelFileVersion, [&](std::vector<char>& p) {
+          const std::uint32_t count = 1000;
+          std::memcpy(p.data() + p.size() - symmetryBlockSize(model), &count, sizeof count);
+        }));
+  e = loadError(many);
+  EXPECT_NE(e.find("symmetry count"), std::string::npos) << e;
+}
+
 TEST_F(ShapeModelFile, TheEdgeEstimatorIsKeptAndVersionOneFilesLoadAsTheProfileFit) {
   ShapeModelParams params;
   params.edgeEstimator = EdgeEstimator::FacetZeroCrossing;
@@ -124,16 +182,19 @@ TEST_F(ShapeModelFile, TheEdgeEstimatorIsKeptAndVersionOneFilesLoadAsTheProfileF
   saveShapeModel(model, file);
   EXPECT_EQ(loadShapeModel(file).edgeEstimator, EdgeEstimator::FacetZeroCrossing);
 
-  // Version 1 had no estimator byte after the subpixel points: its models used the profile fit.
+  // Version 1 had no estimator byte after the subpixel points (nor the symmetries that follow
+  // it since version 3): its models used the profile fit.
+  const std::size_t symmetryBytes = symmetryBlockSize(model);
   const fs::path old = dir_ / "version1.model";
-  write(old, rewritten(bytesOf(file), 1, [](std::vector<char>& p) { p.pop_back(); }));
+  write(old, rewritten(bytesOf(file), 1,
+                       [&](std::vector<char>& p) { p.resize(p.size() - symmetryBytes - 1); }));
   const ShapeModel loaded = loadShapeModel(old);
   EXPECT_EQ(loaded.edgeEstimator, EdgeEstimator::ProfileFit);
   EXPECT_EQ(loaded.finePoints.size(), model.finePoints.size());
 
   const fs::path unknown = dir_ / "estimator7.model";
   write(unknown, rewritten(bytesOf(file), kShapeModelFileVersion,
-                           [](std::vector<char>& p) { p.back() = 7; }));
+                           [&](std::vector<char>& p) { p[p.size() - symmetryBytes - 1] = 7; }));
   const std::string e = loadError(unknown);
   EXPECT_NE(e.find("edge estimator"), std::string::npos) << e;
 }

@@ -1,7 +1,9 @@
 // libFuzzer target: the shape model file loader (algorithms/shape/shape_model_file.hpp).
 // The file's FNV-1a checksum would stop nearly every mutation at "checksum mismatch", so inputs
 // whose first byte is odd are taken as a payload and wrapped in a valid header and checksum
-// (reaching the payload parser); even ones are written as they are (testing the header checks).
+// (reaching the payload parser), of the current version or, with the byte's second bit set, of
+// version 2 (whose payload ends before the symmetries); even ones are written as they are
+// (testing the header checks).
 // Expected outcome for bad input: ShapeModelFileError. A model that loads must be usable: it is
 // searched for in a small image, which must end (libFuzzer's -timeout) without a sanitizer report.
 
@@ -35,10 +37,11 @@ void append(std::vector<std::uint8_t>& bytes, T value) {
   bytes.insert(bytes.end(), p, p + sizeof(T));
 }
 
-std::vector<std::uint8_t> wrapPayload(const std::uint8_t* payload, std::size_t size) {
+std::vector<std::uint8_t> wrapPayload(const std::uint8_t* payload, std::size_t size,
+                                      std::uint32_t version) {
   constexpr std::array<char, 8> kMagic = {'F', 'A', 'C', 'E', 'T', 'S', 'H', 'M'};
   std::vector<std::uint8_t> file(kMagic.begin(), kMagic.end());
-  append<std::uint32_t>(file, facet::kShapeModelFileVersion);
+  append<std::uint32_t>(file, version);
   append<std::uint64_t>(file, size);
   file.insert(file.end(), payload, payload + size);
   append<std::uint64_t>(file, fnv1a(payload, size));
@@ -51,7 +54,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static const facet::fuzz::FuzzInputFolder folder;
   std::filesystem::path file;
   if (size > 0 && (data[0] & 1u)) {
-    const auto wrapped = wrapPayload(data + 1, size - 1);
+    const auto wrapped =
+        wrapPayload(data + 1, size - 1, (data[0] & 2u) ? 2u : facet::kShapeModelFileVersion);
     file = folder.write("model.fsm", wrapped.data(), wrapped.size());
   } else {
     file = folder.write("model.fsm", data, size);
