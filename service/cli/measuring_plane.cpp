@@ -43,7 +43,14 @@ double MeasuringPlane::mmPerPixelAt(cv::Point2d pixel) const {
 }
 
 double MeasuringPlane::span(const MeasuringPath& path, double s0, double s1) const {
-  return mapping_ ? spanInPlane(path, mapping(), s0, s1) : (s1 - s0) * mmPerPixel_;
+  if (!mapping_) return (s1 - s0) * mmPerPixel_;
+  const double mm = spanInPlane(path, mapping(), s0, s1);
+  if (!std::isfinite(mm))
+    throw MeasurementFailure("off_plane",
+                             "the caliper's axis does not map into the measuring "
+                             "plane of " +
+                                 file_);
+  return mm;
 }
 
 LineInPlane MeasuringPlane::line(const MeasuringRect& rect, const LineMeasurement& m) const {

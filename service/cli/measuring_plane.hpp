@@ -31,7 +31,8 @@ class MeasuringPlane {
   [[nodiscard]] cv::Point2d toPlane(cv::Point2d pixel) const;
   // mm per pixel about an image point (the plane's local scale).
   [[nodiscard]] double mmPerPixelAt(cv::Point2d pixel) const;
-  // The signed length from axis position s0 to s1 of a caliper's path, mm.
+  // The signed length from axis position s0 to s1 of a caliper's path, mm (MeasurementFailure
+  // "off_plane" where the path leaves the plane).
   [[nodiscard]] double span(const MeasuringPath& path, double s0, double s1) const;
   // A fitted line in the plane (ends, offset and deviations in mm).
   [[nodiscard]] LineInPlane line(const MeasuringRect& rect, const LineMeasurement& m) const;
