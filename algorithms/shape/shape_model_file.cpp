@@ -17,10 +17,12 @@ constexpr std::array<char, 8> kMagic = {'F', 'A', 'C', 'E', 'T', 'S', 'H', 'M'};
 constexpr std::size_t kHeaderSize = kMagic.size() + sizeof(std::uint32_t) + sizeof(std::uint64_t);
 constexpr std::uint32_t kMaxPoints = 10'000'000;  // far above any real model: guards bad counts
 constexpr std::uint32_t kMaxLevels = 16;
-constexpr int kMaxTemplateSide = 1 << 14;     // pixels
-constexpr double kMaxScale = 10.0;            // the search's border grows with radius * scale
-constexpr double kMaxSearchSamples = 1e6;     // angle or scale steps per search range
-constexpr std::uint32_t kMaxSymmetries = 64;  // a search tries each: far above any real model's
+constexpr int kMaxTemplateSide = 1 << 14;  // pixels
+constexpr double kMaxScale = 10.0;         // the search's border grows with radius * scale
+constexpr double kMaxSearchSamples = 1e6;  // angle or scale steps per search range
+// findSearchSymmetries gives at most 3 of level 0 and 3 of the top level; each costs every search
+// a turned pose to score.
+constexpr std::uint32_t kMaxSymmetries = 16;
 
 std::uint64_t fnv1a(const char* data, std::size_t size) {
   std::uint64_t h = 14695981039346656037ull;
