@@ -7,6 +7,7 @@
 #include "config/recipe_format.hpp"
 #include "service/engine/frame_maps.hpp"
 #include "service/engine/steps/pose_fields.hpp"
+#include "service/engine/steps/pose_offset.hpp"
 #include "service/engine/steps/shape_model_resource.hpp"
 
 namespace facet::service {
@@ -22,14 +23,14 @@ ShapeTraining trainingOf(const AlignParams& a) {
   return {a.reference, a.region, a.angleRange, a.model};
 }
 
-// x, y: offset of the reference point `home` from its nominal place; angle: rotation.
-StepResult withPoseValues(StepResult r, cv::Point2d home) {
+// x, y: offset of the reference point `home` from its nominal place; angle: rotation (in the
+// measuring plane when the station has one, pose_offset.hpp).
+StepResult withPoseValues(StepResult r, cv::Point2d home, const StepContext& part) {
   const cv::Point2d found = mapPoint(*r.refToImage, home);
-  r.values["x"] = found.x - home.x;
-  r.values["y"] = found.y - home.y;
   r.angleDeg = rotationDeg(*r.refToImage, home);
-  r.values["angle"] = *r.angleDeg;
   r.point = found;
+  if (!setPoseOffset(r, part.calibration.worldMapping(), home, found, *r.angleDeg))
+    return StepResult::failed("the part's place does not map into the measuring plane");
   return r;
 }
 
@@ -49,13 +50,19 @@ AlignStep::AlignStep() : TableStep({.point = true, .pose = true, .line = true}) 
   fields_.path("model", &AlignParams::model,
                "Trained shape model (method shape), written by `facet recipe train`.", false, true);
   addSearch(fields_);
-  const std::string xDoc = "Offset of the found position from nominal along x (mm by default).";
-  const std::string yDoc = "Offset of the found position from nominal along y (mm by default).";
+  const std::string xDoc =
+      "Offset of the found position from nominal along x (mm by default; with a lens model and "
+      "a measuring plane, along the plane's x, measured there).";
+  const std::string yDoc =
+      "Offset of the found position from nominal along y (mm by default; with a lens model and "
+      "a measuring plane, along the plane's y, measured there).";
   checks_ = {"align checks",
              "",
              {config::checkField("x", Quantity::Length, xDoc),
               config::checkField("y", Quantity::Length, yDoc),
-              config::checkField("angle", Quantity::Angle, "Rotation of the part, degrees."),
+              config::checkField("angle", Quantity::Angle,
+                                 "Rotation of the part, degrees (in the measuring plane when "
+                                 "the station has one)."),
               config::checkField("score", Quantity::Score, "Match score, 0..1.", 0.0)}};
   describe("align",
            "Finds the part and gives the pose later steps follow: log-polar "
@@ -126,7 +133,7 @@ StepResult AlignStep::run(const config::Step& step, StepContext& part) const {
     r.referenceView =
         cv::Rect2d(shape.home - shape.model.referencePoint, cv::Size2d(shape.model.templateSize));
     drawContour(part.overlay, matches[0].contour, search.tl(), true);
-    return withPoseValues(std::move(r), shape.home);
+    return withPoseValues(std::move(r), shape.home, part);
   }
   const cv::Mat& ref = step.resourcesAs<ReferenceImage>().grey;
   const cv::Rect region = clampRect(a.region, ref.size());
@@ -149,7 +156,7 @@ StepResult AlignStep::run(const config::Step& step, StepContext& part) const {
     return StepResult::failed("alignment score " + std::to_string(score) + " below " +
                               std::to_string(a.minScore));
   const cv::Point2d home(region.x + (region.width - 1) / 2.0, region.y + (region.height - 1) / 2.0);
-  return withPoseValues(std::move(r), home);
+  return withPoseValues(std::move(r), home, part);
 }
 
 }  // namespace facet::service

@@ -9,6 +9,7 @@
 #include "config/recipe_format.hpp"
 #include "service/engine/steps/polarity_names.hpp"
 #include "service/engine/steps/pose_fields.hpp"
+#include "service/engine/steps/pose_offset.hpp"
 
 namespace facet::service {
 namespace {
@@ -28,13 +29,21 @@ FiducialsStep::FiducialsStep() : TableStep({.point = true, .pose = true, .line =
                  {.minimum = 0.0, .exclusiveMinimum = true});
   fields_.choice("polarity", &FiducialsParams::polarity, circlePolarityNames(),
                  "Marks darker or lighter than their surroundings.");
-  checks_ = {"fiducials checks",
-             "",
-             {config::checkField("x", Quantity::Length, "Shift of the marks' centroid along x."),
-              config::checkField("y", Quantity::Length, "Shift of the marks' centroid along y."),
-              config::checkField("angle", Quantity::Angle, "Rotation of the marks, degrees."),
-              config::checkField("spacing", Quantity::Length,
-                                 "Distance between the first two marks.", 0.0)}};
+  checks_ = {
+      "fiducials checks",
+      "",
+      {config::checkField("x", Quantity::Length,
+                          "Shift of the marks' centroid along x (the plane's, measured there, "
+                          "when the station has a lens model and a plane)."),
+       config::checkField("y", Quantity::Length,
+                          "Shift of the marks' centroid along y (likewise)."),
+       config::checkField("angle", Quantity::Angle,
+                          "Rotation of the marks, degrees (in the measuring plane when the "
+                          "station has one)."),
+       config::checkField("spacing", Quantity::Length,
+                          "Distance between the first two marks (in the measuring plane when "
+                          "the station has one).",
+                          0.0)}};
   describe("fiducials", "Finds round marks near their nominal positions.");
 }
 
@@ -84,11 +93,12 @@ StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const
   for (std::size_t i = 0; i < found.size(); ++i) cn += nominal[i], cf += found[i];
   cn *= 1.0 / nominal.size();
   cf *= 1.0 / found.size();
-  r.values["x"] = cf.x - cn.x;
-  r.values["y"] = cf.y - cn.y;
   r.angleDeg = degrees(std::atan2(-S(1, 0), S(0, 0)));
-  r.values["angle"] = *r.angleDeg;
-  r.values["spacing"] = cv::norm(found[1] - found[0]);
+  const auto plane = part.calibration.worldMapping();
+  if (!setPoseOffset(r, plane, cn, cf, *r.angleDeg))
+    return StepResult::failed("the fiducials do not map into the measuring plane");
+  r.values["spacing"] = plane ? cv::norm(plane->toPlane(found[1]) - plane->toPlane(found[0]))
+                              : cv::norm(found[1] - found[0]);
   r.point = cf;
   return r;
 }

@@ -7,6 +7,7 @@
 #include "config/recipe_format.hpp"
 #include "service/engine/frame_maps.hpp"
 #include "service/engine/steps/pose_fields.hpp"
+#include "service/engine/steps/pose_offset.hpp"
 #include "service/engine/steps/shape_model_resource.hpp"
 
 namespace facet::service {
@@ -42,14 +43,20 @@ ShapeStep::ShapeStep() : TableStep({.point = true, .pose = true, .line = true}) 
                   "part, a lens set off-centre in its housing); scores then count a model point "
                   "met that far off. 0 = rigid. Costs search time: try 1 first.",
                   {.minimum = 0.0, .maximum = double(kMaxDeformation)});
-  const std::string xDoc = "Offset of the found position from nominal along x (mm by default).";
-  const std::string yDoc = "Offset of the found position from nominal along y (mm by default).";
+  const std::string xDoc =
+      "Offset of the found position from nominal along x (mm by default; with a lens model and "
+      "a measuring plane, along the plane's x, measured there).";
+  const std::string yDoc =
+      "Offset of the found position from nominal along y (mm by default; with a lens model and "
+      "a measuring plane, along the plane's y, measured there).";
   checks_ = {"shape checks",
              "",
              {config::checkField("count", Quantity::Count, "Number of matches found.", 0.0),
               config::checkField("x", Quantity::Length, xDoc),
               config::checkField("y", Quantity::Length, yDoc),
-              config::checkField("angle", Quantity::Angle, "Rotation of the best match, degrees."),
+              config::checkField("angle", Quantity::Angle,
+                                 "Rotation of the best match, degrees (in the measuring plane "
+                                 "when the station has one)."),
               config::checkField("score", Quantity::Score, "Score of the best match, 0..1.", 0.0)}};
   describe("shape", "Finds a trained shape model and checks count and pose.");
 }
@@ -105,10 +112,9 @@ StepResult ShapeStep::run(const config::Step& step, StepContext& part) const {
   const cv::Point2d nominal = mapPoint(part.frameOf(s.relativeTo), shape.home);
   const ShapeMatch& best = matches[0];
   const cv::Point2d at(best.x + search.x, best.y + search.y);
-  r.values["x"] = at.x - nominal.x;
-  r.values["y"] = at.y - nominal.y;
   r.angleDeg = degrees(best.angle);
-  r.values["angle"] = *r.angleDeg;
+  if (!setPoseOffset(r, part.calibration.worldMapping(), nominal, at, *r.angleDeg))
+    return StepResult::failed("the match does not map into the measuring plane");
   r.values["score"] = best.score;
   r.refToImage = translation(cv::Point2d(search.tl())) * poseMap(best.pose(), shape.home);
   r.referenceView =
