@@ -50,16 +50,10 @@ AlignStep::AlignStep() : TableStep({.point = true, .pose = true, .line = true}) 
   fields_.path("model", &AlignParams::model,
                "Trained shape model (method shape), written by `facet recipe train`.", false, true);
   addSearch(fields_);
-  const std::string xDoc =
-      "Offset of the found position from nominal along x (mm by default; with a lens model and "
-      "a measuring plane, along the plane's x, measured there).";
-  const std::string yDoc =
-      "Offset of the found position from nominal along y (mm by default; with a lens model and "
-      "a measuring plane, along the plane's y, measured there).";
   checks_ = {"align checks",
              "",
-             {config::checkField("x", Quantity::Length, xDoc),
-              config::checkField("y", Quantity::Length, yDoc),
+             {config::checkField("x", Quantity::Length, kOffsetXDoc),
+              config::checkField("y", Quantity::Length, kOffsetYDoc),
               config::checkField("angle", Quantity::Angle,
                                  "Rotation of the part, degrees (in the measuring plane when "
                                  "the station has one)."),

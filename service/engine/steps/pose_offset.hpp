@@ -14,6 +14,14 @@
 
 namespace facet::service {
 
+// The x and y checks' descriptions, in one wording for the steps that locate parts.
+inline constexpr const char* kOffsetXDoc =
+    "Offset of the found position from nominal along x (mm by default; with a lens model and a "
+    "measuring plane, along the plane's x, measured there).";
+inline constexpr const char* kOffsetYDoc =
+    "Offset of the found position from nominal along y (mm by default; with a lens model and a "
+    "measuring plane, along the plane's y, measured there).";
+
 // Sets r.values x, y (pixels of the live image, or mm in the plane with lengthsInMm) and
 // angle (degrees, counter-clockwise on screen) for a part found at `found` turned by
 // `angleDeg` (image) whose nominal place is `nominal`. False when a point misses the plane.

@@ -43,17 +43,11 @@ ShapeStep::ShapeStep() : TableStep({.point = true, .pose = true, .line = true}) 
                   "part, a lens set off-centre in its housing); scores then count a model point "
                   "met that far off. 0 = rigid. Costs search time: try 1 first.",
                   {.minimum = 0.0, .maximum = double(kMaxDeformation)});
-  const std::string xDoc =
-      "Offset of the found position from nominal along x (mm by default; with a lens model and "
-      "a measuring plane, along the plane's x, measured there).";
-  const std::string yDoc =
-      "Offset of the found position from nominal along y (mm by default; with a lens model and "
-      "a measuring plane, along the plane's y, measured there).";
   checks_ = {"shape checks",
              "",
              {config::checkField("count", Quantity::Count, "Number of matches found.", 0.0),
-              config::checkField("x", Quantity::Length, xDoc),
-              config::checkField("y", Quantity::Length, yDoc),
+              config::checkField("x", Quantity::Length, kOffsetXDoc),
+              config::checkField("y", Quantity::Length, kOffsetYDoc),
               config::checkField("angle", Quantity::Angle,
                                  "Rotation of the best match, degrees (in the measuring plane "
                                  "when the station has one)."),
