@@ -44,6 +44,7 @@ std::optional<PlaneCircle> fitCircle(const std::vector<cv::Point2d>& points) {
   c.centreMm = mean + cv::Point2d(cx, cy);
   c.diameterMm = 2 * r;
   c.rmsMm = std::sqrt(res.squaredNorm() / static_cast<double>(n));
+  c.roundnessMm = res.maxCoeff() - res.minCoeff();
   c.points = static_cast<int>(n);
   return c;
 }

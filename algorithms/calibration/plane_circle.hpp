@@ -21,6 +21,9 @@ struct PlaneCircle {
   cv::Point2d centreMm;
   double diameterMm = 0;
   double rmsMm = 0;  // RMS of the mapped points' distances to the fitted circle
+  // Largest minus smallest of those distances (signed): the rim's roundness in the plane. The
+  // image's is not: a round hole seen at an angle is an ellipse there.
+  double roundnessMm = 0;
   int points = 0;
 };
 

@@ -61,8 +61,9 @@ double greyAt(const cv::Mat& image, int x, int y) {
 
 // Grey-value area of component `label` of the region `grey` (the image's clipped region, read in
 // place: converting a whole frame to doubles cost more than the labelling), see the header.
-Moments greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, cv::Rect box,
-                    bool light) {
+// `coverage` non-null: the weights are kept there too (region coordinates).
+Moments greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, cv::Rect box, bool light,
+                    BlobCoverage* coverage) {
   const int reach = 4;  // pixels: blur of sigma ~1.3 has faded below 0.1% of the step here
   const cv::Rect area =
       (box + cv::Size(2 * (reach + 2), 2 * (reach + 2)) - cv::Point(reach + 2, reach + 2)) &
@@ -95,6 +96,7 @@ Moments greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, cv::R
   Moments mo;
   const double contrast = object - background;
   if (std::abs(contrast) < 1e-9) return mo;
+  if (coverage) *coverage = {area, cv::Mat1f::zeros(area.size())};
   for (int r = 0; r < area.height; ++r) {
     for (int c = 0; c < area.width; ++c) {
       if (others.at<uchar>(r, c) || !band.at<uchar>(r, c)) continue;
@@ -103,6 +105,7 @@ Moments greyMoments(const cv::Mat& grey, const cv::Mat& labels, int label, cv::R
                            ? 1.0
                            : (greyAt(grey, area.x + c, area.y + r) - background) / contrast;
       mo.add(w, c + area.x - box.x, r + area.y - box.y);
+      if (coverage) coverage->share(r, c) = static_cast<float>(w);
     }
   }
   return mo;
@@ -171,19 +174,25 @@ BlobResult analyseBlobs(const cv::Mat& image, const BlobParams& params) {
     // A quick pre-filter on the pixel count keeps noise specks from costing a grey-value pass.
     if (b.pixels < 0.5 * params.minArea || b.pixels > 2.0 * params.maxArea + 16) continue;
     Moments mo;
+    BlobCoverage* coverage = params.keepCoverage ? &b.coverage : nullptr;
     if (params.greyArea && !b.touchesBorder) {
-      mo = greyMoments(grey, labels, i, b.bbox, light);
+      mo = greyMoments(grey, labels, i, b.bbox, light, coverage);
     }
     if (mo.m00 <= 0) {
       mo = {};
+      if (coverage) *coverage = {b.bbox, cv::Mat1f::zeros(b.bbox.size())};
       for (int r = b.bbox.y; r < b.bbox.br().y; ++r) {
         const int* row = labels.ptr<int>(r);
-        for (int c = b.bbox.x; c < b.bbox.br().x; ++c)
-          if (row[c] == i) mo.add(1.0, c - b.bbox.x, r - b.bbox.y);
+        for (int c = b.bbox.x; c < b.bbox.br().x; ++c) {
+          if (row[c] != i) continue;
+          mo.add(1.0, c - b.bbox.x, r - b.bbox.y);
+          if (coverage) coverage->share(r - b.bbox.y, c - b.bbox.x) = 1.0F;
+        }
       }
     }
     describe(mo, b.bbox.tl() + clipped.tl(), b);
     b.bbox += clipped.tl();
+    if (coverage) coverage->box += clipped.tl();
     if (b.area < params.minArea || b.area > params.maxArea) continue;
     if (b.majorRadius > 0 && b.minorRadius / b.majorRadius < params.minRoundness) continue;
     result.blobs.push_back(b);

@@ -35,6 +35,15 @@ struct BlobParams {
   double minRoundness = 0.0;  // minor / major axis of the blob's ellipse, 0..1
   bool greyArea = true;       // area, centroid and ellipse from grey values (else pixel counts)
   double minContrast = 10.0;  // grey levels: a region spanning less has no contrast
+  bool keepCoverage = false;  // keep each blob's coverage (Blob::coverage)
+};
+
+// The share of each pixel a blob covers (the weights its area and moments sum), over an image
+// box: what a caller needs to measure the blob in another geometry, e.g. a tilted plane seen
+// through a lens, where one scale at the centroid is not the blob's (plane_blob.hpp).
+struct BlobCoverage {
+  cv::Rect box;     // image pixels
+  cv::Mat1f share;  // box.size(); 0 outside the blob
 };
 
 struct Blob {
@@ -45,6 +54,7 @@ struct Blob {
   double majorRadius = 0, minorRadius = 0;  // semi-axes of the equal-moment ellipse, pixels
   double angle = 0;            // major axis, degrees counter-clockwise on screen, (-90, 90]
   bool touchesBorder = false;  // touches the region's border (may be cut off)
+  BlobCoverage coverage;       // empty unless BlobParams::keepCoverage
 };
 
 struct BlobResult {

@@ -82,6 +82,7 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
   m.rms = fit->rms;
   m.straightness = fit->straightness;
   m.points = static_cast<int>(fit->inliers.size());
+  m.inliers = fit->inliers;
   return m;
 }
 

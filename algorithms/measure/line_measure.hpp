@@ -43,6 +43,7 @@ struct LineMeasurement {
   int points = 0;           // inlier edge points
   int stations = 0;         // cross calipers inside the image
   std::vector<cv::Point2d> edgePoints;  // every edge point found (inliers and outliers)
+  std::vector<int> inliers;             // indices into edgePoints of the fit's inliers
   bool partial = false;                 // part of the rectangle lay outside the image
   Status<MeasureFailure> status;
 };

@@ -79,6 +79,7 @@ void run(const BlobOptions& o) {
   const cv::Mat image = readGreyImage(o.image);
   std::optional<MeasuringPlane> plane;
   if (!o.calibration.empty()) plane.emplace(o.calibration, image.size());
+  p.keepCoverage = plane && plane->mapping();
 
   const auto t0 = std::chrono::steady_clock::now();
   const BlobResult r = analyseBlobs(image, p);
@@ -101,13 +102,13 @@ void run(const BlobOptions& o) {
            {{"major_radius", b.majorRadius}, {"minor_radius", b.minorRadius}, {"angle", b.angle}}},
           {"touches_border", b.touchesBorder}};
       if (plane) {
-        // The plane's scale at the centroid, as facetd's blob step: a blob is small beside the
-        // distances over which the lens and the tilt change the scale.
-        const cv::Point2d q = plane->toPlane(b.centroid);
-        const double s = plane->mmPerPixelAt(b.centroid);
-        j["x_mm"] = q.x;
-        j["y_mm"] = q.y;
-        j["area_mm2"] = b.area * s * s;
+        const PlaneBlob q = plane->blob(b);
+        j["x_mm"] = q.centreMm.x;
+        j["y_mm"] = q.centreMm.y;
+        j["area_mm2"] = q.areaMm2;
+        j["ellipse_mm"] = {{"major_radius", q.majorRadiusMm},
+                           {"minor_radius", q.minorRadiusMm},
+                           {"angle", q.angleDeg}};
       }
       blobs.push_back(j);
     }
@@ -124,8 +125,9 @@ void run(const BlobOptions& o) {
               << " px^2, bbox " << b.bbox.x << "," << b.bbox.y << "," << b.bbox.width << ","
               << b.bbox.height;
     if (plane) {
-      const double s = plane->mmPerPixelAt(b.centroid);
-      std::cout << "; area " << b.area * s * s << " mm^2";
+      const PlaneBlob q = plane->blob(b);
+      std::cout << "; (" << q.centreMm.x << ", " << q.centreMm.y << ") mm, area " << q.areaMm2
+                << " mm^2";
     }
     std::cout << "\n";
   }

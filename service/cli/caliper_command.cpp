@@ -69,10 +69,12 @@ void run(const CaliperOptions& o) {
                        {"first", edgeJson(pr.first, path, inPlane)},
                        {"second", edgeJson(pr.second, path, inPlane)}};
       if (plane) {
-        const cv::Point2d q = plane->toPlane(pr.centre);
+        // The pair's middle in the plane: halfway between its edges there.
+        const double mid = plane->midpoint(path, pr.first.position, pr.second.position);
+        const cv::Point2d q = plane->toPlane(path.at(mid, 0.0));
         j["x_mm"] = q.x;
         j["y_mm"] = q.y;
-        j["position_mm"] = plane->span(path, 0.0, pr.position);
+        j["position_mm"] = plane->span(path, 0.0, mid);
         j["width_mm"] = plane->span(path, pr.first.position, pr.second.position);
       }
       pairs.push_back(j);

@@ -41,11 +41,7 @@ void run(const LineOptions& o) {
   // In the plane: the segment's ends, its angle in the plane's axes (counter-clockwise as on
   // screen: the plane's y runs down the image as pixels do), its deviations.
   std::optional<LineInPlane> seen;
-  if (plane) {
-    // Both ends must reach the plane (toPlane says which does not).
-    for (const cv::Point2d& end : {m.p1, m.p2}) (void)plane->toPlane(end);
-    seen = plane->line(rect, m);
-  }
+  if (plane) seen = plane->line(rect, m);
   const auto planeAngle = [&] {
     const cv::Point2d d = seen->p2 - seen->p1;
     return std::atan2(-d.y, d.x) * 180.0 / CV_PI;

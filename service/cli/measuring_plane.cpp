@@ -53,16 +53,40 @@ double MeasuringPlane::span(const MeasuringPath& path, double s0, double s1) con
   return mm;
 }
 
+double MeasuringPlane::midpoint(const MeasuringPath& path, double s0, double s1) const {
+  const double s = midpointInPlane(path, mapping(), s0, s1);
+  if (!std::isfinite(s))
+    throw MeasurementFailure(
+        "off_plane", "the caliper's axis does not map into the measuring plane of " + file_);
+  return s;
+}
+
 LineInPlane MeasuringPlane::line(const MeasuringRect& rect, const LineMeasurement& m) const {
-  LineInPlane out = lineInPlane(rect, m, mapping());
+  auto out = lineInPlane(rect, m, mapping());
+  if (!out)
+    throw MeasurementFailure("off_plane",
+                             "the line does not map into the measuring plane of " + file_);
   if (!mapping_) {
-    out.p1 *= mmPerPixel_;
-    out.p2 *= mmPerPixel_;
-    out.offset *= mmPerPixel_;
-    out.straightness *= mmPerPixel_;
-    out.rms *= mmPerPixel_;
+    out->p1 *= mmPerPixel_;
+    out->p2 *= mmPerPixel_;
+    out->offset *= mmPerPixel_;
+    out->straightness *= mmPerPixel_;
+    out->rms *= mmPerPixel_;
   }
-  return out;
+  return *out;
+}
+
+PlaneBlob MeasuringPlane::blob(const Blob& b) const {
+  if (!mapping_)
+    return {b.centroid * mmPerPixel_, b.area * mmPerPixel_ * mmPerPixel_,
+            b.majorRadius * mmPerPixel_, b.minorRadius * mmPerPixel_, b.angle};
+  const auto q = blobInPlane(b, *mapping_);
+  if (!q)
+    throw MeasurementFailure("off_plane", "the blob at (" + std::to_string(b.centroid.x) + ", " +
+                                              std::to_string(b.centroid.y) +
+                                              ") does not map into the measuring plane of " +
+                                              file_);
+  return *q;
 }
 
 }  // namespace facet::cli

@@ -9,6 +9,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/calibration/plane_blob.hpp"
 #include "algorithms/calibration/plane_measures.hpp"
 #include "algorithms/calibration/world_mapping.hpp"
 
@@ -34,8 +35,16 @@ class MeasuringPlane {
   // The signed length from axis position s0 to s1 of a caliper's path, mm (MeasurementFailure
   // "off_plane" where the path leaves the plane).
   [[nodiscard]] double span(const MeasuringPath& path, double s0, double s1) const;
-  // A fitted line in the plane (ends, offset and deviations in mm).
+  // The axis position halfway from s0 to s1 as the plane sees it (a pair's middle;
+  // MeasurementFailure "off_plane" where the path leaves the plane).
+  [[nodiscard]] double midpoint(const MeasuringPath& path, double s0, double s1) const;
+  // A fitted line in the plane (ends, offset and deviations in mm; MeasurementFailure "off_plane"
+  // where it leaves the plane).
   [[nodiscard]] LineInPlane line(const MeasuringRect& rect, const LineMeasurement& m) const;
+  // A blob's centre, area and ellipse in the plane (the blob analysed with
+  // BlobParams::keepCoverage when the file has a lens model and a plane; MeasurementFailure
+  // "off_plane" where it leaves the plane).
+  [[nodiscard]] PlaneBlob blob(const Blob& b) const;
 
  private:
   std::string file_, kind_;

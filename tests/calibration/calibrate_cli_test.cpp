@@ -86,6 +86,11 @@ TEST_F(CalibrateCli, CalibratesWritesTheFileAndMeasuresInTheRightPlane) {
   EXPECT_NEAR(c["world"]["x_mm"].get<double>(), 70, 0.02);
   EXPECT_NEAR(c["world"]["y_mm"].get<double>(), 20, 0.02);
   EXPECT_NEAR(c["world"]["diameter_mm"].get<double>(), 6, 0.01);
+  // The rim's roundness in the plane: the spread of its points there, a few times their RMS.
+  EXPECT_GT(c["world"]["roundness_mm"].get<double>(), 2 * c["world"]["rms_mm"].get<double>())
+      << c.dump();
+  EXPECT_LT(c["world"]["roundness_mm"].get<double>(), 6 * c["world"]["rms_mm"].get<double>())
+      << c.dump();
   EXPECT_EQ(c["world"]["calibration"], "lens model + plane");
 }
 

@@ -2,11 +2,13 @@
 // the line writes them: values in mm, and the bad inputs (outside the image, nothing to find, a
 // wrong key) failing with their cause, never with a made-up value.
 #include <cmath>
+#include <sstream>
 
 #include "algorithms/geometry/pose2d.hpp"
 #include "service/engine/frame_maps.hpp"
 #include "service/engine/steps/placed_rect.hpp"
 #include "tests/engine/plate_part.hpp"
+#include "tests/support/scene/plane_scene.hpp"
 
 namespace facet::service {
 namespace {
@@ -369,6 +371,56 @@ TEST_F(MeasuringSteps, InACalibratedPlaneValuesAreMillimetresThere) {
                                   plate::render(), plate::straightPlane());
   ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
   EXPECT_NEAR(value(out, "across.width").value, 12.0, 0.002);
+}
+
+// On a plane seen at 30 degrees through a distorting lens, the blob step measures its largest
+// blob in the plane: its area there, and its centre (which a distance step relates) is the
+// blob's centre in the plane, not the image centroid mapped (which fails the 0.01 mm check).
+// A caliper pair across the same disc has its middle there too (halfway between the edges in
+// the plane, not in the image). The circle's roundness is the rim's in the plane: in the image
+// the round bore is an ellipse, 0.5 mm from round at the plane's scale.
+TEST_F(MeasuringSteps, OnATiltedPlaneABlobsAreaAndCentreAreThePlanes) {
+  scene::PlaneScene s;
+  s.camera.size = {640, 480};
+  s.camera.fx = s.camera.fy = 1200, s.camera.cx = 319.5, s.camera.cy = 239.5;
+  s.camera.k1 = -0.15;
+  s.placement = scene::lookAtPlane({22, 16}, 200, 30, 20, 5, s.camera);
+  s.background = 200;
+  const cv::Point2d blobMm(12, 15), boreMm(35, 18);
+  s.addDisc(blobMm, 8, 40);
+  s.addDisc(boreMm, 4, 40);
+  s.lensBlurSigma = 0.7;
+  s.noiseSigma = 1;
+  config::Calibration calibration;
+  calibration.mmPerPixel = 0.17;
+  calibration.cameraMatrix = cv::Mat(s.camera.matrix());
+  calibration.distortion = s.camera.distortion();
+  calibration.imageSize = s.camera.size;
+  calibration.plane = PlanePose{s.placement.rotation, s.placement.translationMm, 0.0};
+  const cv::Point2d a = s.imageOf(blobMm), b = s.imageOf(boreMm);
+  const cv::Point2d x = s.imageOf(blobMm + cv::Point2d(0.01, 0)) - a;
+  std::ostringstream steps;
+  steps << "  - id: blob\n    kind: blob\n    centre: [" << a.x << ", " << a.y << "]\n"
+        << "    length: 130\n    width: 130\n    polarity: dark\n    checks:\n"
+        << "      area: {nominal: 201.06, tol_minus: 0.4, tol_plus: 0.4}\n"
+        << "  - id: bore\n    kind: circle\n    centre: [" << b.x << ", " << b.y << "]\n"
+        << "    nominal_diameter: 8\n    search_width: 2\n    polarity: dark_inside\n"
+        << "    checks:\n      roundness: {nominal: 0, tol_minus: 0, tol_plus: 0.05}\n"
+        << "  - id: apart\n    kind: distance\n    measure: centre_to_centre\n"
+        << "    from: blob\n    to: bore\n    checks:\n"
+        << "      distance: {nominal: 23.195, tol_minus: 0.01, tol_plus: 0.01}\n"
+        << "  - id: across\n    kind: caliper\n    centre: [" << a.x << ", " << a.y << "]\n"
+        << "    angle: " << std::atan2(-x.y, x.x) * 180 / CV_PI << "\n"
+        << "    length: 130\n    width: 4\n    measure: pairs\n    polarity: falling\n"
+        << "    checks:\n      width: {nominal: 16, tol_minus: 0.03, tol_plus: 0.03}\n"
+        << "  - id: across_apart\n    kind: distance\n    measure: centre_to_centre\n"
+        << "    from: across\n    to: bore\n    checks:\n"
+        << "      distance: {nominal: 23.195, tol_minus: 0.01, tol_plus: 0.01}\n";
+  const auto out = plate::inspect(dir_, steps.str(), s.render(), calibration);
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "blob.area").value, 64 * CV_PI, 0.002 * 64 * CV_PI);
+  EXPECT_NEAR(value(out, "apart.distance").value, cv::norm(blobMm - boreMm), 0.005);
+  EXPECT_NEAR(value(out, "across_apart.distance").value, cv::norm(blobMm - boreMm), 0.005);
 }
 
 // An arc relative to a pose step follows it too: centre mapped, start turned, radius scaled.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "algorithms/calibration/plane_blob.hpp"
 #include "config/recipe_format.hpp"
 #include "service/engine/steps/placed_rect.hpp"
 #include "service/engine/steps/pose_fields.hpp"
@@ -79,6 +80,9 @@ StepResult BlobStep::run(const config::Step& step, StepContext& part) const {
   p.minArea = b.minArea;
   p.maxArea = b.maxArea;
   p.minRoundness = b.minRoundness;
+  // With a lens model and a measuring plane the largest blob is measured there (plane_blob.hpp).
+  const auto plane = part.calibration.worldMapping();
+  p.keepCoverage = plane.has_value();
   const BlobResult m = analyseBlobs(part.grey, p);
   const bool none =
       m.status.cause == MeasureFailure::NoBlob || m.status.cause == MeasureFailure::NoContrast;
@@ -99,15 +103,20 @@ StepResult BlobStep::run(const config::Step& step, StepContext& part) const {
     r.point = cv::Point2d(rect.cx, rect.cy);
     return r;
   }
-  // With a lens model and a measuring plane, areas use the plane's scale at the blob.
-  const auto plane = part.calibration.worldMapping();
   const Blob& largest = kept.front();  // the tool sorts by area
-  const double scale = plane ? plane->mmPerPixelAt(largest.centroid) : 1.0;
-  r.lengthsInMm = plane.has_value();
   r.values["count"] = static_cast<double>(kept.size());
   r.values["presence"] = 1;
-  r.values["area"] = largest.area * scale * scale;
-  r.point = largest.centroid;
+  if (plane) {
+    const auto inPlane = blobInPlane(largest, *plane);
+    if (!inPlane)
+      return StepResult::failed("blob not measured: it does not map into the measuring plane");
+    r.lengthsInMm = true;
+    r.values["area"] = inPlane->areaMm2;
+    r.point = plane->toImage(inPlane->centreMm);
+  } else {
+    r.values["area"] = largest.area;
+    r.point = largest.centroid;
+  }
   for (const Blob& blob : kept) {
     const cv::Rect& box = blob.bbox;
     part.overlay.polygon({{box.x - 0.5, box.y - 0.5},

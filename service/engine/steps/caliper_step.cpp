@@ -1,5 +1,7 @@
 #include "service/engine/steps/caliper_step.hpp"
 
+#include <cmath>
+
 #include "algorithms/calibration/plane_measures.hpp"
 #include "config/recipe_format.hpp"
 #include "service/engine/steps/edge_polarity_names.hpp"
@@ -114,14 +116,25 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
   part.overlay.polygon(arc ? arcOutline(*arc) : rectCorners(*rect), true, true);
   if (!m.status.ok()) return StepResult::failed("caliper not measured: " + m.status.message);
 
-  // Where each selected edge or pair lies on the axis (s), and the pairs' ends.
+  // Lengths along the axis, from its middle: in the measuring plane, in mm, when the station has
+  // a lens model and a plane (plane_measures.hpp).
+  const auto plane = part.calibration.worldMapping();
+  const WorldMapping* mapping = plane ? &*plane : nullptr;
+  const auto span = [&](double s0, double s1) { return spanInPlane(path, mapping, s0, s1); };
+
+  // Where each selected edge or pair lies on the axis (s), and the pairs' ends. A pair's middle
+  // is the plane's: halfway between its edges there.
   std::vector<double> along;
   std::vector<cv::Point2d> points;
   std::vector<std::pair<double, double>> ends;
   if (p.pairs) {
     for (const CaliperPair& pr : m.pairs) {
-      along.push_back((pr.first.position + pr.second.position) / 2);
-      points.push_back(pr.centre);
+      const double mid = midpointInPlane(path, mapping, pr.first.position, pr.second.position);
+      if (!std::isfinite(mid))
+        return StepResult::failed(
+            "caliper not measured: its axis does not map into the measuring plane");
+      along.push_back(mid);
+      points.push_back(mapping ? path.at(mid, 0.0) : pr.centre);
       ends.emplace_back(pr.first.position, pr.second.position);
     }
   } else {
@@ -130,11 +143,6 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
       points.push_back(e.point);
     }
   }
-  // Lengths along the axis, from its middle: in the measuring plane, in mm, when the station has
-  // a lens model and a plane (plane_measures.hpp).
-  const auto plane = part.calibration.worldMapping();
-  const WorldMapping* mapping = plane ? &*plane : nullptr;
-  const auto span = [&](double s0, double s1) { return spanInPlane(path, mapping, s0, s1); };
 
   StepResult r;
   r.lengthsInMm = plane.has_value();
@@ -151,11 +159,11 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
   if (!p.pairs)
     for (const CaliperEdge& e : m.edges)
       part.overlay.polyline({path.at(e.position, -half), path.at(e.position, half)}, true);
-  for (const CaliperPair& pr : m.pairs) {
+  for (const CaliperPair& pr : m.pairs)
     for (const CaliperEdge* e : {&pr.first, &pr.second})
       part.overlay.polyline({path.at(e->position, -half), path.at(e->position, half)}, true);
-    part.overlay.cross(pr.centre, 3, true);
-  }
+  if (p.pairs)
+    for (const cv::Point2d& centre : points) part.overlay.cross(centre, 3, true);
   return r;
 }
 

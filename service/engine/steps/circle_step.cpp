@@ -97,7 +97,7 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
     r.values["x"] = w->centreMm.x - nominal.x;
     r.values["y"] = w->centreMm.y - nominal.y;
     r.values["position"] = cv::norm(w->centreMm - nominal);
-    r.values["roundness"] = m.roundness * plane->mmPerPixelAt(m.centre);
+    r.values["roundness"] = w->roundnessMm;
     r.point = plane->toImage(w->centreMm);
   } else {
     r.values["diameter"] = m.diameter;

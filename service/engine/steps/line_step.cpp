@@ -47,18 +47,21 @@ StepResult LineStep::run(const config::Step& step, StepContext& part) const {
   part.overlay.polygon(rectCorners(rect), true, true);
   if (!m.status.ok()) return StepResult::failed("line not measured: " + m.status.message);
 
-  // With a lens model and a measuring plane, the angle is taken between the line and the axis as
-  // the plane sees them, and lengths are the plane's (plane_measures.hpp).
+  // With a lens model and a measuring plane, the line is fitted in the plane to its edge points,
+  // its angle taken from the axis as the plane sees it, lengths the plane's (plane_measures.hpp).
   const auto plane = part.calibration.worldMapping();
-  const LineInPlane seen = lineInPlane(rect, m, plane ? &*plane : nullptr);
-  const cv::Point2d mid = (m.p1 + m.p2) * 0.5;
+  const auto seen = lineInPlane(rect, m, plane ? &*plane : nullptr);
+  if (!seen)
+    return StepResult::failed("line not measured: it does not map into the measuring plane");
+  // The line's middle: the plane's when it was fitted there.
+  const cv::Point2d mid = plane ? plane->toImage((seen->p1 + seen->p2) * 0.5) : (m.p1 + m.p2) * 0.5;
 
   StepResult r;
   r.lengthsInMm = plane.has_value();
-  r.values["angle"] = l.angle + seen.angleFromAxis;
-  r.values["position"] = seen.offset;
-  r.values["straightness"] = seen.straightness;
-  r.values["rms"] = seen.rms;
+  r.values["angle"] = l.angle + seen->angleFromAxis;
+  r.values["position"] = seen->offset;
+  r.values["straightness"] = seen->straightness;
+  r.values["rms"] = seen->rms;
   r.point = mid;
   r.angleDeg = m.angle;
   if (m.partial) r.note = "part of the line rectangle lies outside the image: measured inside only";
