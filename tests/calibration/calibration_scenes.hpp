@@ -7,6 +7,7 @@
 #include <opencv2/core.hpp>
 
 #include "algorithms/calibration/board_spec.hpp"
+#include "algorithms/calibration/world_mapping.hpp"
 #include "tests/support/scene/calibration_plates.hpp"
 
 namespace facet::test {
@@ -17,6 +18,18 @@ inline scene::LensCamera testCamera() {
   c.k1 = -0.22, c.k2 = 0.08, c.p1 = 0.0012, c.p2 = -0.0008;
   return c;
 }
+
+// The test camera looking at a plane tilted 35 degrees from 280 mm, with the exact mapping of
+// the plane into the image (the renderer's) and back (the code under test's).
+struct TiltedPlane {
+  scene::LensCamera camera = testCamera();
+  scene::PlanePlacement placement = scene::lookAtPlane({40, 30}, 280, 35, 20, 10, camera);
+  WorldMapping mapping{CameraModel{camera.matrix(), camera.distortion(), camera.size},
+                       PlanePose{placement.rotation, placement.translationMm, 0.0}};
+  [[nodiscard]] cv::Point2d pixelOf(cv::Point2d mm) const {
+    return camera.project(placement.toCamera(mm));
+  }
+};
 
 inline scene::PlaneScene plateScene(const BoardSpec& board, const scene::LensCamera& camera,
                                     std::uint64_t seed, int index, double noise = 2.0) {

@@ -11,12 +11,7 @@
 namespace facet {
 namespace {
 
-struct TiltedRim {
-  scene::LensCamera camera = test::testCamera();
-  scene::PlanePlacement placement = scene::lookAtPlane({40, 30}, 280, 35, 20, 10, camera);
-  WorldMapping mapping{CameraModel{camera.matrix(), camera.distortion(), camera.size},
-                       PlanePose{placement.rotation, placement.translationMm, 0.0}};
-
+struct TiltedRim : test::TiltedPlane {
   // The image measurement of a rim of `radiusMm` about `centreMm`, its points exactly on it
   // (`bumpMm`: one point that far outside it).
   [[nodiscard]] CircleMeasurement measured(cv::Point2d centreMm, double radiusMm,
@@ -24,8 +19,7 @@ struct TiltedRim {
     CircleMeasurement m;
     for (int i = 0; i < 360; i += 3) {
       const double a = i * CV_PI / 180, r = radiusMm + (i == 90 ? bumpMm : 0.0);
-      m.inlierPoints.push_back(
-          camera.project(placement.toCamera(centreMm + r * cv::Point2d(std::cos(a), std::sin(a)))));
+      m.inlierPoints.push_back(pixelOf(centreMm + r * cv::Point2d(std::cos(a), std::sin(a))));
     }
     const auto image = fitCircle(m.inlierPoints);
     m.centre = image->centreMm;

@@ -13,15 +13,7 @@
 namespace facet {
 namespace {
 
-struct TiltedPlane {
-  scene::LensCamera camera = test::testCamera();
-  scene::PlanePlacement placement = scene::lookAtPlane({40, 30}, 280, 35, 20, 10, camera);
-  WorldMapping mapping{CameraModel{camera.matrix(), camera.distortion(), camera.size},
-                       PlanePose{placement.rotation, placement.translationMm, 0.0}};
-  [[nodiscard]] cv::Point2d pixelOf(cv::Point2d mm) const {
-    return camera.project(placement.toCamera(mm));
-  }
-};
+using test::TiltedPlane;
 
 TEST(PlaneMeasures, WithoutAPlaneLengthsAndLinesStayInPixels) {
   const MeasuringPath rect(MeasuringRect{100, 80, 60, 10, 30});
