@@ -47,6 +47,16 @@ std::optional<PlaneBlob> blobInPlane(const Blob& blob, const WorldMapping& plane
   double m00 = 0, m10 = 0, m01 = 0, m20 = 0, m11 = 0, m02 = 0;
   std::vector<cv::Point2d> rowValue(static_cast<std::size_t>(nodesX)),
       rowSlope(static_cast<std::size_t>(nodesX));
+  // Each column's cell and basis, the same on every row.
+  std::vector<int> columnCell(static_cast<std::size_t>(cover.box.width));
+  std::vector<Basis> columnBasis;
+  columnBasis.reserve(static_cast<std::size_t>(cover.box.width));
+  for (int c = 0; c < cover.box.width; ++c) {
+    const double u = static_cast<double>(c) / kNodeStep;
+    const int cx = std::min(static_cast<int>(u / 2), cellsX - 1);
+    columnCell[static_cast<std::size_t>(c)] = cx;
+    columnBasis.emplace_back(u - 2 * cx);
+  }
   for (int r = 0; r < cover.box.height; ++r) {
     const double v = static_cast<double>(r) / kNodeStep;
     const int cy = std::min(static_cast<int>(v / 2), cellsY - 1);
@@ -64,9 +74,8 @@ std::optional<PlaneBlob> blobInPlane(const Blob& blob, const WorldMapping& plane
     const float* share = cover.share.ptr<float>(r);
     for (int c = 0; c < cover.box.width; ++c) {
       if (share[c] == 0.0F) continue;
-      const double u = static_cast<double>(c) / kNodeStep;
-      const int cx = std::min(static_cast<int>(u / 2), cellsX - 1);
-      const Basis bx(u - 2 * cx);
+      const int cx = columnCell[static_cast<std::size_t>(c)];
+      const Basis& bx = columnBasis[static_cast<std::size_t>(c)];
       cv::Point2d q(0, 0), alongX(0, 0), alongY(0, 0);
       for (int k = 0; k < 3; ++k) {
         const auto at = static_cast<std::size_t>(2 * cx + k);
