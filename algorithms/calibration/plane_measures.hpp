@@ -42,8 +42,8 @@ struct LineInPlane {
 
 // With a plane the line is fitted there: the measurement's inlier edge points are carried into
 // the plane and fitted again with the same robust fit (line_fit.hpp). A lens bends the image of a
-// straight edge, so the image's fit would call it crooked (0.4 px of bow for 200 px at 400 px
-// from the centre with k1 = -0.22) and place it off by part of that; in the plane it is straight.
+// straight edge: the image's fit called a 60 mm edge near the border of the tests' view (k1
+// -0.22) 0.08 mm crooked and put it 0.09 mm off (a bow of 0.3 px); in the plane it is straight.
 // A measurement without its points (made by hand) is carried by its ends, its deviations by the
 // plane's scale there. nullopt when a point does not map into the plane.
 std::optional<LineInPlane> lineInPlane(const MeasuringRect& rect, const LineMeasurement& line,
