@@ -30,18 +30,12 @@
 #include "algorithms/measure/blob_analysis.hpp"
 #include "algorithms/measure/caliper.hpp"
 #include "algorithms/measure/line_measure.hpp"
+#include "tests/calibration/calibration_scenes.hpp"
 #include "tests/support/scene/plane_scene.hpp"
 
 namespace {
 
 using namespace facet;
-
-scene::LensCamera camera() {
-  scene::LensCamera c;
-  c.fx = 1500, c.fy = 1502, c.cx = 645.2, c.cy = 508.7;
-  c.k1 = -0.22, c.k2 = 0.08, c.p1 = 0.0012, c.p2 = -0.0008;
-  return c;
-}
 
 // Sums of squares of one quantity's errors, facet and baseline.
 struct Errors {
@@ -78,7 +72,7 @@ void measureScene(double tilt, double lensBlur, std::uint64_t seed, TiltRow& row
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> unit(0, 1);
   scene::PlaneScene s;
-  s.camera = camera();
+  s.camera = test::testCamera();
   const cv::Point2d target(40 + 20 * unit(rng), 30 + 20 * unit(rng));
   s.placement = scene::lookAtPlane(target, 250, tilt, 360 * unit(rng), 360 * unit(rng), s.camera);
   s.background = 30;
