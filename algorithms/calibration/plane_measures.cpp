@@ -34,14 +34,9 @@ bool fitInPlane(const LineMeasurement& line, const WorldMapping& plane, cv::Poin
   params.minScale *= scale;
   const auto fit = fitLineRobust(points, params);
   if (!fit) return false;
-  const cv::Point2d dir = fit->direction.dot(axis) < 0 ? -fit->direction : fit->direction;
-  double t0 = 1e300, t1 = -1e300;
-  for (int i : fit->inliers) {
-    const double t = (points[static_cast<std::size_t>(i)] - fit->point).dot(dir);
-    t0 = std::min(t0, t), t1 = std::max(t1, t);
-  }
-  out.p1 = fit->point + t0 * dir;
-  out.p2 = fit->point + t1 * dir;
+  const LineSegment seg = inlierSegment(*fit, points, axis);
+  out.p1 = seg.p1;
+  out.p2 = seg.p2;
   out.straightness = fit->straightness;
   out.rms = fit->rms;
   return true;

@@ -89,4 +89,15 @@ std::optional<FittedLine> fitLineRobust(const std::vector<cv::Point2d>& pts,
   return out;
 }
 
+LineSegment inlierSegment(const FittedLine& line, const std::vector<cv::Point2d>& points,
+                          cv::Point2d towards) {
+  const cv::Point2d dir = line.direction.dot(towards) < 0 ? -line.direction : line.direction;
+  double t0 = 1e300, t1 = -1e300;
+  for (int i : line.inliers) {
+    const double t = (points[static_cast<std::size_t>(i)] - line.point).dot(dir);
+    t0 = std::min(t0, t), t1 = std::max(t1, t);
+  }
+  return {line.point + t0 * dir, line.point + t1 * dir, dir};
+}
+
 }  // namespace facet

@@ -24,6 +24,15 @@ struct FittedLine {
   double straightness = 0;   // largest |orthogonal residual| among the inliers, pixels
 };
 
+// The segment the fit's inliers cover: their extent along the line, its direction turned to
+// agree with `towards` (p1 to p2 runs that way).
+struct LineSegment {
+  cv::Point2d p1, p2;
+  cv::Point2d direction;  // unit, from p1 to p2
+};
+LineSegment inlierSegment(const FittedLine& line, const std::vector<cv::Point2d>& points,
+                          cv::Point2d towards);
+
 // nullopt when fewer than 3 points or no line has 3 supporters.
 std::optional<FittedLine> fitLineRobust(const std::vector<cv::Point2d>& points,
                                         const LineFitParams& params = {});

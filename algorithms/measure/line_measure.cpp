@@ -68,17 +68,10 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
     return failed(MeasureFailure::TooFewPoints, "the edge points do not form a line", m.partial);
 
   // Orient the line along the rectangle's axis and take the inliers' extent on it.
-  cv::Point2d dir = fit->direction;
-  const cv::Point2d axis = along.axisAt(0.0);
-  if (dir.dot(axis) < 0) dir = -dir;
-  double t0 = 1e300, t1 = -1e300;
-  for (int i : fit->inliers) {
-    const double t = (m.edgePoints[i] - fit->point).dot(dir);
-    t0 = std::min(t0, t), t1 = std::max(t1, t);
-  }
-  m.p1 = fit->point + t0 * dir;
-  m.p2 = fit->point + t1 * dir;
-  m.angle = std::atan2(-dir.y, dir.x) * 180.0 / CV_PI;
+  const LineSegment seg = inlierSegment(*fit, m.edgePoints, along.axisAt(0.0));
+  m.p1 = seg.p1;
+  m.p2 = seg.p2;
+  m.angle = std::atan2(-seg.direction.y, seg.direction.x) * 180.0 / CV_PI;
   m.rms = fit->rms;
   m.straightness = fit->straightness;
   m.points = static_cast<int>(fit->inliers.size());

@@ -2,7 +2,6 @@
 // projection of plane points (plane_measures.hpp).
 #include "algorithms/calibration/plane_measures.hpp"
 
-#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -143,14 +142,8 @@ TEST(PlaneMeasures, AnEdgeBowedByTheLensIsStraightInThePlane) {
   // The image's own fit sees a bow of 0.3 px; its ends carried into the plane (the line through
   // them is the chord of the bow) put the line 0.09 mm off, and call it 0.08 mm crooked.
   LineMeasurement ends;
-  double t0 = 1e300, t1 = -1e300;
-  for (int i : fit->inliers) {
-    const double u =
-        (line.edgePoints[static_cast<std::size_t>(i)] - fit->point).dot(fit->direction);
-    t0 = std::min(t0, u), t1 = std::max(t1, u);
-  }
-  ends.p1 = fit->point + t0 * fit->direction, ends.p2 = fit->point + t1 * fit->direction;
-  if ((ends.p2 - ends.p1).dot(line.p2 - line.p1) < 0) std::swap(ends.p1, ends.p2);
+  const LineSegment seg = inlierSegment(*fit, line.edgePoints, line.p2 - line.p1);
+  ends.p1 = seg.p1, ends.p2 = seg.p2;
   ends.straightness = fit->straightness;
   const auto chord = lineInPlane(rect, ends, &t.mapping);
   ASSERT_TRUE(chord.has_value());

@@ -134,7 +134,7 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
         return StepResult::failed(
             "caliper not measured: its axis does not map into the measuring plane");
       along.push_back(mid);
-      points.push_back(mapping ? path.at(mid, 0.0) : pr.centre);
+      points.push_back(path.at(mid, 0.0));  // without a plane: the pair's own centre
       ends.emplace_back(pr.first.position, pr.second.position);
     }
   } else {
