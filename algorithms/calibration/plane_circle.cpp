@@ -1,8 +1,16 @@
 #include "algorithms/calibration/plane_circle.hpp"
 
 #include <cmath>
+#include <iomanip>
+#include <sstream>
 
 #include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/circle/circle_fit.hpp"
+
+#include "algorithms/calibration/plane_circle_profile.hpp"
+#include "algorithms/calibration/plane_patch.hpp"
 
 namespace facet {
 
@@ -49,26 +57,140 @@ std::optional<PlaneCircle> fitCircle(const std::vector<cv::Point2d>& points) {
   return c;
 }
 
-std::optional<PlaneCircle> circleInPlane(const CircleMeasurement& m, const WorldMapping& mapping) {
-  if (!m.status.ok() || m.inlierPoints.size() < 3) return std::nullopt;
+namespace {
+
+// The curvature bias constant of a measurement's edge points: second-derivative edges on a blurred
+// curved rim sit k / r inside it, k = (sigma^2 + 1.2) / 2 for a Gaussian blur sigma
+// (circle_measure.hpp), which the grey-value fit measured.
+double edgeBiasK(const CircleMeasurement& m) {
+  return m.greyRefined ? (m.blur * m.blur + 1.2) / 2 : CircleMeasureParams{}.radiusBiasK;
+}
+
+// The circle through a rim's edge points in the plane, each moved out by the bias k / r first.
+std::optional<PlaneCircle> edgePointCircle(const std::vector<cv::Point2d>& points, double k,
+                                           const WorldMapping& mapping) {
   // The edge points' own circle in the image, for the outward direction of each point.
-  const auto edges = fitCircle(m.inlierPoints);
+  const auto edges = fitCircle(points);
   if (!edges) return std::nullopt;
-  // Second-derivative edges on a blurred curved rim sit k / r inside it, k = (sigma^2 + 1.2) / 2
-  // for a Gaussian blur sigma (circle_measure.hpp); the grey-value fit measured sigma. (Its
-  // radius cannot be used directly: it fits a circle to what may be an ellipse in the image.)
-  const double k = m.greyRefined ? (m.blur * m.blur + 1.2) / 2 : CircleMeasureParams{}.radiusBiasK;
-  const double shift = k / m.radius;
+  // (The grey fit's radius cannot be used directly: it fits a circle to what may be an ellipse in
+  // the image.)
+  const double shift = k / (edges->diameterMm / 2);
   std::vector<cv::Point2d> plane;
-  plane.reserve(m.inlierPoints.size());
-  for (const auto& p : m.inlierPoints) {
+  plane.reserve(points.size());
+  for (const auto& p : points) {
     const cv::Point2d radial = p - edges->centreMm;
     const double d = cv::norm(radial);
     const cv::Point2d q = mapping.toPlane(d > 0 ? p + radial * (shift / d) : p);
     if (!std::isfinite(q.x) || !std::isfinite(q.y)) return std::nullopt;
     plane.push_back(q);
   }
-  return fitCircle(plane);
+  auto c = fitCircle(plane);
+  if (!c) return c;
+  // Coverage as CircleMeasure counts it, its gaps in pixels of arc at the plane's scale there.
+  const double scale = mapping.mmPerPixelAt(mapping.toImage(c->centreMm));
+  std::vector<Eigen::Vector2d> around;
+  around.reserve(plane.size());
+  for (const auto& q : plane) around.emplace_back(q.x / scale, q.y / scale);
+  c->coverageDeg = circle_fit::coverageDeg(
+      around,
+      {Eigen::Vector2d{c->centreMm.x / scale, c->centreMm.y / scale}, c->diameterMm / 2 / scale});
+  return c;
+}
+
+}  // namespace
+
+std::optional<PlaneCircle> circleInPlane(const CircleMeasurement& m, const WorldMapping& mapping) {
+  if (!m.status.ok() || m.inlierPoints.size() < 3) return std::nullopt;
+  return edgePointCircle(m.inlierPoints, edgeBiasK(m), mapping);
+}
+
+bool refusedAsImageCircle(const CircleMeasurement& m) {
+  return (m.status.cause == CircleFailure::CoverageTooSmall ||
+          m.status.cause == CircleFailure::FitTooPoor) &&
+         m.inlierPoints.size() >= 3;
+}
+
+namespace {
+
+// The annulus's edge points judged against a circle in the plane: the rim's (within the RANSAC
+// threshold of it, gradient along its normal with the rim's polarity) and the strong foreign ones
+// (off it by more than a pixel, or across it), as CircleMeasure judges them against its image
+// circle. On a rim seen at an angle (an ellipse in the image) the image circle's judgement
+// leaves most of the rim out of its 0.5 px band and calls it foreign.
+struct JudgedEdges {
+  std::vector<cv::Point2d> rim;
+  std::vector<EdgePoint> foreign;
+};
+JudgedEdges judgeEdges(const CircleMeasurement& m, const WorldMapping& mapping,
+                       cv::Point2d centreMm, double radiusMm) {
+  const CircleMeasureParams defaults;
+  const double cosTol = std::cos(defaults.directionToleranceDeg * CV_PI / 180.0);
+  JudgedEdges judged;
+  if (m.annulusEdges.empty()) return judged;
+  // The mapping over the edges' box, interpolated (plane_patch.hpp): its place and derivatives at
+  // each of a big rim's thousands of edge points, without an undistortion each.
+  std::vector<cv::Point2f> at;
+  at.reserve(m.annulusEdges.size());
+  for (const EdgePoint& e : m.annulusEdges)
+    at.emplace_back(static_cast<float>(e.position.x), static_cast<float>(e.position.y));
+  const cv::Rect box = cv::boundingRect(at) + cv::Size(2, 2) - cv::Point(1, 1);
+  const auto patch = PlanePatch::over(mapping, box);
+  if (!patch) return judged;
+  for (const EdgePoint& e : m.annulusEdges) {
+    const PlanePixel p = patch->at(e.position);
+    const RimGeometry g = rimGeometry(p.mm - centreMm, p.alongX, p.alongY, radiusMm);
+    const double cosA = m.rimSign * e.normal.dot(g.imageNormal);
+    if (std::abs(g.distance) <= defaults.ransacThreshold && cosA >= cosTol)
+      judged.rim.push_back(e.position);
+    else if (e.magnitude >= m.highThreshold && (std::abs(g.distance) > 1.0 || cosA < cosTol))
+      judged.foreign.push_back(e);
+  }
+  return judged;
+}
+
+}  // namespace
+
+std::optional<PlaneCircle> circleInPlane(const cv::Mat& image, const CircleMeasurement& m,
+                                         const WorldMapping& mapping) {
+  if (!m.status.ok() && !refusedAsImageCircle(m)) return std::nullopt;
+  auto c = edgePointCircle(m.inlierPoints, edgeBiasK(m), mapping);
+  if (!c) return c;
+  // The rim's points again, about the circle in the plane, and its edge points' circle from them
+  // when they are more than the image fit's inliers.
+  JudgedEdges edges = judgeEdges(m, mapping, c->centreMm, c->diameterMm / 2);
+  if (edges.rim.size() > m.inlierPoints.size()) {
+    if (const auto wider = edgePointCircle(edges.rim, edgeBiasK(m), mapping)) {
+      c = wider;
+      edges = judgeEdges(m, mapping, c->centreMm, c->diameterMm / 2);
+    }
+  }
+  if (const auto fine = fitPlaneCircleProfile(image, mapping, c->centreMm, c->diameterMm / 2,
+                                              edges.rim, edges.foreign, m.noiseSigma)) {
+    c->centreMm = fine->centreMm;
+    c->diameterMm = 2 * fine->radiusMm;
+    c->greyRefined = true;
+  }
+  return c;
+}
+
+std::string refusalInPlane(const PlaneCircle& w, const CircleMeasureParams& p,
+                           const WorldMapping& mapping) {
+  auto number = [](double v) {
+    std::ostringstream out;
+    out << std::setprecision(4) << v;
+    return out.str();
+  };
+  const double scale = mapping.mmPerPixelAt(p.centre);
+  if (w.coverageDeg < p.minCoverageDeg)
+    return "in the plane too, the rim's points cover " + number(w.coverageDeg) +
+           " degrees, less than " + number(p.minCoverageDeg);
+  if (w.rmsMm > p.maxRms * scale)
+    return "in the plane too, the rim's points lie " + number(w.rmsMm / scale) +
+           " px RMS off the circle, more than " + number(p.maxRms);
+  if (std::abs(w.diameterMm / 2 - p.radius * scale) > p.width * scale ||
+      cv::norm(w.centreMm - mapping.toPlane(p.centre)) > p.width * scale)
+    return "in the plane too, the fitted circle leaves the search annulus";
+  return {};
 }
 
 }  // namespace facet

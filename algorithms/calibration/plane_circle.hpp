@@ -1,13 +1,15 @@
 #pragma once
 // A circle measured in the measuring plane, in mm: the rim's subpixel edge points (from
-// CircleMeasure in the image) are mapped into the plane and a circle fitted there. A circle seen
-// at an angle or through a distorting lens is no circle in the image; in the plane it is.
+// CircleMeasure in the image) are mapped into the plane and a circle fitted there, then refined
+// with the grey values of the image around the rim, modelled in the plane. A circle seen at an
+// angle or through a distorting lens is no circle in the image; in the plane it is.
 //
 // The edge points of a curved rim sit slightly inside it (second-derivative edges on a blurred
 // curve, about k / r with k from the blur that CircleMeasure's grey-value fit measured); each
 // point is moved outwards by that before mapping.
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -25,15 +27,41 @@ struct PlaneCircle {
   // image's is not: a round hole seen at an angle is an ellipse there.
   double roundnessMm = 0;
   int points = 0;
+  double coverageDeg = 0;    // angular extent the rim's points cover, in the plane (0 unset)
+  bool greyRefined = false;  // centre and diameter from the grey-value fit in the plane
 };
 
 // Least-squares (orthogonal distance) circle through plane points; nullopt below 3 points or
 // when the fit does not converge.
 std::optional<PlaneCircle> fitCircle(const std::vector<cv::Point2d>& points);
 
-// The image measurement's circle in the plane; nullopt when the measurement failed or its points
-// leave the plane.
+// The image measurement's circle in the plane from its edge points; nullopt when the measurement
+// failed or its points leave the plane.
 std::optional<PlaneCircle> circleInPlane(const CircleMeasurement& measurement,
                                          const WorldMapping& mapping);
+
+// Whether a failed image measurement failed only as a circle in the image: its inliers' coverage
+// or RMS, or its fitted circle's place, judged against a circle, which a rim seen at an angle
+// is not (an ellipse of 0.87 : 1 at 30 degrees). Its inliers still start a measurement in the
+// plane, which judges the rim again there.
+bool refusedAsImageCircle(const CircleMeasurement& measurement);
+
+// The image measurement's circle in the plane, measured there: the rim's edge points re-collected
+// about the circle in the plane (the image fit's inliers are those near a circle in the image),
+// fitted there, then centre and diameter refined with the grey values around the rim, modelled
+// in the plane (plane_circle_profile.hpp): the precision of the image's grey-value fit with the
+// plane's geometry. Roundness, RMS and coverage are the re-collected edge points'. When the grey
+// fit does not converge the edge points' circle is returned (greyRefined false). Takes a
+// measurement that succeeded or was refusedAsImageCircle; nullopt for others, and when the
+// points leave the plane.
+std::optional<PlaneCircle> circleInPlane(const cv::Mat& image, const CircleMeasurement& measurement,
+                                         const WorldMapping& mapping);
+
+// Why a circle measured in the plane from a rim the image refusedAsImageCircle is refused in the
+// plane too, by the image measurement's own tests there: the coverage, the RMS (its pixels at the
+// plane's scale at the expected centre) and the search annulus (`params`' centre, radius and
+// width carried into the plane). Empty when it passes.
+std::string refusalInPlane(const PlaneCircle& circle, const CircleMeasureParams& params,
+                           const WorldMapping& mapping);
 
 }  // namespace facet

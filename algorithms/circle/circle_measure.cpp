@@ -335,6 +335,9 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
   const Circle circle = *fitted;
   m.inliers = static_cast<int>(in.size());
+  m.annulusEdges = edges.points;
+  m.rimSign = rimSign;
+  m.noiseSigma = edges.noiseSigma;
   m.inlierPoints.reserve(in.size());
   double sum2 = 0, lo = 0, hi = 0;
   for (const auto& p : in) {

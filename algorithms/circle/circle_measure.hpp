@@ -35,6 +35,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/status/status.hpp"
 
 namespace facet {
@@ -126,6 +127,12 @@ struct CircleMeasurement {
   double lowThreshold = 0.0;  // Canny thresholds actually used
   double highThreshold = 0.0;
   std::vector<cv::Point2d> inlierPoints;  // subpixel edge points of the fit, for display
+  // What a measurement of the same rim in another geometry (the measuring plane) needs: every
+  // subpixel edge point found in the annulus, the rim's polarity (+1: the grey rises outwards,
+  // dark inside; -1: it falls) and the annulus's noise level (grey levels, 8-bit scale).
+  std::vector<EdgePoint> annulusEdges;
+  int rimSign = 0;
+  double noiseSigma = 0.0;
 
   Status<CircleFailure> status;  // NaN centre, radius and diameter when !ok()
 };

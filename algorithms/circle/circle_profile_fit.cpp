@@ -147,24 +147,11 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // its covered runs (below); a long rim trades a little information for less contamination.
   constexpr double kSmallRim = 25.0;
   const bool smallRim = radius < kSmallRim;
-  // Close gaps of up to 2 bins (edge points missed in noise), then, on a long rim, drop 1 bin
-  // (about 2 px of arc) at each end of every covered run: next to an occluder or a clutter blob
-  // the band mixes in foreign edges. Pixels near detected foreign edges are excluded below and
-  // contaminated sectors after the first fit, so on a small rim the margin only costs information
-  // (at r = 10 px it cost 6% of the centre's precision on a 70% rim with clutter).
-  {
-    std::vector<std::uint8_t> closed = covered;
-    for (int i = 0; i < bins; ++i)
-      if (!covered[i] && ((covered[(i + bins - 1) % bins] || covered[(i + bins - 2) % bins]) &&
-                          (covered[(i + 1) % bins] || covered[(i + 2) % bins])))
-        closed[i] = 1;
-    const int margin = smallRim ? 0 : 1;
-    for (int i = 0; i < bins; ++i) {
-      bool inside = true;
-      for (int k = -margin; k <= margin && inside; ++k) inside = closed[(i + k + bins) % bins] != 0;
-      covered[i] = inside ? 1 : 0;
-    }
-  }
+  // Gaps of up to 2 bins closed; on a long rim 1 bin (about 2 px of arc) dropped at each end of
+  // every covered run. Pixels near detected foreign edges are excluded below and contaminated
+  // sectors after the first fit, so on a small rim the margin only costs information (at
+  // r = 10 px it cost 6% of the centre's precision on a 70% rim with clutter).
+  covered = rim_band::closedCoverage(covered, smallRim ? 0 : 1);
   // Half-width of the band, pixels. Its pixels away from the edge pin down the levels and the
   // illumination ramp, which the radius (and, on a partial rim, the centre) is correlated with:
   // 6 px instead of 4 gains about 15% in the radius of faint rims and in the centre of a partly
@@ -182,43 +169,9 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
   const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - rOut)));
   const int y1 = std::min(image.rows - 1, static_cast<int>(std::ceil(centre.y + rOut)));
-  // Pixels near a foreign edge (clutter, an occluder's border) stay out of the fit: within 2 px,
-  // and farther for a strong edge, as far as its blurred step still changes the grey by more than
-  // a quarter of the noise. The step's height follows from the edge's gradient magnitude (a step
-  // b blurred by s peaks at b / (sqrt(2 pi) s)); a fixed 2 px let the halo of a high-contrast blob
-  // next to the rim (several grey levels there, radial like the rim's own gradient) into the fit.
-  // A row of the map is zeroed when an edge first reaches it (most rows have none; zeroing the
-  // whole map cost more than marking it); a row not zeroed holds no tainted pixel.
-  cv::Mat tainted;
-  std::vector<std::uint8_t> taintedRow;  // 1: the row of `tainted` is zeroed and marked
-  if (!foreignPoints.empty() && x1 >= x0 && y1 >= y0) {
-    constexpr double kEdgeBlur = 1.0;  // pixels; a sharp edge seen through the pixel grid
-    constexpr double kMinTaint = 2.0, kMaxTaint = 4.0;                    // pixels
-    const double tolerance = noiseSigma > 0.0 ? 0.25 * noiseSigma : 0.5;  // grey levels
-    tainted.create(y1 - y0 + 1, x1 - x0 + 1, CV_8U);
-    taintedRow.assign(y1 - y0 + 1, 0);
-    for (const EdgePoint& e : foreignPoints) {
-      const double step = e.magnitude * std::sqrt(2.0 * kPi) * kEdgeBlur;
-      auto halo = [&](double d) {  // grey change d px from the edge
-        const double z = d / kEdgeBlur;
-        return step * upperTail(z, std::exp(-0.5 * z * z));
-      };
-      double reach = kMinTaint;
-      while (reach < kMaxTaint && halo(reach) > tolerance) reach += 0.25;
-      const cv::Point2d q = e.position;
-      const int qx = static_cast<int>(std::lround(q.x)), qy = static_cast<int>(std::lround(q.y));
-      const int span = static_cast<int>(std::ceil(reach));
-      for (int v = std::max(y0, qy - span); v <= std::min(y1, qy + span); ++v) {
-        if (!taintedRow[v - y0]) {
-          std::memset(tainted.ptr<std::uint8_t>(v - y0), 0, static_cast<std::size_t>(tainted.cols));
-          taintedRow[v - y0] = 1;
-        }
-        for (int u = std::max(x0, qx - span); u <= std::min(x1, qx + span); ++u)
-          if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= reach * reach)
-            tainted.at<std::uint8_t>(v - y0, u - x0) = 1;
-      }
-    }
-  }
+  // Pixels near a foreign edge (clutter, an occluder's border) stay out of the fit.
+  const rim_band::ForeignReach tainted(foreignPoints, noiseSigma,
+                                       cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
   // The band's pixels that take part (in a covered bin, clear of foreign edges), in the runs'
   // order. Along a row the angular bin is monotonic (diamondAngle), so a run whose end pixels'
   // bins enclose covered bins only is covered throughout and needs no bin per pixel here; the
@@ -235,9 +188,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     const int n = run.x1 - run.x0;
     if (n <= 0) continue;
     const double dy = run.y - centre.y;
-    const auto* taint = !taintedRow.empty() && taintedRow[run.y - y0]
-                            ? tainted.ptr<std::uint8_t>(run.y - y0) - x0
-                            : nullptr;
+    const std::uint8_t* taint = tainted.row(run.y);
     const int first = angularBin(static_cast<double>(run.x0) - centre.x, dy, bins);
     const int last = angularBin(static_cast<double>(run.x1 - 1) - centre.x, dy, bins);
     if (taint == nullptr &&
@@ -284,11 +235,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   p(7) = medianOf(inside) - p(4);
 
   // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
-  // bins, enough for a centre precision of about kTargetSigma px per axis by the Cramer-Rao bound
-  // (information per band pixel about (b / noise)^2 / (2 sqrt(pi) s) / (2 * 2 band)); this
-  // bounds the time of big, high-contrast circles and keeps every pixel of faint ones. When
-  // pixels are to spare, the narrower band goes first: its pixels carry more about the rim.
-  constexpr double kTargetSigma = 0.0035;
+  // bins, as many pixels as rim_band::pixelsNeeded. When pixels are to spare, the narrower band
+  // goes first: its pixels carry more about the rim.
   const double lo = std::max(0.0, radius - kNarrowBand), hi = radius + kNarrowBand;
   bool narrow = false;  // keep the pixels within kNarrowBand of the rim only
   double share = 1.0;   // ... and of their bins this share
@@ -297,10 +245,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   std::size_t narrowPixels = 0;
   if (noiseSigma > 0.0) {
     const double snr = p(7) / noiseSigma;
-    auto needed = [&](double halfWidth) {
-      const double infoPerPixel = snr * snr / (2.0 * std::sqrt(kPi) * 1.05) / (4.0 * halfWidth);
-      return std::max(1000.0, 1.0 / (kTargetSigma * kTargetSigma * infoPerPixel));
-    };
+    auto needed = [&](double halfWidth) { return rim_band::pixelsNeeded(snr, halfWidth); };
     if (static_cast<double>(inBand) > needed(halfBand)) {
       narrow = true;
       narrowBand.reserve(2 * band.size());
@@ -341,7 +286,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   }
   if (noiseSigma > 0.0) {
     // After the thinning, so that a big rim pays only for the pixels it keeps.
-    dropForeignGradients(samples, image, centre, radius, noiseSigma,
+    dropForeignGradients(samples, image, radius, noiseSigma,
                          cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
     if (samples.size() < 30) return std::nullopt;
   }

@@ -1,8 +1,11 @@
 #include "algorithms/circle/rim_band.hpp"
 
+#include "algorithms/circle/step_profile.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <numbers>
 #include <span>
 #include <utility>
 
@@ -12,6 +15,67 @@ double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
+}
+
+double pixelsNeeded(double snr, double halfWidth) {
+  constexpr double kTargetSigma = 0.0035;
+  const double infoPerPixel =
+      snr * snr / (2.0 * std::sqrt(std::numbers::pi) * 1.05) / (4.0 * halfWidth);
+  return std::max(1000.0, 1.0 / (kTargetSigma * kTargetSigma * infoPerPixel));
+}
+
+std::vector<std::uint8_t> closedCoverage(const std::vector<std::uint8_t>& covered, int margin) {
+  const int bins = static_cast<int>(covered.size());
+  auto at = [&](const std::vector<std::uint8_t>& v, int i) {
+    return v[static_cast<std::size_t>((i % bins + bins) % bins)] != 0;
+  };
+  std::vector<std::uint8_t> closed = covered, kept(covered.size(), 0);
+  for (int i = 0; i < bins; ++i)
+    if (!at(covered, i) && (at(covered, i - 1) || at(covered, i - 2)) &&
+        (at(covered, i + 1) || at(covered, i + 2)))
+      closed[static_cast<std::size_t>(i)] = 1;
+  for (int i = 0; i < bins; ++i) {
+    bool inside = true;
+    for (int k = -margin; k <= margin && inside; ++k) inside = at(closed, i + k);
+    kept[static_cast<std::size_t>(i)] = inside ? 1 : 0;
+  }
+  return kept;
+}
+
+ForeignReach::ForeignReach(const std::vector<EdgePoint>& foreign, double noiseSigma, cv::Rect box)
+    : box_(box) {
+  if (foreign.empty() || box.width <= 0 || box.height <= 0) return;
+  constexpr double kEdgeBlur = 1.0;  // pixels; a sharp edge seen through the pixel grid
+  constexpr double kMinReach = 2.0, kMaxReach = 4.0;                    // pixels
+  const double tolerance = noiseSigma > 0.0 ? 0.25 * noiseSigma : 0.5;  // grey levels
+  map_.create(box.height, box.width, CV_8U);
+  marked_.assign(static_cast<std::size_t>(box.height), 0);
+  const int x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
+  for (const EdgePoint& e : foreign) {
+    // The step's height follows from the edge's gradient magnitude (a step b blurred by s peaks
+    // at b / (sqrt(2 pi) s)); a fixed 2 px let the halo of a high-contrast blob next to the rim
+    // (several grey levels there, radial like the rim's own gradient) into the fit.
+    const double step = e.magnitude * std::sqrt(2.0 * std::numbers::pi) * kEdgeBlur;
+    auto halo = [&](double d) {  // grey change d px from the edge
+      const double z = d / kEdgeBlur;
+      return step * step_profile::upperTail(z, std::exp(-0.5 * z * z));
+    };
+    double reach = kMinReach;
+    while (reach < kMaxReach && halo(reach) > tolerance) reach += 0.25;
+    const cv::Point2d q = e.position;
+    const int qx = static_cast<int>(std::lround(q.x)), qy = static_cast<int>(std::lround(q.y));
+    const int span = static_cast<int>(std::ceil(reach));
+    for (int v = std::max(box.y, qy - span); v <= std::min(y1, qy + span); ++v) {
+      const auto r = static_cast<std::size_t>(v - box.y);
+      if (!marked_[r]) {
+        std::memset(map_.ptr<std::uint8_t>(v - box.y), 0, static_cast<std::size_t>(map_.cols));
+        marked_[r] = 1;
+      }
+      for (int u = std::max(box.x, qx - span); u <= std::min(x1, qx + span); ++u)
+        if ((u - q.x) * (u - q.x) + (v - q.y) * (v - q.y) <= reach * reach)
+          map_.at<std::uint8_t>(v - box.y, u - box.x) = 1;
+    }
+  }
 }
 
 // Robust sigma (1.4826 x median absolute value) of residuals around zero, from an evenly strided
@@ -70,8 +134,8 @@ cv::Point2d sobel3(const cv::Mat& image, int x, int y, double scale) {
 }
 
 template <typename T>
-void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d centre,
-                 double radius, double noiseSigma, cv::Rect box, double scale) {
+void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radius,
+                 double noiseSigma, cv::Rect box, double scale) {
   constexpr double kGradientZ = 4.0;
   constexpr double kFlatZone = 3.0;  // pixels from the rim: the blurred edge's slope is < 1% there
   // The 3x3 Sobel divided by 8 is a unit-gain derivative; its noise is sqrt(12) / 8 of the pixels'.
@@ -85,7 +149,7 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d
     const int x = e.column, y = e.row;
     if (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1) continue;
     const cv::Point2d g = sobel3<T>(image, x, y, scale);
-    const double dx = x - centre.x, dy = y - centre.y;
+    const double dx = e.x, dy = e.y;
     const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
     const double tangential = (g.y * dx - g.x * dy) / rho;
     // Both tests, then a choice without a branch: which one applies (the narrow band reaches
@@ -127,12 +191,12 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d
 // test on the residuals, this one does not depend on the fit being right (a circle pulled by
 // clutter leaves coherent residuals along its own rim). The neighbours go too: a blurred blob's
 // tail is still a few grey levels high where its gradient has sunk into the noise.
-void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, cv::Point2d centre,
-                          double radius, double noiseSigma, cv::Rect box) {
+void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, double radius,
+                          double noiseSigma, cv::Rect box) {
   if (image.depth() == CV_16U)
-    dropForeign<std::uint16_t>(samples, image, centre, radius, noiseSigma, box, 1.0 / 256.0);
+    dropForeign<std::uint16_t>(samples, image, radius, noiseSigma, box, 1.0 / 256.0);
   else
-    dropForeign<std::uint8_t>(samples, image, centre, radius, noiseSigma, box, 1.0);
+    dropForeign<std::uint8_t>(samples, image, radius, noiseSigma, box, 1.0);
 }
 
 }  // namespace facet::rim_band

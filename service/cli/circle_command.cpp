@@ -54,15 +54,37 @@ void run(const CircleOptions& o) {
 
   const auto t0 = std::chrono::steady_clock::now();
   const CircleMeasurement m = measureCircle(image, p);
+  // With a plane, a rim the image refused as a circle (an ellipse on a steep view) is measured
+  // and judged in the plane; the time includes it.
+  std::string inPlane;
+  const nlohmann::json world = plane ? worldCircle(*plane, image, m, p, inPlane) : nlohmann::json();
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   if (m.status.cause == CircleFailure::BadInput)
     throw InputError(o.image + ": " + m.status.message);
-  if (!m.status.ok())
-    throw MeasurementFailure(std::string(toString(m.status.cause)),
-                             o.image + ": " + m.status.message);
-
-  const nlohmann::json world = plane ? worldCircle(*plane, m) : nlohmann::json();
+  if (!m.status.ok() && world.is_null())
+    throw MeasurementFailure(
+        std::string(toString(m.status.cause)),
+        o.image + ": " + m.status.message + (inPlane.empty() ? "" : "; " + inPlane));
+  if (!m.status.ok()) {
+    // Refused as a circle in the image, measured in the plane: the image fields say so.
+    const cv::Point2d at =
+        plane->mapping()->toImage({world["x_mm"].get<double>(), world["y_mm"].get<double>()});
+    if (o.json) {
+      printJson({{"x", at.x},
+                 {"y", at.y},
+                 {"image_refusal", std::string(toString(m.status.cause)) + ": " + m.status.message},
+                 {"time_ms", ms},
+                 {"world", world}});
+    } else {
+      std::cout << std::setprecision(6) << "the image refused the rim as a circle ("
+                << m.status.message << "); measured in the plane: centre ("
+                << world["x_mm"].get<double>() << ", " << world["y_mm"].get<double>()
+                << ") mm, diameter " << world["diameter_mm"].get<double>() << " mm, image point ("
+                << at.x << ", " << at.y << ") px, " << ms << " ms\n";
+    }
+    return;
+  }
   if (o.json) {
     nlohmann::json out{{"x", m.centre.x},
                        {"y", m.centre.y},

@@ -5,16 +5,29 @@
 
 namespace facet::cli {
 
-nlohmann::json worldCircle(const MeasuringPlane& plane, const CircleMeasurement& m) {
+nlohmann::json worldCircle(const MeasuringPlane& plane, const cv::Mat& image,
+                           const CircleMeasurement& m, const CircleMeasureParams& params,
+                           std::string& refusal) {
   if (const WorldMapping* mapping = plane.mapping()) {
-    const auto c = circleInPlane(m, *mapping);
-    if (!c)
+    const bool judged = !m.status.ok();
+    if (judged && !refusedAsImageCircle(m)) return nullptr;
+    const auto c = circleInPlane(image, m, *mapping);
+    if (!c) {
+      if (judged) return nullptr;
       throw MeasurementFailure("off_plane",
                                "the circle's rim does not map into the measuring plane");
+    }
+    if (judged) {
+      refusal = refusalInPlane(*c, params, *mapping);
+      if (!refusal.empty()) return nullptr;
+    }
     return {{"x_mm", c->centreMm.x},          {"y_mm", c->centreMm.y},
             {"diameter_mm", c->diameterMm},   {"rms_mm", c->rmsMm},
-            {"roundness_mm", c->roundnessMm}, {"calibration", plane.kind()}};
+            {"roundness_mm", c->roundnessMm}, {"coverage_deg", c->coverageDeg},
+            {"grey_refined", c->greyRefined}, {"judged_in_plane", judged},
+            {"calibration", plane.kind()}};
   }
+  if (!m.status.ok()) return nullptr;
   const cv::Point2d centre = plane.toPlane(m.centre);
   return {{"x_mm", centre.x},
           {"y_mm", centre.y},

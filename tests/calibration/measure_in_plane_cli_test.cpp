@@ -15,6 +15,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include "algorithms/calibration/world_mapping.hpp"
 #include "config/calibration_file.hpp"
 #include "tests/calibration/calibration_scenes.hpp"
 #include "tests/support/cli/facet_cli.hpp"
@@ -166,6 +167,66 @@ TEST_F(MeasureInPlaneCli, BlobGivesTheDiscsAreaAndCentreInThePlane) {
   EXPECT_GT(b["ellipse"]["major_radius"].get<double>(),
             1.03 * b["ellipse"]["minor_radius"].get<double>())
       << b.dump();
+}
+
+// The disc through `facet circle --calibration`: the rim's edge points and grey values fitted in
+// the plane (the image's grey fit fits a circle to the disc's ellipse there).
+TEST_F(MeasureInPlaneCli, CircleGivesTheDiscInThePlane) {
+  const cv::Point2d c = part.imageOf(kDisc);
+  const double r = 0.5 * (cv::norm(part.imageOf(kDisc + cv::Point2d(kDiscRadius, 0)) - c) +
+                          cv::norm(part.imageOf(kDisc + cv::Point2d(0, kDiscRadius)) - c));
+  const auto j =
+      run("circle --image " + (dir / "part.png").string() + " --centre " +
+          csv({c.x + 0.6, c.y - 0.4}) + " --radius " + csv({r}) + " --width " + csv({0.3 * r}) +
+          " --polarity dark_inside --calibration " + (dir / "lens_plane.yaml").string());
+  const auto& w = j["world"];
+  ASSERT_TRUE(w.is_object()) << j.dump();
+  EXPECT_TRUE(w["grey_refined"].get<bool>()) << w.dump();
+  EXPECT_FALSE(w["judged_in_plane"].get<bool>()) << w.dump();
+  EXPECT_NEAR(w["x_mm"].get<double>(), kDisc.x, 0.002) << w.dump();
+  EXPECT_NEAR(w["y_mm"].get<double>(), kDisc.y, 0.002) << w.dump();
+  EXPECT_NEAR(w["diameter_mm"].get<double>(), 2 * kDiscRadius, 0.003) << w.dump();
+  EXPECT_GT(w["coverage_deg"].get<double>(), 300) << w.dump();
+}
+
+// A hole seen at 40 degrees, which the image refuses as a circle (its rim is an ellipse of
+// 0.77 : 1 there): `facet circle --calibration` measures and judges it in the plane and says so;
+// without the calibration the command fails as before.
+TEST_F(MeasureInPlaneCli, CircleMeasuresInThePlaneAHoleTheImageRefuses) {
+  scene::PlaneScene steep;
+  steep.camera = test::testCamera();
+  steep.placement = scene::lookAtPlane({40, 30}, 250, 40, 20, 10, steep.camera);
+  steep.background = 30;
+  steep.addPolygon({{-20, -20}, {100, -20}, {100, 80}, {-20, 80}}, 210);
+  const cv::Point2d hole(45, 27);
+  steep.addDisc(hole, 5, 40);
+  steep.lensBlurSigma = 0.7;
+  steep.noiseSigma = 2;
+  cv::imwrite((dir / "steep.png").string(), steep.render());
+  config::CalibrationData truth;
+  truth.camera = CameraModel{steep.camera.matrix(), steep.camera.distortion(), steep.camera.size};
+  truth.plane = PlanePose{steep.placement.rotation, steep.placement.translationMm, 0.0};
+  std::ofstream(dir / "steep.yaml") << config::calibrationFileText(truth, "test truth");
+  const WorldMapping mapping(*truth.camera, *truth.plane);
+  const cv::Point2d c = steep.imageOf(hole);
+  const double r = 5 / mapping.mmPerPixelAt(c);
+  const std::string command = "circle --image " + (dir / "steep.png").string() + " --centre " +
+                              csv({c.x + 0.6, c.y - 0.4}) + " --radius " + csv({r}) + " --width " +
+                              csv({0.35 * r}) + " --polarity dark_inside";
+  const auto inImage = test::runFacet(command + " --json");
+  ASSERT_NE(inImage.exitCode, 0) << "the view no longer makes the image refuse the hole\n"
+                                 << inImage.out;
+  const auto j = run(command + " --calibration " + (dir / "steep.yaml").string());
+  const auto& w = j["world"];
+  ASSERT_TRUE(w.is_object()) << j.dump();
+  EXPECT_TRUE(w["judged_in_plane"].get<bool>()) << w.dump();
+  EXPECT_NE(j["image_refusal"].get<std::string>(), "") << j.dump();
+  EXPECT_NEAR(w["x_mm"].get<double>(), hole.x, 0.002) << w.dump();
+  EXPECT_NEAR(w["y_mm"].get<double>(), hole.y, 0.002) << w.dump();
+  EXPECT_NEAR(w["diameter_mm"].get<double>(), 10, 0.003) << w.dump();
+  // The image point given is the image of the plane's centre.
+  EXPECT_LT(cv::norm(cv::Point2d(j["x"].get<double>(), j["y"].get<double>()) - c), 0.02)
+      << j.dump();
 }
 
 TEST_F(MeasureInPlaneCli, AScaleOnlyFileMultipliesAndAFileForOtherImagesIsRefused) {
