@@ -191,6 +191,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   auto n = static_cast<Eigen::Index>(band.size());
   Eigen::VectorXd r(n), rTry(n), weight = Eigen::VectorXd::Ones(n);
   Eigen::Matrix<double, Eigen::Dynamic, 8> jac(n, 8), jacTry(n, 8);
+  bool pixelModel = false;  // fitCircleProfile's model of sharp images (below)
   auto evaluate = [&](const Vector8& v, Eigen::VectorXd& res,
                       Eigen::Matrix<double, Eigen::Dynamic, 8>& j) {
     const cv::Point2d c = unit * cv::Point2d(v(kCx), v(kCy));
@@ -199,6 +200,21 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
     for (Eigen::Index i = 0; i < n; ++i) {
       const RimPixel& e = band[static_cast<std::size_t>(i)];
       const RimGeometry g = rimGeometryAt(e.mm - c, e.alongX, e.alongY, radius);
+      if (pixelModel) {  // the sharp images' model: s the lens blur, the pixel's box averaged
+        const step_profile::PixelStep p =
+            step_profile::pixelStep(g.distance, s, g.imageNormal.x, g.imageNormal.y);
+        res(i) = e.grey - (v(kLevel) + v(kRampX) * e.x + v(kRampY) * e.y + b * p.value);
+        const double perUnit = -b * p.dd * unit / g.scale;  // dI/dd dd/dC, dd/dC = -u unit / k
+        j(i, kCx) = perUnit * g.planeNormal.x;
+        j(i, kCy) = perUnit * g.planeNormal.y;
+        j(i, kRadius) = perUnit;
+        j(i, kBlur) = b * p.ds;
+        j(i, kLevel) = 1.0;
+        j(i, kRampX) = e.x;
+        j(i, kRampY) = e.y;
+        j(i, kContrast) = p.value;
+        continue;
+      }
       const double z = g.distance / s, gauss = step_profile::gaussian(z);
       const double phi = step_profile::upperTail(z, gauss);  // Phi(-d / s)
       const double bg = bNorm * gauss;                       // -dI/dd
@@ -337,9 +353,17 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
     if (!solve({true, true, true, true, true, withRamp, withRamp, true})) return std::nullopt;
   }
 
+  // A sharp image: refit with each pixel's area in the model, as fitCircleProfile does.
+  if (q(kBlur) < step_profile::kSharpBlur) {
+    pixelModel = true;
+    q(kBlur) = std::sqrt(std::max(q(kBlur) * q(kBlur) - step_profile::kPixelVariance, 0.01));
+    if (!solve({true, true, true, true, true, withRamp, withRamp, true})) return std::nullopt;
+  }
   // A rim is a step well above the noise: a contrast within a few noise levels of none is no rim
   // (an image without contrast leaves every parameter but the level free).
-  const double blur = q(kBlur);
+  // The equivalent Gaussian blur, PSF and pixel together.
+  const double blur =
+      pixelModel ? std::sqrt(q(kBlur) * q(kBlur) + step_profile::kPixelVariance) : q(kBlur);
   if (!q.allFinite() || std::abs(q(kContrast)) < std::max(4.0 * sigma, 1.0) || blur < 0.2 ||
       blur > 5.0 || q(kRadius) <= 0.0 || std::hypot(q(kCx), q(kCy)) > maxShiftPx ||
       std::abs(q(kRadius) - radiusPx) > maxShiftPx)

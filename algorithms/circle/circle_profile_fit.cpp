@@ -130,6 +130,29 @@ void evaluateProfile(const Vector8& q, std::ptrdiff_t n, const double* __restric
   }
 }
 
+// The same pass with each pixel's area in the model (step_profile::pixelStep): q(3) is the lens's
+// blur alone, and the pixel's box is averaged over along the rim's normal there. For sharp
+// images only (see fitCircleProfile); a plain loop.
+void evaluatePixelProfile(const Vector8& q, std::ptrdiff_t n, const double* x, const double* y,
+                          const double* grey, double* out, double* cx, double* cy, double* cr,
+                          double* cs, double* cb) {
+  const double cx0 = q(0), cy0 = q(1), radius = q(2), s = q(3), level = q(4), rampX = q(5),
+               rampY = q(6), b = q(7);
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const double ex = x[i] - cx0, ey = y[i] - cy0;
+    const double rho = std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
+    const step_profile::PixelStep e = step_profile::pixelStep(rho - radius, s, ex / rho, ey / rho);
+    out[i] = grey[i] - (level + rampX * x[i] + rampY * y[i] + b * e.value);
+    // dI/dd = b e.dd; dd/dcx = -ex/rho, dd/dcy = -ey/rho, dd/dR = -1 (the normal's turn with the
+    // centre is second order).
+    cx[i] = -b * e.dd * ex / rho;
+    cy[i] = -b * e.dd * ey / rho;
+    cr[i] = -b * e.dd;
+    cs[i] = b * e.ds;
+    cb[i] = e.value;
+  }
+}
+
 }  // namespace
 
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
@@ -324,7 +347,14 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     }
   };
   loadBand();
+  bool pixelModel = false;  // the sharp images' model (below): q(3) the lens blur alone
   auto evaluate = [&](const Vector8& q, Eigen::VectorXd& res, Columns& j) {
+    if (pixelModel) {
+      evaluatePixelProfile(q, static_cast<std::ptrdiff_t>(m), px.data(), py.data(), grey.data(),
+                           res.data(), j.col(0).data(), j.col(1).data(), j.col(2).data(),
+                           j.col(3).data(), j.col(7).data());
+      return;
+    }
     evaluateProfile(q, static_cast<std::ptrdiff_t>(m), px.data(), py.data(), grey.data(),
                     res.data(), j.col(0).data(), j.col(1).data(), j.col(2).data(), j.col(3).data(),
                     j.col(7).data());
@@ -478,7 +508,21 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       return std::nullopt;
   }
 
-  const double blur = p(3);
+  // A sharp image (a lens blur of a third of a pixel or less): the pixel's box dominates the
+  // profile, which the Gaussian misfits by several grey levels at high contrast; the robust
+  // weights then reject the steepest pixels, unevenly around the rim. A perfectly sharp disc at
+  // noise 0.5 came out 0.28 px RMS off (0.015 at noise 1). Refit from there with the pixel's
+  // area in the model; its blur parameter is the lens's alone.
+  using step_profile::kPixelVariance;
+  if (p(3) < step_profile::kSharpBlur) {
+    pixelModel = true;
+    p(3) = std::sqrt(std::max(p(3) * p(3) - kPixelVariance, 0.01));
+    if (!solve({true, true, true, true, true, withRamp, withRamp, true}, 15, true))
+      return std::nullopt;
+  }
+  // The equivalent Gaussian blur, PSF and pixel together: its variance across the rim is what
+  // moves the 50% level inside a convex rim (below).
+  const double blur = pixelModel ? std::sqrt(p(3) * p(3) + kPixelVariance) : p(3);
   const cv::Point2d c{centre.x + p(0), centre.y + p(1)};
   if (!p.allFinite() || blur < 0.2 || blur > 5.0 || p(2) <= 0.0 ||
       std::hypot(c.x - centre.x, c.y - centre.y) > maxShift || std::abs(p(2) - radius) > maxShift)

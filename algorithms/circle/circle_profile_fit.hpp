@@ -22,6 +22,12 @@
 // The 50% level of a blurred disc lies s^2 / (2 R) inside its true rim (the disc is convex, so
 // it covers less than half of the PSF centred on its rim); the fitted s corrects that bias
 // without any calibration constant.
+//
+// A sharp image (fitted s below step_profile::kSharpBlur: a lens blur of a third of a pixel or
+// less, an exact render) is refitted with each pixel's area in the model (step_profile::
+// pixelStep), s then the lens's blur alone: there the pixel's box dominates the profile and the
+// Gaussian misfits it by several grey levels at high contrast. `blur` reports the equivalent
+// Gaussian sqrt(s^2 + 1/12) either way.
 
 #include <optional>
 #include <vector>
@@ -35,7 +41,7 @@ namespace facet {
 struct CircleProfileFit {
   cv::Point2d centre;   // pixels
   double radius = 0.0;  // pixels, curvature bias corrected
-  double blur = 0.0;    // fitted s, pixels
+  double blur = 0.0;    // fitted s (the equivalent Gaussian, PSF and pixel together), pixels
   double noise = 0.0;   // robust sigma of the grey residuals, grey levels (8-bit scale)
   int pixels = 0;       // pixels used
 };

@@ -140,6 +140,10 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radi
   constexpr double kFlatZone = 3.0;  // pixels from the rim: the blurred edge's slope is < 1% there
   // The 3x3 Sobel divided by 8 is a unit-gain derivative; its noise is sqrt(12) / 8 of the pixels'.
   const double limit = kGradientZ * noiseSigma * std::sqrt(12.0) / 8.0;
+  // The rim's own gradient, seen by the 3x3 Sobel on a sharp step (a sharp lens, an exact render),
+  // turns by up to several degrees from the normal with the step's place in the pixel: a
+  // tangential share of the rim's own magnitude, not a foreign gradient. sin(10 degrees).
+  constexpr double kSobelTurn = 0.17;
   // The flag map only when some pixel is foreign: a clean rim needs none. A row of it is zeroed
   // when first marked (zeroing the whole map cost a quarter of this screen); a row not zeroed
   // holds no flag.
@@ -156,7 +160,8 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radi
     // 4 px from the rim) follows no pattern the branch predictor learns.
     const bool far = std::abs(rho - radius) > kFlatZone;
     const bool steep = g.x * g.x + g.y * g.y > limit * limit;
-    const bool across = std::abs(tangential) > limit;
+    const bool across =
+        std::abs(tangential) > limit + kSobelTurn * std::sqrt(g.x * g.x + g.y * g.y);
     const bool foreign = (far & steep) | (!far & across);
     if (!foreign) continue;
     if (flagged.empty()) {
