@@ -43,6 +43,15 @@ std::string csv(std::initializer_list<double> values) {
   return s.str();
 }
 
+// The renderer's own camera and plane as a calibration (the commands, not a calibration, under
+// test).
+config::CalibrationData truthOf(const scene::PlaneScene& scene) {
+  config::CalibrationData truth;
+  truth.camera = CameraModel{scene.camera.matrix(), scene.camera.distortion(), scene.camera.size};
+  truth.plane = PlanePose{scene.placement.rotation, scene.placement.translationMm, 0.0};
+  return truth;
+}
+
 class MeasureInPlaneCli : public ::testing::Test {
  protected:
   static inline fs::path dir;
@@ -62,10 +71,8 @@ class MeasureInPlaneCli : public ::testing::Test {
     part.noiseSigma = 2;
     cv::imwrite((dir / "part.png").string(), part.render());
 
-    config::CalibrationData truth;
-    truth.camera = CameraModel{part.camera.matrix(), part.camera.distortion(), part.camera.size};
-    truth.plane = PlanePose{part.placement.rotation, part.placement.translationMm, 0.0};
-    std::ofstream(dir / "lens_plane.yaml") << config::calibrationFileText(truth, "test truth");
+    std::ofstream(dir / "lens_plane.yaml")
+        << config::calibrationFileText(truthOf(part), "test truth");
     std::ofstream(dir / "scale.yaml") << "format: facet-calibration 1\nmm_per_pixel: 0.1\n";
     std::ofstream(dir / "small.yaml")
         << "format: facet-calibration 1\nimage_size: [640, 480]\n"
@@ -203,9 +210,7 @@ TEST_F(MeasureInPlaneCli, CircleMeasuresInThePlaneAHoleTheImageRefuses) {
   steep.lensBlurSigma = 0.7;
   steep.noiseSigma = 2;
   cv::imwrite((dir / "steep.png").string(), steep.render());
-  config::CalibrationData truth;
-  truth.camera = CameraModel{steep.camera.matrix(), steep.camera.distortion(), steep.camera.size};
-  truth.plane = PlanePose{steep.placement.rotation, steep.placement.translationMm, 0.0};
+  const config::CalibrationData truth = truthOf(steep);
   std::ofstream(dir / "steep.yaml") << config::calibrationFileText(truth, "test truth");
   const WorldMapping mapping(*truth.camera, *truth.plane);
   const cv::Point2d c = steep.imageOf(hole);

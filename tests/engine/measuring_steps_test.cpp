@@ -375,6 +375,31 @@ TEST_F(MeasuringSteps, InACalibratedPlaneValuesAreMillimetresThere) {
   EXPECT_NEAR(value(out, "across.width").value, 12.0, 0.002);
 }
 
+// A 640x480 camera with a distorting lens (k1 -0.15) 200 mm from a light plane tilted `tiltDeg`
+// degrees; lens blur 0.7 px, noise 1.
+scene::PlaneScene tiltedView(double tiltDeg) {
+  scene::PlaneScene s;
+  s.camera.size = {640, 480};
+  s.camera.fx = s.camera.fy = 1200, s.camera.cx = 319.5, s.camera.cy = 239.5;
+  s.camera.k1 = -0.15;
+  s.placement = scene::lookAtPlane({22, 16}, 200, tiltDeg, 20, 5, s.camera);
+  s.background = 200;
+  s.lensBlurSigma = 0.7;
+  s.noiseSigma = 1;
+  return s;
+}
+
+// The view's own camera and plane as the station's calibration.
+config::Calibration calibrationOf(const scene::PlaneScene& s) {
+  config::Calibration calibration;
+  calibration.mmPerPixel = 0.17;
+  calibration.cameraMatrix = cv::Mat(s.camera.matrix());
+  calibration.distortion = s.camera.distortion();
+  calibration.imageSize = s.camera.size;
+  calibration.plane = PlanePose{s.placement.rotation, s.placement.translationMm, 0.0};
+  return calibration;
+}
+
 // On a plane seen at 30 degrees through a distorting lens, the blob step measures its largest
 // blob in the plane: its area there, and its centre (which a distance step relates) is the
 // blob's centre in the plane, not the image centroid mapped (which fails the 0.01 mm check).
@@ -382,23 +407,11 @@ TEST_F(MeasuringSteps, InACalibratedPlaneValuesAreMillimetresThere) {
 // the plane, not in the image). The circle's roundness is the rim's in the plane: in the image
 // the round bore is an ellipse, 0.5 mm from round at the plane's scale.
 TEST_F(MeasuringSteps, OnATiltedPlaneABlobsAreaAndCentreAreThePlanes) {
-  scene::PlaneScene s;
-  s.camera.size = {640, 480};
-  s.camera.fx = s.camera.fy = 1200, s.camera.cx = 319.5, s.camera.cy = 239.5;
-  s.camera.k1 = -0.15;
-  s.placement = scene::lookAtPlane({22, 16}, 200, 30, 20, 5, s.camera);
-  s.background = 200;
+  scene::PlaneScene s = tiltedView(30);
   const cv::Point2d blobMm(12, 15), boreMm(35, 18);
   s.addDisc(blobMm, 8, 40);
   s.addDisc(boreMm, 4, 40);
-  s.lensBlurSigma = 0.7;
-  s.noiseSigma = 1;
-  config::Calibration calibration;
-  calibration.mmPerPixel = 0.17;
-  calibration.cameraMatrix = cv::Mat(s.camera.matrix());
-  calibration.distortion = s.camera.distortion();
-  calibration.imageSize = s.camera.size;
-  calibration.plane = PlanePose{s.placement.rotation, s.placement.translationMm, 0.0};
+  const config::Calibration calibration = calibrationOf(s);
   const cv::Point2d a = s.imageOf(blobMm), b = s.imageOf(boreMm);
   const cv::Point2d x = s.imageOf(blobMm + cv::Point2d(0.01, 0)) - a;
   std::ostringstream steps;
@@ -430,22 +443,10 @@ TEST_F(MeasuringSteps, OnATiltedPlaneABlobsAreaAndCentreAreThePlanes) {
 // leaves the annulus; checked below with the step's own parameters). The circle step judges the
 // rim again in the plane, where it is round, and measures it there: its place within 0.005 mm.
 TEST_F(MeasuringSteps, OnASteepViewACircleTheImageRefusesIsMeasuredInThePlane) {
-  scene::PlaneScene s;
-  s.camera.size = {640, 480};
-  s.camera.fx = s.camera.fy = 1200, s.camera.cx = 319.5, s.camera.cy = 239.5;
-  s.camera.k1 = -0.15;
-  s.placement = scene::lookAtPlane({22, 16}, 200, 40, 20, 5, s.camera);
-  s.background = 200;
+  scene::PlaneScene s = tiltedView(40);
   const cv::Point2d boreMm(22, 16);
   s.addDisc(boreMm, 4, 40);
-  s.lensBlurSigma = 0.7;
-  s.noiseSigma = 1;
-  config::Calibration calibration;
-  calibration.mmPerPixel = 0.17;
-  calibration.cameraMatrix = cv::Mat(s.camera.matrix());
-  calibration.distortion = s.camera.distortion();
-  calibration.imageSize = s.camera.size;
-  calibration.plane = PlanePose{s.placement.rotation, s.placement.translationMm, 0.0};
+  const config::Calibration calibration = calibrationOf(s);
   const cv::Mat image = s.render();
   // The nominal centre 0.5 px off the bore's image, as a part placed by hand would be.
   const cv::Point2d b = s.imageOf(boreMm) + cv::Point2d(0.4, -0.3);
