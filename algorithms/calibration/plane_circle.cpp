@@ -67,8 +67,11 @@ double edgeBiasK(const CircleMeasurement& m) {
 }
 
 // The circle through a rim's edge points in the plane, each moved out by the bias k / r first.
+// Each point mapped through `patch` when there is one (the annulus's, which the grey fit uses),
+// else exactly: a big rim has hundreds of points, each an iterative undistortion.
 std::optional<PlaneCircle> edgePointCircle(const std::vector<cv::Point2d>& points, double k,
-                                           const WorldMapping& mapping) {
+                                           const WorldMapping& mapping,
+                                           const PlanePatch* patch = nullptr) {
   // The edge points' own circle in the image, for the outward direction of each point.
   const auto edges = fitCircle(points);
   if (!edges) return std::nullopt;
@@ -80,7 +83,8 @@ std::optional<PlaneCircle> edgePointCircle(const std::vector<cv::Point2d>& point
   for (const auto& p : points) {
     const cv::Point2d radial = p - edges->centreMm;
     const double d = cv::norm(radial);
-    const cv::Point2d q = mapping.toPlane(d > 0 ? p + radial * (shift / d) : p);
+    const cv::Point2d at = d > 0 ? p + radial * (shift / d) : p;
+    const cv::Point2d q = patch ? patch->at(at).mm : mapping.toPlane(at);
     if (!std::isfinite(q.x) || !std::isfinite(q.y)) return std::nullopt;
     plane.push_back(q);
   }
@@ -112,6 +116,20 @@ bool refusedAsImageCircle(const CircleMeasurement& m) {
 
 namespace {
 
+// The mapping over the box of the annulus's edge points, interpolated (plane_patch.hpp): its
+// place and derivatives at each of a big rim's thousands of edge points, without an undistortion
+// each.
+std::optional<PlanePatch> annulusPatch(const CircleMeasurement& m, const WorldMapping& mapping) {
+  std::vector<cv::Point2f> at;
+  at.reserve(m.annulusEdges.size() + m.inlierPoints.size());
+  for (const EdgePoint& e : m.annulusEdges)
+    at.emplace_back(static_cast<float>(e.position.x), static_cast<float>(e.position.y));
+  for (const cv::Point2d& p : m.inlierPoints)
+    at.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+  if (at.empty()) return std::nullopt;
+  return PlanePatch::over(mapping, cv::boundingRect(at) + cv::Size(2, 2) - cv::Point(1, 1));
+}
+
 // The annulus's edge points judged against a circle in the plane: the rim's (within the RANSAC
 // threshold of it, gradient along its normal with the rim's polarity) and the strong foreign ones
 // (off it by more than a pixel, or across it), as CircleMeasure judges them against its image
@@ -121,23 +139,13 @@ struct JudgedEdges {
   std::vector<cv::Point2d> rim;
   std::vector<EdgePoint> foreign;
 };
-JudgedEdges judgeEdges(const CircleMeasurement& m, const WorldMapping& mapping,
-                       cv::Point2d centreMm, double radiusMm) {
+JudgedEdges judgeEdges(const CircleMeasurement& m, const PlanePatch& patch, cv::Point2d centreMm,
+                       double radiusMm) {
   const CircleMeasureParams defaults;
   const double cosTol = std::cos(defaults.directionToleranceDeg * CV_PI / 180.0);
   JudgedEdges judged;
-  if (m.annulusEdges.empty()) return judged;
-  // The mapping over the edges' box, interpolated (plane_patch.hpp): its place and derivatives at
-  // each of a big rim's thousands of edge points, without an undistortion each.
-  std::vector<cv::Point2f> at;
-  at.reserve(m.annulusEdges.size());
-  for (const EdgePoint& e : m.annulusEdges)
-    at.emplace_back(static_cast<float>(e.position.x), static_cast<float>(e.position.y));
-  const cv::Rect box = cv::boundingRect(at) + cv::Size(2, 2) - cv::Point(1, 1);
-  const auto patch = PlanePatch::over(mapping, box);
-  if (!patch) return judged;
   for (const EdgePoint& e : m.annulusEdges) {
-    const PlanePixel p = patch->at(e.position);
+    const PlanePixel p = patch.at(e.position);
     const RimGeometry g = rimGeometry(p.mm - centreMm, p.alongX, p.alongY, radiusMm);
     const double cosA = m.rimSign * e.normal.dot(g.imageNormal);
     if (std::abs(g.distance) <= defaults.ransacThreshold && cosA >= cosTol)
@@ -153,15 +161,17 @@ JudgedEdges judgeEdges(const CircleMeasurement& m, const WorldMapping& mapping,
 std::optional<PlaneCircle> circleInPlane(const cv::Mat& image, const CircleMeasurement& m,
                                          const WorldMapping& mapping) {
   if (!m.status.ok() && !refusedAsImageCircle(m)) return std::nullopt;
-  auto c = edgePointCircle(m.inlierPoints, edgeBiasK(m), mapping);
+  const auto patch = annulusPatch(m, mapping);
+  if (!patch) return std::nullopt;
+  auto c = edgePointCircle(m.inlierPoints, edgeBiasK(m), mapping, &*patch);
   if (!c) return c;
   // The rim's points again, about the circle in the plane, and its edge points' circle from them
   // when they are more than the image fit's inliers.
-  JudgedEdges edges = judgeEdges(m, mapping, c->centreMm, c->diameterMm / 2);
+  JudgedEdges edges = judgeEdges(m, *patch, c->centreMm, c->diameterMm / 2);
   if (edges.rim.size() > m.inlierPoints.size()) {
-    if (const auto wider = edgePointCircle(edges.rim, edgeBiasK(m), mapping)) {
+    if (const auto wider = edgePointCircle(edges.rim, edgeBiasK(m), mapping, &*patch)) {
       c = wider;
-      edges = judgeEdges(m, mapping, c->centreMm, c->diameterMm / 2);
+      edges = judgeEdges(m, *patch, c->centreMm, c->diameterMm / 2);
     }
   }
   if (const auto fine = fitPlaneCircleProfile(image, mapping, c->centreMm, c->diameterMm / 2,
@@ -181,16 +191,34 @@ std::string refusalInPlane(const PlaneCircle& w, const CircleMeasureParams& p,
     return out.str();
   };
   const double scale = mapping.mmPerPixelAt(p.centre);
-  if (w.coverageDeg < p.minCoverageDeg)
+  // Each test written as "passes only when", so that a NaN anywhere refuses.
+  if (!(w.coverageDeg >= p.minCoverageDeg))
     return "in the plane too, the rim's points cover " + number(w.coverageDeg) +
            " degrees, less than " + number(p.minCoverageDeg);
-  if (w.rmsMm > p.maxRms * scale)
+  if (!(w.rmsMm <= p.maxRms * scale))
     return "in the plane too, the rim's points lie " + number(w.rmsMm / scale) +
            " px RMS off the circle, more than " + number(p.maxRms);
-  if (std::abs(w.diameterMm / 2 - p.radius * scale) > p.width * scale ||
-      cv::norm(w.centreMm - mapping.toPlane(p.centre)) > p.width * scale)
+  if (!(std::abs(w.diameterMm / 2 - p.radius * scale) <= p.width * scale &&
+        cv::norm(w.centreMm - mapping.toPlane(p.centre)) <= p.width * scale))
     return "in the plane too, the fitted circle leaves the search annulus";
   return {};
+}
+
+PlaneCircleVerdict measureCircleInPlane(const cv::Mat& image, const CircleMeasurement& m,
+                                        const CircleMeasureParams& params,
+                                        const WorldMapping& mapping) {
+  PlaneCircleVerdict verdict;
+  verdict.judgedInPlane = !m.status.ok();
+  if (verdict.judgedInPlane && !refusedAsImageCircle(m)) {
+    verdict.judgedInPlane = false;
+    return verdict;
+  }
+  verdict.circle = circleInPlane(image, m, mapping);
+  if (verdict.circle && verdict.judgedInPlane) {
+    verdict.refusal = refusalInPlane(*verdict.circle, params, mapping);
+    if (!verdict.refusal.empty()) verdict.circle.reset();
+  }
+  return verdict;
 }
 
 }  // namespace facet

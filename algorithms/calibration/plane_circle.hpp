@@ -64,4 +64,20 @@ std::optional<PlaneCircle> circleInPlane(const cv::Mat& image, const CircleMeasu
 std::string refusalInPlane(const PlaneCircle& circle, const CircleMeasureParams& params,
                            const WorldMapping& mapping);
 
+// What a station with a measuring plane makes of an image measurement of a circle.
+struct PlaneCircleVerdict {
+  std::optional<PlaneCircle> circle;  // measured in the plane and accepted
+  // The image refused the rim as a circle (refusedAsImageCircle), so the plane judged it: it
+  // accepted it (circle set) or refused it too (`refusal` says why, when the rim mapped at all).
+  bool judgedInPlane = false;
+  std::string refusal;
+};
+
+// The circle of a measurement made with `params`, in the plane: circleInPlane for a measurement
+// that succeeded; for one the image refusedAsImageCircle, circleInPlane judged by refusalInPlane.
+// No circle for other failures, and when the rim does not map into the plane.
+PlaneCircleVerdict measureCircleInPlane(const cv::Mat& image, const CircleMeasurement& measurement,
+                                        const CircleMeasureParams& params,
+                                        const WorldMapping& mapping);
+
 }  // namespace facet

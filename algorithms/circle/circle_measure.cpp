@@ -31,11 +31,13 @@ using circle_fit::fitGeometric;
 using circle_fit::residual;
 using circle_fit::robustWeight;
 
-CircleMeasurement failed(CircleMeasurement m, CircleFailure f, std::string message) {
+// `m` marked failed and moved out (every caller returns it): a measurement carries the annulus's
+// edge points, which a copy would duplicate.
+CircleMeasurement failed(CircleMeasurement& m, CircleFailure f, std::string message) {
   m.status = Status<CircleFailure>::failed(f, std::move(message));
   m.centre = {kNaN, kNaN};
   m.radius = m.diameter = kNaN;
-  return m;
+  return std::move(m);
 }
 
 // A number for a message: "600" or "0.0123", not std::to_string's "600.000000".
@@ -174,15 +176,15 @@ std::vector<Eigen::Vector2d> strayArc(const std::vector<Eigen::Vector2d>& in, co
 // Strong edge points that are not the rim: off the circle or not radial with the rim's polarity
 // (rimSign +1: gradient outwards). Weak ones (below the high threshold) are mostly noise and must
 // not punch holes into the grey-value fit.
-std::vector<EdgePoint> foreignEdges(const AnnulusEdges& edges, const Circle& circle, int rimSign,
-                                    double cosTol) {
+std::vector<EdgePoint> foreignEdges(const std::vector<EdgePoint>& edges, double highThreshold,
+                                    const Circle& circle, int rimSign, double cosTol) {
   std::vector<EdgePoint> foreign;
-  for (const EdgePoint& e : edges.points) {
+  for (const EdgePoint& e : edges) {
     const Eigen::Vector2d radial = Eigen::Vector2d{e.position.x, e.position.y} - circle.centre;
     const double d = radial.norm();
     if (d == 0.0) continue;
     const double cosA = rimSign * (e.normal.x * radial.x() + e.normal.y * radial.y()) / d;
-    if (e.magnitude >= edges.highThreshold && (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
+    if (e.magnitude >= highThreshold && (std::abs(d - circle.radius) > 1.0 || cosA < cosTol))
       foreign.push_back(e);
   }
   return foreign;
@@ -225,8 +227,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   const cv::Point2d c0 = params.centre;
 
   // Canny thresholds from the annulus alone, then Facet subpixel points (annulus_edges.hpp).
-  const AnnulusEdges edges =
-      detectAnnulusEdges(image, c0, rIn, rOut, params.cannyLow, params.cannyHigh);
+  AnnulusEdges edges = detectAnnulusEdges(image, c0, rIn, rOut, params.cannyLow, params.cannyHigh);
   if (edges.annulusPixels == 0)
     return failed(m, CircleFailure::AnnulusOutsideImage,
                   "the search annulus around (" + readable(c0.x) + ", " + readable(c0.y) +
@@ -335,7 +336,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     return failed(m, CircleFailure::FitTooPoor, "the geometric circle fit did not converge");
   const Circle circle = *fitted;
   m.inliers = static_cast<int>(in.size());
-  m.annulusEdges = edges.points;
+  m.annulusEdges = std::move(edges.points);
   m.rimSign = rimSign;
   m.noiseSigma = edges.noiseSigma;
   m.inlierPoints.reserve(in.size());
@@ -367,8 +368,9 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
                   "the fit's rms " + readable(m.rms) + " px exceeds " + readable(params.maxRms));
 
   if (params.refineWithGreyValues) {
-    auto fine = fitCircleProfile(image, m.centre, circle.radius, m.inlierPoints,
-                                 foreignEdges(edges, circle, rimSign, cosTol), edges.noiseSigma);
+    auto fine = fitCircleProfile(
+        image, m.centre, circle.radius, m.inlierPoints,
+        foreignEdges(m.annulusEdges, m.highThreshold, circle, rimSign, cosTol), edges.noiseSigma);
     // The grey fit only uses the sectors the inliers cover, and clutter that pulls the edge
     // points' circle can push a clean arc of the rim out of the inliers (or out as a stray arc):
     // at r = 10 px a lost third of the rim cost 0.1 px. The grey fit is several times more
@@ -381,9 +383,10 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
         if (std::abs(residual(refined, p)) <= params.ransacThreshold)
           rim.emplace_back(p.x(), p.y());
       if (rim.size() > m.inlierPoints.size())
-        if (auto again =
-                fitCircleProfile(image, fine->centre, fine->radius, rim,
-                                 foreignEdges(edges, refined, rimSign, cosTol), edges.noiseSigma))
+        if (auto again = fitCircleProfile(
+                image, fine->centre, fine->radius, rim,
+                foreignEdges(m.annulusEdges, m.highThreshold, refined, rimSign, cosTol),
+                edges.noiseSigma))
           fine = again;
     }
     if (fine) {

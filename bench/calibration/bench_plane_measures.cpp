@@ -175,11 +175,10 @@ void measureScene(double tilt, double lensBlur, std::uint64_t seed, TiltRow& row
     const CircleMeasurement m = measureCircle(image, p);
     const double t1 = cpuMs();
     // As the circle step: a rim the image refuses as a circle is judged in the plane.
-    auto w = circleInPlane(image, m, plane);
+    const auto w = measureCircleInPlane(image, m, p, plane).circle;
     const double t2 = cpuMs();
     imageCircleMs.push_back(t1 - t0);
     planeCircleMs.push_back(t2 - t1);
-    if (w && !m.status.ok() && !refusalInPlane(*w, p, plane).empty()) w.reset();
     const auto edges = circleInPlane(m, plane);  // the baseline: the edge points in the plane
     if (w && !edges) {
       // Refused by the image as a circle (the baseline has nothing), measured in the plane.

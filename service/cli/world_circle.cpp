@@ -9,18 +9,15 @@ nlohmann::json worldCircle(const MeasuringPlane& plane, const cv::Mat& image,
                            const CircleMeasurement& m, const CircleMeasureParams& params,
                            std::string& refusal) {
   if (const WorldMapping* mapping = plane.mapping()) {
-    const bool judged = !m.status.ok();
-    if (judged && !refusedAsImageCircle(m)) return nullptr;
-    const auto c = circleInPlane(image, m, *mapping);
-    if (!c) {
-      if (judged) return nullptr;
+    const PlaneCircleVerdict verdict = measureCircleInPlane(image, m, params, *mapping);
+    refusal = verdict.refusal;
+    if (!verdict.circle) {
+      if (!m.status.ok()) return nullptr;
       throw MeasurementFailure("off_plane",
                                "the circle's rim does not map into the measuring plane");
     }
-    if (judged) {
-      refusal = refusalInPlane(*c, params, *mapping);
-      if (!refusal.empty()) return nullptr;
-    }
+    const PlaneCircle* c = &*verdict.circle;
+    const bool judged = verdict.judgedInPlane;
     return {{"x_mm", c->centreMm.x},          {"y_mm", c->centreMm.y},
             {"diameter_mm", c->diameterMm},   {"rms_mm", c->rmsMm},
             {"roundness_mm", c->roundnessMm}, {"coverage_deg", c->coverageDeg},

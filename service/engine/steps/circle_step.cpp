@@ -69,18 +69,12 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   part.overlay.circle(expected, std::max(1.0, p.radius - p.width), true, true);
   part.overlay.circle(expected, p.radius + p.width, true, true);
   std::string note;
-  std::optional<PlaneCircle> w;  // the circle in the plane
-  std::string inPlane;           // why the plane refused it too
-  if (plane && refusedAsImageCircle(m)) {
-    // A hole seen at an angle is an ellipse in the image, which the image's circle tests may
-    // refuse (at 30 degrees of tilt, 2-3 holes in 8 in bench_plane_measures); judged in the
-    // plane by the same tests, it is measured there.
-    if (auto judged = circleInPlane(part.grey, m, *plane)) {
-      inPlane = refusalInPlane(*judged, p, *plane);
-      if (inPlane.empty()) w = judged;
-    }
-  }
-  if (!w && !m.status.ok() && m.status.cause != CircleFailure::BadInput &&
+  // A hole seen at an angle is an ellipse in the image, which the image's circle tests may refuse
+  // (at 30 degrees of tilt, 2-3 holes in 8 in bench_plane_measures); the plane judges it by the
+  // same tests and measures it there.
+  PlaneCircleVerdict inPlane;
+  if (plane) inPlane = measureCircleInPlane(part.grey, m, p, *plane);
+  if (!inPlane.circle && !m.status.ok() && m.status.cause != CircleFailure::BadInput &&
       m.status.cause != CircleFailure::AnnulusOutsideImage) {
     // Nothing round in the annulus: a hole drilled off its place is still a hole, and the line
     // must learn how far off it is, not only that the step failed. Look for the disc within one
@@ -92,20 +86,22 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
                                                   .minScore = 0.6})) {
       CircleMeasureParams there = p;
       there.centre = found->centre;
-      if (const CircleMeasurement moved = measureCircle(part.grey, there); moved.status.ok()) {
-        m = moved;
+      if (CircleMeasurement moved = measureCircle(part.grey, there); moved.status.ok()) {
+        m = std::move(moved);
         note = "found off its nominal place";
+        if (plane) inPlane = measureCircleInPlane(part.grey, m, there, *plane);
       }
     }
   }
-  if (!w && !m.status.ok())
+  if (!inPlane.circle && !m.status.ok())
     return StepResult::failed("circle not measured: " + std::string(toString(m.status.cause)) +
-                              (inPlane.empty() ? "" : " (" + inPlane + ")"));
+                              (inPlane.refusal.empty() ? "" : " (" + inPlane.refusal + ")"));
   StepResult r;
   r.note = note;
   if (plane) {
-    if (!w) w = circleInPlane(part.grey, m, *plane);
-    if (!w) return StepResult::failed("circle not measured: its rim does not map into the plane");
+    if (!inPlane.circle)
+      return StepResult::failed("circle not measured: its rim does not map into the plane");
+    const PlaneCircle* w = &*inPlane.circle;
     // Offsets along the plane's axes (the calibration plate's x and y), mm.
     const cv::Point2d nominal = plane->toPlane(expected);
     r.lengthsInMm = true;
