@@ -4,6 +4,7 @@
 #include "algorithms/calibration/plane_circle_profile.hpp"
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -163,6 +164,13 @@ TEST(PlaneCircleProfile, AHoleTheImageRefusesAsACircleIsMeasuredInThePlane) {
     EXPECT_TRUE(g->greyRefined);
     EXPECT_LT(cv::norm(g->centreMm - c), 0.002);
     EXPECT_NEAR(g->diameterMm, 2 * r, 0.002);
+    // What the circle step and the command ask: the same circle, judged in the plane.
+    const PlaneCircleVerdict v = measureCircleInPlane(t.image, m, t.params(c, r), t.mapping);
+    EXPECT_TRUE(v.judgedInPlane);
+    EXPECT_EQ(v.refusal, "");
+    ASSERT_TRUE(v.circle.has_value());
+    EXPECT_EQ(v.circle->centreMm, g->centreMm);
+    EXPECT_EQ(v.circle->diameterMm, g->diameterMm);
   }
 }
 
@@ -181,6 +189,52 @@ TEST(PlaneCircleProfile, AHiddenRimIsRefusedInThePlaneToo) {
   const std::string why = refusalInPlane(*g, t.params(c, 5.0), t.mapping);
   EXPECT_NE(why.find("in the plane too"), std::string::npos) << why;
   EXPECT_LT(g->coverageDeg, 120);
+  const PlaneCircleVerdict v = measureCircleInPlane(t.image, m, t.params(c, 5.0), t.mapping);
+  EXPECT_TRUE(v.judgedInPlane);
+  EXPECT_FALSE(v.circle.has_value());
+  EXPECT_EQ(v.refusal, why);
+}
+
+// A measurement the image accepted is measured in the plane without a judgement there; one that
+// failed for another cause than its circle's shape (here: its annulus lies off the image) gives
+// nothing to measure and no refusal of the plane's.
+TEST(PlaneCircleProfile, OnlyARimRefusedAsACircleIsJudgedInThePlane) {
+  const TiltedHoles t(30, 0.7, 1, {{kBig, 5.0}});
+  const CircleMeasureParams p = t.params(kBig, 5.0);
+  const CircleMeasurement m = measureCircle(t.image, p);
+  ASSERT_TRUE(m.status.ok()) << m.status.message;
+  const PlaneCircleVerdict v = measureCircleInPlane(t.image, m, p, t.mapping);
+  EXPECT_FALSE(v.judgedInPlane);
+  ASSERT_TRUE(v.circle.has_value());
+  EXPECT_LT(cv::norm(v.circle->centreMm - kBig), 0.002);
+
+  CircleMeasureParams off = p;
+  off.centre = {-500, -500};
+  const CircleMeasurement outside = measureCircle(t.image, off);
+  ASSERT_EQ(outside.status.cause, CircleFailure::AnnulusOutsideImage);
+  const PlaneCircleVerdict none = measureCircleInPlane(t.image, outside, off, t.mapping);
+  EXPECT_FALSE(none.circle.has_value());
+  EXPECT_FALSE(none.judgedInPlane);
+  EXPECT_EQ(none.refusal, "");
+}
+
+// The plane's tests pass only on figures that pass: a coverage, RMS, diameter or centre that is
+// not a number refuses the circle.
+TEST(PlaneCircleProfile, ACircleWithAFigureThatIsNotANumberIsRefusedInThePlane) {
+  const TiltedHoles t(30, 0.7, 1, {{kBig, 5.0}});
+  const CircleMeasureParams p = t.params(kBig, 5.0);
+  const auto good = circleInPlane(t.image, measureCircle(t.image, p), t.mapping);
+  ASSERT_TRUE(good.has_value());
+  ASSERT_EQ(refusalInPlane(*good, p, t.mapping), "");
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int field = 0; field < 4; ++field) {
+    PlaneCircle c = *good;
+    if (field == 0) c.coverageDeg = nan;
+    if (field == 1) c.rmsMm = nan;
+    if (field == 2) c.diameterMm = nan;
+    if (field == 3) c.centreMm.x = nan;
+    EXPECT_NE(refusalInPlane(c, p, t.mapping), "") << "field " << field;
+  }
 }
 
 TEST(PlaneCircleProfile, RefusesWhatItCannotFit) {
