@@ -43,13 +43,45 @@ int binOf(cv::Point2d offset, int bins) {
   return std::min(bins - 1, static_cast<int>(a / (2 * kPi) * bins));
 }
 
-// A band pixel as the fit uses it.
-struct RimPixel {
-  cv::Point2d mm;              // its place in the plane, relative to the start centre
-  cv::Point2d alongX, alongY;  // the plane's derivatives there, mm per pixel
-  double x, y;                 // the pixel, relative to the start centre's image
-  double grey;
-  int bin;
+using Columns = Eigen::Matrix<double, Eigen::Dynamic, 8>;
+
+// The band's pixels as the fit uses them, one column per quantity, so that the model's pass over
+// them vectorises (as fitCircleProfile's does).
+struct RimBand {
+  Eigen::VectorXd mmX, mmY;          // place in the plane, relative to the start centre
+  Eigen::VectorXd xAlongX, yAlongX;  // the plane's derivative along the image's x, mm per pixel
+  Eigen::VectorXd xAlongY, yAlongY;  // ... and along its y
+  Eigen::VectorXd x, y;              // the pixel, relative to the start centre's image
+  Eigen::VectorXd grey;
+  std::vector<int> bin;
+
+  [[nodiscard]] Eigen::Index size() const { return grey.size(); }
+  void resize(Eigen::Index n) {
+    for (Eigen::VectorXd* c : {&mmX, &mmY, &xAlongX, &yAlongX, &xAlongY, &yAlongY, &x, &y, &grey})
+      c->resize(n);
+    bin.resize(static_cast<std::size_t>(n));
+  }
+  void set(Eigen::Index i, const PlanePixel& p, cv::Point2d mm, cv::Point2d px, double g, int b) {
+    mmX(i) = mm.x, mmY(i) = mm.y;
+    xAlongX(i) = p.alongX.x, yAlongX(i) = p.alongX.y;
+    xAlongY(i) = p.alongY.x, yAlongY(i) = p.alongY.y;
+    x(i) = px.x, y(i) = px.y, grey(i) = g;
+    bin[static_cast<std::size_t>(i)] = b;
+  }
+  [[nodiscard]] RimGeometry geometryAt(Eigen::Index i, cv::Point2d centre, double radius) const;
+  // Keeps the pixels whose bin `drop` does not mark, in order.
+  void keep(const std::vector<std::uint8_t>& drop) {
+    Eigen::Index k = 0;
+    for (Eigen::Index i = 0; i < size(); ++i) {
+      if (drop[static_cast<std::size_t>(bin[static_cast<std::size_t>(i)])]) continue;
+      for (Eigen::VectorXd* c : {&mmX, &mmY, &xAlongX, &yAlongX, &xAlongY, &yAlongY, &x, &y, &grey})
+        (*c)(k) = (*c)(i);
+      bin[static_cast<std::size_t>(k++)] = bin[static_cast<std::size_t>(i)];
+    }
+    for (Eigen::VectorXd* c : {&mmX, &mmY, &xAlongX, &yAlongX, &xAlongY, &yAlongY, &x, &y, &grey})
+      c->conservativeResize(k);
+    bin.resize(static_cast<std::size_t>(k));
+  }
 };
 
 // rimGeometry, inlined into the loops over the band's pixels.
@@ -61,6 +93,67 @@ inline RimGeometry rimGeometryAt(cv::Point2d offset, cv::Point2d alongX, cv::Poi
   const cv::Point2d g(alongX.dot(u), alongY.dot(u));
   const double k = std::max(std::sqrt(g.x * g.x + g.y * g.y), 1e-12);
   return {(rho - radiusMm) / k, k, u, g / k};
+}
+
+RimGeometry RimBand::geometryAt(Eigen::Index i, cv::Point2d centre, double radius) const {
+  return rimGeometryAt(cv::Point2d(mmX(i), mmY(i)) - centre, {xAlongX(i), yAlongX(i)},
+                       {xAlongY(i), yAlongY(i)}, radius);
+}
+
+// The model's pass over the band with the Gaussian profile: residuals (grey - model) and the
+// Jacobian's columns that change (centre, radius, blur, contrast); rimGeometryAt written out per
+// column. A function of its own so that the arrays can be declared distinct (__restrict) and the
+// loop vectorises: as a loop over the pixels' structures it was a fifth of a calibrated circle's
+// time.
+void evaluateGaussianBand(const Vector8& v, double unit, std::ptrdiff_t n,
+                          const double* __restrict mmX, const double* __restrict mmY,
+                          const double* __restrict xAlongX, const double* __restrict yAlongX,
+                          const double* __restrict xAlongY, const double* __restrict yAlongY,
+                          const double* __restrict x, const double* __restrict y,
+                          const double* __restrict grey, double* __restrict out,
+                          double* __restrict jcx, double* __restrict jcy, double* __restrict jr,
+                          double* __restrict js, double* __restrict jb) {
+  const double cx = unit * v(kCx), cy = unit * v(kCy), radius = unit * v(kRadius), s = v(kBlur),
+               level = v(kLevel), rampX = v(kRampX), rampY = v(kRampY), b = v(kContrast);
+  const double inv = 1.0 / s, bNorm = b / (std::sqrt(2.0 * kPi) * s);
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const double ox = mmX[i] - cx, oy = mmY[i] - cy;
+    const double rho = std::max(std::sqrt(ox * ox + oy * oy), 1e-12);
+    const double ux = ox / rho, uy = oy / rho;
+    const double gx = xAlongX[i] * ux + yAlongX[i] * uy, gy = xAlongY[i] * ux + yAlongY[i] * uy;
+    const double k = std::max(std::sqrt(gx * gx + gy * gy), 1e-12);
+    const double z = (rho - radius) / k * inv, gauss = step_profile::gaussian(z);
+    const double phi = step_profile::upperTail(z, gauss);  // Phi(-d / s)
+    const double bg = bNorm * gauss;                       // -dI/dd
+    out[i] = grey[i] - (level + rampX * x[i] + rampY * y[i] + b * phi);
+    // dd/dC = -u unit / k (the change of the rim's scale with C is second order near it).
+    const double perUnit = bg * unit / k;
+    jcx[i] = perUnit * ux;
+    jcy[i] = perUnit * uy;
+    jr[i] = perUnit;
+    js[i] = bg * z;
+    jb[i] = phi;
+  }
+}
+
+// The same pass with each pixel's area in the model (the sharp images'; step_profile::pixelStep).
+void evaluatePixelBand(const Vector8& v, double unit, const RimBand& band, double* out,
+                       Columns& j) {
+  const cv::Point2d c = unit * cv::Point2d(v(kCx), v(kCy));
+  const double radius = unit * v(kRadius), s = v(kBlur), b = v(kContrast);
+  for (Eigen::Index i = 0; i < band.size(); ++i) {
+    const RimGeometry g = band.geometryAt(i, c, radius);
+    const step_profile::PixelStep p =
+        step_profile::pixelStep(g.distance, s, g.imageNormal.x, g.imageNormal.y);
+    out[i] =
+        band.grey(i) - (v(kLevel) + v(kRampX) * band.x(i) + v(kRampY) * band.y(i) + b * p.value);
+    const double perUnit = -b * p.dd * unit / g.scale;  // dI/dd dd/dC, dd/dC = -u unit / k
+    j(i, kCx) = perUnit * g.planeNormal.x;
+    j(i, kCy) = perUnit * g.planeNormal.y;
+    j(i, kRadius) = perUnit;
+    j(i, kBlur) = b * p.ds;
+    j(i, kContrast) = p.value;
+  }
 }
 
 }  // namespace
@@ -175,61 +268,44 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
     rim_band::dropForeignGradients(samples, image, radiusPx, noiseSigma, box);
     if (samples.size() < 30) return std::nullopt;
   }
-  std::vector<RimPixel> band;
-  band.reserve(samples.size());
-  for (const rim_band::Sample& s : samples) {
-    const PlanePixel p = patch->at(cv::Point2d(s.column, s.row));
-    band.push_back({p.mm - centreMm, p.alongX, p.alongY, s.column - centrePx.x, s.row - centrePx.y,
-                    s.grey, s.bin});
+  RimBand band;
+  band.resize(static_cast<Eigen::Index>(samples.size()));
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    const rim_band::Sample& e = samples[i];
+    const PlanePixel p = patch->at(cv::Point2d(e.column, e.row));
+    band.set(static_cast<Eigen::Index>(i), p, p.mm - centreMm,
+             {e.column - centrePx.x, e.row - centrePx.y}, e.grey, e.bin);
   }
 
   Vector8 q;
   q << 0.0, 0.0, radiusPx, 1.2, rim_band::medianOf(outside), 0.0, 0.0, contrast;
   const double tukeyC = noiseSigma > 0.0 ? 8.0 : 4.685;  // fitCircleProfile's reasons
 
-  // Residuals (grey - model) and the model's Jacobian at parameters v.
-  auto n = static_cast<Eigen::Index>(band.size());
-  Eigen::VectorXd r(n), rTry(n), weight = Eigen::VectorXd::Ones(n);
-  Eigen::Matrix<double, Eigen::Dynamic, 8> jac(n, 8), jacTry(n, 8);
-  bool pixelModel = false;  // fitCircleProfile's model of sharp images (below)
-  auto evaluate = [&](const Vector8& v, Eigen::VectorXd& res,
-                      Eigen::Matrix<double, Eigen::Dynamic, 8>& j) {
-    const cv::Point2d c = unit * cv::Point2d(v(kCx), v(kCy));
-    const double radius = unit * v(kRadius), s = v(kBlur), b = v(kContrast);
-    const double bNorm = b / (std::sqrt(2.0 * kPi) * s);
-    for (Eigen::Index i = 0; i < n; ++i) {
-      const RimPixel& e = band[static_cast<std::size_t>(i)];
-      const RimGeometry g = rimGeometryAt(e.mm - c, e.alongX, e.alongY, radius);
-      if (pixelModel) {  // the sharp images' model: s the lens blur, the pixel's box averaged
-        const step_profile::PixelStep p =
-            step_profile::pixelStep(g.distance, s, g.imageNormal.x, g.imageNormal.y);
-        res(i) = e.grey - (v(kLevel) + v(kRampX) * e.x + v(kRampY) * e.y + b * p.value);
-        const double perUnit = -b * p.dd * unit / g.scale;  // dI/dd dd/dC, dd/dC = -u unit / k
-        j(i, kCx) = perUnit * g.planeNormal.x;
-        j(i, kCy) = perUnit * g.planeNormal.y;
-        j(i, kRadius) = perUnit;
-        j(i, kBlur) = b * p.ds;
-        j(i, kLevel) = 1.0;
-        j(i, kRampX) = e.x;
-        j(i, kRampY) = e.y;
-        j(i, kContrast) = p.value;
-        continue;
-      }
-      const double z = g.distance / s, gauss = step_profile::gaussian(z);
-      const double phi = step_profile::upperTail(z, gauss);  // Phi(-d / s)
-      const double bg = bNorm * gauss;                       // -dI/dd
-      res(i) = e.grey - (v(kLevel) + v(kRampX) * e.x + v(kRampY) * e.y + b * phi);
-      // dd/dC = -u unit / k (the change of the rim's scale with C is second order near it).
-      const double perUnit = bg * unit / g.scale;
-      j(i, kCx) = perUnit * g.planeNormal.x;
-      j(i, kCy) = perUnit * g.planeNormal.y;
-      j(i, kRadius) = perUnit;
-      j(i, kBlur) = bg * z;
-      j(i, kLevel) = 1.0;
-      j(i, kRampX) = e.x;
-      j(i, kRampY) = e.y;
-      j(i, kContrast) = phi;
+  // Residuals (grey - model) and the model's Jacobian at parameters v. The Jacobian's columns of
+  // the level and the ramp (1, x, y) never change: set once per band.
+  Eigen::Index n = 0;
+  Eigen::VectorXd r, rTry, weight;
+  Columns jac, jacTry;
+  auto loadBand = [&] {
+    n = band.size();
+    r.resize(n), rTry.resize(n);
+    weight.setOnes(n);
+    for (Columns* j : {&jac, &jacTry}) {
+      j->resize(n, 8);
+      j->col(kLevel).setOnes();
+      j->col(kRampX) = band.x;
+      j->col(kRampY) = band.y;
     }
+  };
+  loadBand();
+  bool pixelModel = false;  // fitCircleProfile's model of sharp images (below)
+  auto evaluate = [&](const Vector8& v, Eigen::VectorXd& res, Columns& j) {
+    if (pixelModel) return evaluatePixelBand(v, unit, band, res.data(), j);
+    evaluateGaussianBand(v, unit, n, band.mmX.data(), band.mmY.data(), band.xAlongX.data(),
+                         band.yAlongX.data(), band.xAlongY.data(), band.yAlongY.data(),
+                         band.x.data(), band.y.data(), band.grey.data(), res.data(),
+                         j.col(kCx).data(), j.col(kCy).data(), j.col(kRadius).data(),
+                         j.col(kBlur).data(), j.col(kContrast).data());
   };
   auto cost = [&](const Eigen::VectorXd& res) {
     return (weight.array() * res.array().square()).sum();
@@ -340,16 +416,12 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   // Sectors whose residuals stay too large for the noise leave, and the fit is repeated.
   const std::vector<std::uint8_t> bad =
       rim_band::contaminatedBins(samples, {r.data(), static_cast<std::size_t>(n)}, bins);
-  std::size_t kept = 0;
-  for (const RimPixel& e : band) kept += bad[static_cast<std::size_t>(e.bin)] == 0;
-  if (static_cast<double>(band.size() - kept) >=
-      kMinRefitShare * static_cast<double>(band.size())) {
+  Eigen::Index kept = 0;
+  for (const int b : band.bin) kept += bad[static_cast<std::size_t>(b)] == 0;
+  if (static_cast<double>(n - kept) >= kMinRefitShare * static_cast<double>(n)) {
     if (kept < 30) return std::nullopt;
-    std::erase_if(band,
-                  [&](const RimPixel& e) { return bad[static_cast<std::size_t>(e.bin)] != 0; });
-    n = static_cast<Eigen::Index>(band.size());
-    r.resize(n), rTry.resize(n), jac.resize(n, 8), jacTry.resize(n, 8);
-    weight.setOnes(n);
+    band.keep(bad);
+    loadBand();
     if (!solve({true, true, true, true, true, withRamp, withRamp, true})) return std::nullopt;
   }
 
@@ -372,15 +444,14 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   // rim's radius of curvature in the image: about R / k with k the plane's scale across the rim.
   const cv::Point2d c = unit * cv::Point2d(q(kCx), q(kCy));
   double scaleSum = 0.0;
-  for (const RimPixel& e : band)
-    scaleSum += rimGeometry(e.mm - c, e.alongX, e.alongY, unit * q(kRadius)).scale;
-  const double k = scaleSum / static_cast<double>(band.size());
+  for (Eigen::Index i = 0; i < n; ++i) scaleSum += band.geometryAt(i, c, unit * q(kRadius)).scale;
+  const double k = scaleSum / static_cast<double>(n);
   PlaneCircleProfileFit fit;
   fit.centreMm = centreMm + c;
   fit.radiusMm = unit * q(kRadius) + k * k * blur * blur / (2.0 * unit * q(kRadius));
   fit.blur = blur;
   fit.noise = sigma;
-  fit.pixels = static_cast<int>(band.size());
+  fit.pixels = static_cast<int>(n);
   return fit;
 }
 
