@@ -163,13 +163,18 @@ std::optional<PlaneCircle> circleInPlane(const cv::Mat& image, const CircleMeasu
   if (!m.status.ok() && !refusedAsImageCircle(m)) return std::nullopt;
   const auto patch = annulusPatch(m, mapping);
   if (!patch) return std::nullopt;
-  auto c = edgePointCircle(m.inlierPoints, edgeBiasK(m), mapping, &*patch);
+  // The edge points are moved out by the bias of a typical blur (circle_measure.hpp's default),
+  // not by the blur of the image's own grey fit: they only start the grey fit in the plane, and
+  // the circle step does without the image's (below), so that the step and `facet circle
+  // --calibration`, which keeps it for its pixel values, measure the same circle.
+  const double k = CircleMeasureParams{}.radiusBiasK;
+  auto c = edgePointCircle(m.inlierPoints, k, mapping, &*patch);
   if (!c) return c;
   // The rim's points again, about the circle in the plane, and its edge points' circle from them
   // when they are more than the image fit's inliers.
   JudgedEdges edges = judgeEdges(m, *patch, c->centreMm, c->diameterMm / 2);
   if (edges.rim.size() > m.inlierPoints.size()) {
-    if (const auto wider = edgePointCircle(edges.rim, edgeBiasK(m), mapping, &*patch)) {
+    if (const auto wider = edgePointCircle(edges.rim, k, mapping, &*patch)) {
       c = wider;
       edges = judgeEdges(m, *patch, c->centreMm, c->diameterMm / 2);
     }

@@ -52,8 +52,9 @@ bool refusedAsImageCircle(const CircleMeasurement& measurement);
 // in the plane (plane_circle_profile.hpp): the precision of the image's grey-value fit with the
 // plane's geometry. Roundness, RMS and coverage are the re-collected edge points'. When the grey
 // fit does not converge the edge points' circle is returned (greyRefined false). Takes a
-// measurement that succeeded or was refusedAsImageCircle; nullopt for others, and when the
-// points leave the plane.
+// measurement that succeeded or was refusedAsImageCircle, with or without the image's own
+// grey-value fit (its result is not used here); nullopt for others, and when the points leave
+// the plane.
 std::optional<PlaneCircle> circleInPlane(const cv::Mat& image, const CircleMeasurement& measurement,
                                          const WorldMapping& mapping);
 

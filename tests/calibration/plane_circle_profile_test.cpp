@@ -218,6 +218,29 @@ TEST(PlaneCircleProfile, OnlyARimRefusedAsACircleIsJudgedInThePlane) {
   EXPECT_EQ(none.refusal, "");
 }
 
+// The circle step on a calibrated station measures the image's edge points without the image's
+// grey fit (nothing uses it there); `facet circle --calibration` keeps it for its pixel values.
+// Both give the same circle in the plane.
+TEST(PlaneCircleProfile, TheImagesOwnGreyFitDoesNotChangeTheCircleInThePlane) {
+  const TiltedHoles t(10, 0.7, 2, {{kBig, 5.0}, {kSmall, 2.5}});
+  for (const auto& [c, r] : {std::pair{kBig, 5.0}, std::pair{kSmall, 2.5}}) {
+    CircleMeasureParams p = t.params(c, r);
+    const CircleMeasurement withGrey = measureCircle(t.image, p);
+    p.refineWithGreyValues = false;
+    const CircleMeasurement edgesOnly = measureCircle(t.image, p);
+    ASSERT_TRUE(withGrey.status.ok()) << withGrey.status.message;
+    ASSERT_TRUE(withGrey.greyRefined);
+    ASSERT_FALSE(edgesOnly.greyRefined);
+    const auto a = circleInPlane(t.image, withGrey, t.mapping);
+    const auto b = circleInPlane(t.image, edgesOnly, t.mapping);
+    ASSERT_TRUE(a.has_value() && b.has_value());
+    EXPECT_TRUE(b->greyRefined);
+    EXPECT_EQ(a->centreMm, b->centreMm);
+    EXPECT_EQ(a->diameterMm, b->diameterMm);
+    EXPECT_LT(cv::norm(b->centreMm - c), 0.002);
+  }
+}
+
 // The plane's tests pass only on figures that pass: a coverage, RMS, diameter or centre that is
 // not a number refuses the circle.
 TEST(PlaneCircleProfile, ACircleWithAFigureThatIsNotANumberIsRefusedInThePlane) {
