@@ -56,9 +56,11 @@ struct RimBand {
   std::vector<int> bin;
 
   [[nodiscard]] Eigen::Index size() const { return grey.size(); }
+  [[nodiscard]] std::array<Eigen::VectorXd*, 9> columns() {
+    return {&mmX, &mmY, &xAlongX, &yAlongX, &xAlongY, &yAlongY, &x, &y, &grey};
+  }
   void resize(Eigen::Index n) {
-    for (Eigen::VectorXd* c : {&mmX, &mmY, &xAlongX, &yAlongX, &xAlongY, &yAlongY, &x, &y, &grey})
-      c->resize(n);
+    for (Eigen::VectorXd* c : columns()) c->resize(n);
     bin.resize(static_cast<std::size_t>(n));
   }
   void set(Eigen::Index i, const PlanePixel& p, cv::Point2d mm, cv::Point2d px, double g, int b) {
@@ -74,12 +76,10 @@ struct RimBand {
     Eigen::Index k = 0;
     for (Eigen::Index i = 0; i < size(); ++i) {
       if (drop[static_cast<std::size_t>(bin[static_cast<std::size_t>(i)])]) continue;
-      for (Eigen::VectorXd* c : {&mmX, &mmY, &xAlongX, &yAlongX, &xAlongY, &yAlongY, &x, &y, &grey})
-        (*c)(k) = (*c)(i);
+      for (Eigen::VectorXd* c : columns()) (*c)(k) = (*c)(i);
       bin[static_cast<std::size_t>(k++)] = bin[static_cast<std::size_t>(i)];
     }
-    for (Eigen::VectorXd* c : {&mmX, &mmY, &xAlongX, &yAlongX, &xAlongY, &yAlongY, &x, &y, &grey})
-      c->conservativeResize(k);
+    for (Eigen::VectorXd* c : columns()) c->conservativeResize(k);
     bin.resize(static_cast<std::size_t>(k));
   }
 };
