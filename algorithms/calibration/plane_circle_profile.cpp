@@ -105,14 +105,13 @@ RimGeometry RimBand::geometryAt(Eigen::Index i, cv::Point2d centre, double radiu
 // column. A function of its own so that the arrays can be declared distinct (__restrict) and the
 // loop vectorises: as a loop over the pixels' structures it was a fifth of a calibrated circle's
 // time.
-void evaluateGaussianBand(const Vector8& v, double unit, std::ptrdiff_t n,
-                          const double* __restrict mmX, const double* __restrict mmY,
-                          const double* __restrict xAlongX, const double* __restrict yAlongX,
-                          const double* __restrict xAlongY, const double* __restrict yAlongY,
-                          const double* __restrict x, const double* __restrict y,
-                          const double* __restrict grey, double* __restrict out,
-                          double* __restrict jcx, double* __restrict jcy, double* __restrict jr,
-                          double* __restrict js, double* __restrict jb) {
+FACET_PIXEL_PASS void evaluateGaussianBand(
+    const Vector8& v, double unit, std::ptrdiff_t n, const double* __restrict mmX,
+    const double* __restrict mmY, const double* __restrict xAlongX,
+    const double* __restrict yAlongX, const double* __restrict xAlongY,
+    const double* __restrict yAlongY, const double* __restrict x, const double* __restrict y,
+    const double* __restrict grey, double* __restrict out, double* __restrict jcx,
+    double* __restrict jcy, double* __restrict jr, double* __restrict js, double* __restrict jb) {
   const double cx = unit * v(kCx), cy = unit * v(kCy), radius = unit * v(kRadius), s = v(kBlur),
                level = v(kLevel), rampX = v(kRampX), rampY = v(kRampY), b = v(kContrast);
   const double inv = 1.0 / s, bNorm = b / (std::sqrt(2.0 * kPi) * s);

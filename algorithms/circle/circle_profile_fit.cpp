@@ -106,10 +106,12 @@ void narrowStretches(const Stretch& s, double centreX, double dy, double lo2, do
 // function of its own so that the arrays can be declared distinct (__restrict): otherwise the
 // compiler would check more pairs of them for overlap than it is willing to, and the loops would
 // not vectorise.
-void evaluateProfile(const Vector8& q, std::ptrdiff_t n, const double* __restrict x,
-                     const double* __restrict y, const double* __restrict grey,
-                     double* __restrict out, double* __restrict cx, double* __restrict cy,
-                     double* __restrict cr, double* __restrict cs, double* __restrict cb) {
+FACET_PIXEL_PASS void evaluateProfile(const Vector8& q, std::ptrdiff_t n,
+                                      const double* __restrict x, const double* __restrict y,
+                                      const double* __restrict grey, double* __restrict out,
+                                      double* __restrict cx, double* __restrict cy,
+                                      double* __restrict cr, double* __restrict cs,
+                                      double* __restrict cb) {
   const double cx0 = q(0), cy0 = q(1), radius = q(2), s = q(3), level = q(4), rampX = q(5),
                rampY = q(6), b = q(7);
   const double inv = 1.0 / s, bNorm = b * (1.0 / (std::sqrt(2.0 * kPi) * s));

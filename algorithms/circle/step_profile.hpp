@@ -9,6 +9,16 @@
 #include <cstdint>
 #include <numbers>
 
+// For the fits' passes over a rim's pixels (elementwise arithmetic, no reductions): a second
+// build of the function with AVX2, 4 pixels per instruction instead of SSE's 2, chosen when the
+// program loads on a processor that has it. Without FMA the operations are the same, and so
+// are the values.
+#if defined(__x86_64__)
+#define FACET_PIXEL_PASS __attribute__((target_clones("avx2", "default")))
+#else
+#define FACET_PIXEL_PASS
+#endif
+
 namespace facet::step_profile {
 
 // exp(x) for x <= 0, within 3e-13 relative of std::exp (flushed to zero below -708, where
