@@ -193,15 +193,20 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   // and the farthest image of the plane points halfBand image pixels inside and outside the rim
   // (at 72 angles, each with the plane's scale across the rim there, plus a margin). Only their
   // annulus is visited, clipped 1 px inside the image (the gradient screen needs each pixel's
-  // neighbours).
+  // neighbours). The scale comes from the projection's derivatives, inverted: projecting is a
+  // closed form, mapping an image point into the plane an iterative undistortion.
   double nearest = std::numeric_limits<double>::infinity(), farthest = 0.0;
   for (int i = 0; i < 72; ++i) {
     const cv::Point2d along(std::cos(2 * kPi * i / 72), std::sin(2 * kPi * i / 72));
-    const cv::Point2d rim = plane.toImage(centreMm + radiusMm * along);
-    const cv::Point2d at = plane.toPlane(rim);
-    const cv::Point2d dx = plane.toPlane(rim + cv::Point2d(0.5, 0)) - at;
-    const cv::Point2d dy = plane.toPlane(rim + cv::Point2d(0, 0.5)) - at;
-    const double reach = 1.2 * (halfBand + 1.0) * rimGeometry(along, 2 * dx, 2 * dy, 1.0).scale;
+    const cv::Point2d atMm = centreMm + radiusMm * along;
+    const cv::Point2d rim = plane.toImage(atMm);
+    const double h = 1e-3 * radiusMm;
+    const cv::Point2d byX = (plane.toImage(atMm + cv::Point2d(h, 0)) - rim) / h;  // px per mm
+    const cv::Point2d byY = (plane.toImage(atMm + cv::Point2d(0, h)) - rim) / h;
+    const cv::Matx22d toMm = cv::Matx22d(byX.x, byY.x, byX.y, byY.y).inv();
+    const double reach =
+        1.2 * (halfBand + 1.0) *
+        rimGeometry(along, {toMm(0, 0), toMm(1, 0)}, {toMm(0, 1), toMm(1, 1)}, 1.0).scale;
     const cv::Point2d in = plane.toImage(centreMm + std::max(0.0, radiusMm - reach) * along);
     const cv::Point2d out = plane.toImage(centreMm + (radiusMm + reach) * along);
     if (!std::isfinite(in.x + in.y + out.x + out.y)) return std::nullopt;
