@@ -5,8 +5,9 @@
 // angle or through a distorting lens is no circle in the image; in the plane it is.
 //
 // The edge points of a curved rim sit slightly inside it (second-derivative edges on a blurred
-// curve, about k / r with k from the blur that CircleMeasure's grey-value fit measured); each
-// point is moved outwards by that before mapping.
+// curve, about k / r with k from the blur); each point is moved outwards by that before mapping:
+// k from the blur CircleMeasure's grey-value fit measured for the edge points' circle, the
+// default k for the start of the grey-value fit in the plane (which measures the blur itself).
 
 #include <optional>
 #include <string>
