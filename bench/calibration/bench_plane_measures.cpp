@@ -67,8 +67,8 @@ struct Errors {
 };
 
 struct TiltRow {
-  Errors blobCentre, blobArea, pairMiddle, circleCentre, circleDiameter, roundness, straightness,
-      lineOffset;
+  Errors blobCentre, blobArea, pairMiddle, circleCentre, markCentre, circleDiameter, roundness,
+      straightness, lineOffset;
   int missed = 0;
   int notRefined = 0;  // circles measured by their edge points alone (no grey fit in the plane)
   // Circles the image refused as circles (the baseline measures nothing), measured in the plane,
@@ -184,7 +184,8 @@ void measureScene(double tilt, double lensBlur, std::uint64_t seed, TiltRow& row
     planeCircleMs.push_back(t2 - t1);
     // The baseline: the edge points of the image measurement with its grey fit (whose blur sets
     // their curvature bias), mapped into the plane.
-    const auto edges = circleInPlane(measureCircle(image, p), plane);
+    const CircleMeasurement inImage = measureCircle(image, p);
+    const auto edges = circleInPlane(inImage, plane);
     if (w && !edges) {
       // Refused by the image as a circle (the baseline has nothing), measured in the plane.
       ++row.planeOnly;
@@ -196,6 +197,10 @@ void measureScene(double tilt, double lensBlur, std::uint64_t seed, TiltRow& row
       ++row.missed;
     } else {
       row.circleCentre.add(cv::norm(w->centreMm - hole), cv::norm(edges->centreMm - hole));
+      // A fiducial mark's centre, as the fiducials step takes it; baseline: the image circle's
+      // centre mapped (what the step took before it measured marks in the plane).
+      row.markCentre.add(cv::norm(w->centreMm - hole),
+                         cv::norm(plane.toPlane(inImage.centre) - hole));
       row.circleDiameter.add(w->diameterMm - 2 * holeR, edges->diameterMm - 2 * holeR);
       row.notRefined += w->greyRefined ? 0 : 1;
       row.roundness.add(w->roundnessMm, m.roundness * plane.mmPerPixelAt(m.centre));
@@ -255,6 +260,7 @@ int main(int argc, char** argv) {
                     {"blob area, %", &TiltRow::blobArea},
                     {"caliper pair middle, mm", &TiltRow::pairMiddle},
                     {"circle centre, mm", &TiltRow::circleCentre},
+                    {"mark centre (fiducials), mm", &TiltRow::markCentre},
                     {"circle diameter, mm", &TiltRow::circleDiameter},
                     {"circle roundness, mm", &TiltRow::roundness},
                     {"line straightness, mm", &TiltRow::straightness},
@@ -290,7 +296,8 @@ int main(int argc, char** argv) {
   std::printf(
       "baseline: blob centroid mapped, area x scale^2 there; the image's halfway point "
       "mapped; the circle's edge points fitted in the plane (facet before its grey-value fit "
-      "there); image roundness and straightness x scale; the image line's ends mapped\n");
+      "there); the image circle's centre mapped (a fiducial mark); image roundness and "
+      "straightness x scale; the image line's ends mapped\n");
   std::printf(
       "tool runs that measured nothing: %d; circles without the grey fit in the plane: %d\n",
       missed, notRefined);
