@@ -213,11 +213,8 @@ PlaneCircleVerdict measureCircleInPlane(const cv::Mat& image, const CircleMeasur
                                         const CircleMeasureParams& params,
                                         const WorldMapping& mapping) {
   PlaneCircleVerdict verdict;
+  if (!m.status.ok() && !refusedAsImageCircle(m)) return verdict;
   verdict.judgedInPlane = !m.status.ok();
-  if (verdict.judgedInPlane && !refusedAsImageCircle(m)) {
-    verdict.judgedInPlane = false;
-    return verdict;
-  }
   verdict.circle = circleInPlane(image, m, mapping);
   if (verdict.circle && verdict.judgedInPlane) {
     verdict.refusal = refusalInPlane(*verdict.circle, params, mapping);

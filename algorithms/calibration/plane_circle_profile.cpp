@@ -432,14 +432,13 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   // A sharp image: refit with each pixel's area in the model, as fitCircleProfile does.
   if (q(kBlur) < step_profile::kSharpBlur) {
     pixelModel = true;
-    q(kBlur) = std::sqrt(std::max(q(kBlur) * q(kBlur) - step_profile::kPixelVariance, 0.01));
+    q(kBlur) = step_profile::lensBlurOf(q(kBlur));
     if (!solve({true, true, true, true, true, withRamp, withRamp, true})) return std::nullopt;
   }
   // A rim is a step well above the noise: a contrast within a few noise levels of none is no rim
   // (an image without contrast leaves every parameter but the level free).
   // The equivalent Gaussian blur, PSF and pixel together.
-  const double blur =
-      pixelModel ? std::sqrt(q(kBlur) * q(kBlur) + step_profile::kPixelVariance) : q(kBlur);
+  const double blur = pixelModel ? step_profile::equivalentBlur(q(kBlur)) : q(kBlur);
   if (!q.allFinite() || std::abs(q(kContrast)) < std::max(4.0 * sigma, 1.0) || blur < 0.2 ||
       blur > 5.0 || q(kRadius) <= 0.0 || std::hypot(q(kCx), q(kCy)) > maxShiftPx ||
       std::abs(q(kRadius) - radiusPx) > maxShiftPx)

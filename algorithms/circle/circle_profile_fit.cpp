@@ -515,16 +515,15 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // weights then reject the steepest pixels, unevenly around the rim. A perfectly sharp disc at
   // noise 0.5 came out 0.28 px RMS off (0.015 at noise 1). Refit from there with the pixel's
   // area in the model; its blur parameter is the lens's alone.
-  using step_profile::kPixelVariance;
   if (p(3) < step_profile::kSharpBlur) {
     pixelModel = true;
-    p(3) = std::sqrt(std::max(p(3) * p(3) - kPixelVariance, 0.01));
+    p(3) = step_profile::lensBlurOf(p(3));
     if (!solve({true, true, true, true, true, withRamp, withRamp, true}, 15, true))
       return std::nullopt;
   }
   // The equivalent Gaussian blur, PSF and pixel together: its variance across the rim is what
   // moves the 50% level inside a convex rim (below).
-  const double blur = pixelModel ? std::sqrt(p(3) * p(3) + kPixelVariance) : p(3);
+  const double blur = pixelModel ? step_profile::equivalentBlur(p(3)) : p(3);
   const cv::Point2d c{centre.x + p(0), centre.y + p(1)};
   if (!p.allFinite() || blur < 0.2 || blur > 5.0 || p(2) <= 0.0 ||
       std::hypot(c.x - centre.x, c.y - centre.y) > maxShift || std::abs(p(2) - radius) > maxShift)

@@ -4,6 +4,7 @@
 // calls or branches, so that the fit's loops over the rim band vectorise (std::exp is a call per
 // pixel; it was a fifth of the fit's time).
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -87,6 +88,17 @@ constexpr double kPixelVariance = 1.0 / 12.0;
 // The Gaussian profile's blur below which the grey-value fits refit with pixelStep: the Gaussian
 // s of a lens blur of 0.35 px (s^2 = sigma^2 + 1/12).
 constexpr double kSharpBlur = 0.45;
+
+// The lens's blur within a Gaussian profile's s (s^2 = sigma^2 + 1/12), the pixel model's start;
+// held at 0.1 px where s leaves less than that.
+inline double lensBlurOf(double gaussianBlur) {
+  return std::sqrt(std::max(gaussianBlur * gaussianBlur - kPixelVariance, 0.01));
+}
+// The Gaussian equivalent of a lens blur seen through square pixels: the variance across a rim,
+// PSF and pixel together, that moves the 50% level inside a convex rim.
+inline double equivalentBlur(double lensBlur) {
+  return std::sqrt(lensBlur * lensBlur + kPixelVariance);
+}
 
 inline PixelStep pixelStep(double d, double s, double nx, double ny) {
   const double inv = 1.0 / s;

@@ -400,6 +400,12 @@ config::Calibration calibrationOf(const scene::PlaneScene& s) {
   return calibration;
 }
 
+// The view's mapping into its plane, as the station's calibration gives it.
+WorldMapping mappingOf(const scene::PlaneScene& s) {
+  return {CameraModel{s.camera.matrix(), s.camera.distortion(), s.camera.size},
+          *calibrationOf(s).plane};
+}
+
 // On a plane seen at 30 degrees through a distorting lens, the blob step measures its largest
 // blob in the plane: its area there, and its centre (which a distance step relates) is the
 // blob's centre in the plane, not the image centroid mapped (which fails the 0.01 mm check).
@@ -450,8 +456,7 @@ TEST_F(MeasuringSteps, OnASteepViewACircleTheImageRefusesIsMeasuredInThePlane) {
   const cv::Mat image = s.render();
   // The nominal centre 0.5 px off the bore's image, as a part placed by hand would be.
   const cv::Point2d b = s.imageOf(boreMm) + cv::Point2d(0.4, -0.3);
-  const WorldMapping plane(CameraModel{s.camera.matrix(), s.camera.distortion(), s.camera.size},
-                           *calibration.plane);
+  const WorldMapping plane = mappingOf(s);
   CircleMeasureParams p;  // as the step sets them
   p.centre = b;
   p.radius = 4.0 / plane.mmPerPixelAt(b);
@@ -485,8 +490,7 @@ TEST_F(MeasuringSteps, OnATiltedPlaneFiducialMarksAreMeasuredInThePlane) {
   const config::Calibration calibration = calibrationOf(s);
   const cv::Mat image = s.render();
   const cv::Point2d a = s.imageOf(aMm), b = s.imageOf(bMm);
-  const WorldMapping plane(CameraModel{s.camera.matrix(), s.camera.distortion(), s.camera.size},
-                           *calibration.plane);
+  const WorldMapping plane = mappingOf(s);
   double worst = 0;  // the image's own circle centre, px from the image of the mark's centre
   for (const cv::Point2d& c : {a, b}) {
     CircleMeasureParams p;

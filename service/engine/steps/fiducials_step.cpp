@@ -65,7 +65,7 @@ StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const
   // centre of a 4 mm mark measured in the image lay 4-6 px (about 1 mm) from the image of its
   // true centre; measured in the plane, within 0.001 mm.
   const auto plane = part.calibration.worldMapping();
-  std::vector<cv::Point2d> nominal, found;
+  std::vector<cv::Point2d> nominal, found, foundMm;  // foundMm: the marks' centres in the plane
   for (const auto& mark : f.marks) {
     const cv::Point2d expected = mapPoint(H, mark);
     const double scale = plane ? plane->mmPerPixelAt(expected) : part.mmPerPixel();
@@ -102,7 +102,8 @@ StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const
                            : std::string(toString(m.status.cause)) +
                                  (inPlane.refusal.empty() ? "" : " (" + inPlane.refusal + ")")));
       // The image point of the mark's centre in the plane: the pose is fitted in the image.
-      const cv::Point2d centre = plane->toImage(inPlane.circle->centreMm);
+      foundMm.push_back(inPlane.circle->centreMm);
+      const cv::Point2d centre = plane->toImage(foundMm.back());
       part.overlay.circle(centre, inPlane.circle->diameterMm / 2 / scale, true);
       found.push_back(centre);
     }
@@ -120,8 +121,7 @@ StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const
   r.angleDeg = degrees(std::atan2(-S(1, 0), S(0, 0)));
   if (!setPoseOffset(r, plane, cn, cf, *r.angleDeg))
     return StepResult::failed("the fiducials do not map into the measuring plane");
-  r.values["spacing"] = plane ? cv::norm(plane->toPlane(found[1]) - plane->toPlane(found[0]))
-                              : cv::norm(found[1] - found[0]);
+  r.values["spacing"] = plane ? cv::norm(foundMm[1] - foundMm[0]) : cv::norm(found[1] - found[0]);
   r.point = cf;
   return r;
 }
