@@ -21,7 +21,10 @@
 //      curvature bias from the fitted blur instead of a constant. Angular sectors whose grey
 //      residuals are too large for the noise (faint clutter near the rim) are dropped and the
 //      fit repeated.
-// RMS, roundness, inliers and coverage always describe the edge points of step 5.
+//   5b. (default) when an ellipse explains the rim's points significantly better than the circle
+//      and takes in at least its inliers (a tilted view: rim_ellipse.hpp), the rim is that
+//      ellipse; step 6 then fits the blurred disc in the coordinates that make it a circle.
+// RMS, roundness, inliers and coverage always describe the edge points of step 5 (5b).
 //
 // Failures are reported as a cause and a message (Status<CircleFailure>), never as a bogus
 // circle: when `status.ok()` is false the centre, radius and diameter are NaN.
@@ -92,6 +95,11 @@ struct CircleMeasureParams {
   // second-derivative edges on a curved, blurred rim, which puts the fitted radius about
   // radiusBiasK / radius pixels too small. Default on.
   bool correctRadiusBias = true;
+  // A rim the image shows as an ellipse (a round feature on a plane viewed at a tilt, off the
+  // lens's axis, or an oval part) is measured as that ellipse when one explains the rim's edge
+  // points significantly better than a circle (rim_ellipse.hpp). Off: always a circle, whose
+  // robust fit keeps only the arcs one circle matches on such a rim. Default on.
+  bool measureEllipticRims = true;
   // Curvature-bias constant k of the edge-point fit, pixels^2 (bias = -k / r). The default was
   // measured with the Facet 5x5 operator on discs blurred with a Gaussian PSF of sigma 1 px
   // (bench_circle --no-grey-refinement --no-bias-correction prints it); it grows with the blur
@@ -113,15 +121,23 @@ enum class CircleFailure {
 [[nodiscard]] std::string_view toString(CircleFailure failure);
 
 struct CircleMeasurement {
-  cv::Point2d centre{};       // pixels; NaN when !status.ok()
-  double radius = 0.0;        // pixels; NaN when !status.ok()
-  double diameter = 0.0;      // pixels; NaN when !status.ok()
-  double roundness = 0.0;     // max minus min signed radial deviation of the inliers, pixels
-  double rms = 0.0;           // RMS of the inliers' orthogonal residuals, pixels
-  int edgePoints = 0;         // subpixel edge points found in the annulus
-  int candidates = 0;         // edge points left after the gradient-direction test
-  int inliers = 0;            // inliers of the final fit
-  double coverageDeg = 0.0;   // angular extent covered by the inliers, degrees
+  cv::Point2d centre{};    // pixels; NaN when !status.ok()
+  double radius = 0.0;     // pixels; NaN when !status.ok()
+  double diameter = 0.0;   // pixels; NaN when !status.ok()
+  double roundness = 0.0;  // max minus min signed radial deviation of the inliers, pixels
+  double rms = 0.0;    // RMS of the inliers' orthogonal residuals (to the ellipse if elliptic), px
+  int edgePoints = 0;  // subpixel edge points found in the annulus
+  int candidates = 0;  // edge points left after the gradient-direction test
+  int inliers = 0;     // inliers of the final fit
+  double coverageDeg = 0.0;  // angular extent covered by the inliers, degrees
+  // The rim was measured as an ellipse (measureEllipticRims): the centre is the ellipse's, the
+  // radius that of the circle of its area (the axes' geometric mean), the roundness about the
+  // axes' difference. A round feature seen at a tilt in an uncalibrated view: its centre is
+  // right, its size is not one diameter (calibrate the measuring plane for millimetres).
+  bool elliptic = false;
+  double majorDiameter = 0.0;  // pixels; the diameter when the rim is a circle
+  double minorDiameter = 0.0;
+  double majorAxisDeg = 0.0;  // of the major axis, degrees counter-clockwise on screen, [0, 180)
   bool greyRefined = false;   // centre and radius come from the grey-value refinement
   double blur = 0.0;          // blur fitted by the grey-value refinement, pixels (0 without)
   double lowThreshold = 0.0;  // Canny thresholds actually used

@@ -161,7 +161,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
                                                  const std::vector<EdgePoint>& foreignPoints,
-                                                 double noiseSigma, double maxShift) {
+                                                 double noiseSigma, double maxShift,
+                                                 const cv::Matx22d& toCircle) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
 
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
@@ -186,10 +187,25 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const double halfBand = smallRim ? 8.0 : 6.0;
   constexpr double kNarrowBand = 4.0;
 
+  // An elliptic rim: its offsets from the centre map to the circle's by toCircle (symmetric,
+  // determinant 1), whose larger eigenvalue `stretch` is the square root of the axes' ratio. Its
+  // band lies in the image annulus from (R - halfBand) / stretch to (R + halfBand) * stretch.
+  const bool elliptic = toCircle != cv::Matx22d::eye();
+  const double halfTrace = (toCircle(0, 0) + toCircle(1, 1)) / 2.0;
+  const double stretch =
+      elliptic
+          ? halfTrace + std::sqrt(std::max(0.0, halfTrace * halfTrace - cv::determinant(toCircle)))
+          : 1.0;
+  // An offset's distance from the rim, in the circle's coordinates.
+  auto mappedDistance = [&](double dx, double dy) {
+    return cv::norm(toCircle * cv::Vec2d(dx, dy)) - radius;
+  };
+
   // The band |rho - R| <= halfBand inside the image, as stretches of rows: a big rim's band holds
   // several times the pixels the fit keeps (the thinning below), and only those need their bins,
   // coordinates and grey values.
-  const double rOut = radius + halfBand, rIn = std::max(0.0, radius - halfBand);
+  const double rOut = (radius + halfBand) * stretch,
+               rIn = std::max(0.0, (radius - halfBand) / stretch);
   const int x0 = std::max(0, static_cast<int>(std::floor(centre.x - rOut)));
   const int x1 = std::min(image.cols - 1, static_cast<int>(std::ceil(centre.x + rOut)));
   const int y0 = std::max(0, static_cast<int>(std::floor(centre.y - rOut)));
@@ -247,7 +263,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       for (; next < end; next += levelStride) {
         const int column = s.x0 + static_cast<int>(next - start);
         const double dx = column - centre.x, dy = s.row - centre.y;
-        const double d = std::sqrt(dx * dx + dy * dy) - radius;
+        const double d = elliptic ? mappedDistance(dx, dy) : std::sqrt(dx * dx + dy * dy) - radius;
         if (d < -2.0) inside.push_back(greyAt(image, column, s.row));
         if (d > 2.0) outside.push_back(greyAt(image, column, s.row));
       }
@@ -268,7 +284,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // The narrow band's pixels of the band (filled when narrow), in the band's order.
   std::vector<Stretch> narrowBand;
   std::size_t narrowPixels = 0;
-  if (noiseSigma > 0.0) {
+  if (noiseSigma > 0.0 && !elliptic) {  // an elliptic rim's band is narrowed below
     const double snr = p(7) / noiseSigma;
     auto needed = [&](double halfWidth) { return rim_band::pixelsNeeded(snr, halfWidth); };
     if (static_cast<double>(inBand) > needed(halfBand)) {
@@ -309,12 +325,46 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     samples.push_back({e.column - centre.x, e.row - centre.y, greyAt(image, e.column, e.row), e.bin,
                        e.column, e.row});
   }
+  if (elliptic) {
+    // The band about the elliptic rim (the image annulus holds it with margins) and, as for a
+    // circle, a big clean rim's narrower band in an evenly spread share of the bins.
+    auto outside = [&](double limit) {
+      return [&, limit](const Sample& e) { return std::abs(mappedDistance(e.x, e.y)) > limit; };
+    };
+    std::erase_if(samples, outside(halfBand));
+    const double snr = noiseSigma > 0.0 ? p(7) / noiseSigma : 0.0;
+    if (noiseSigma > 0.0 &&
+        static_cast<double>(samples.size()) > rim_band::pixelsNeeded(snr, halfBand)) {
+      std::erase_if(samples, outside(kNarrowBand));
+      share = rim_band::pixelsNeeded(snr, kNarrowBand) / static_cast<double>(samples.size());
+      if (share < 1.0)
+        std::erase_if(samples, [&](const Sample& e) {
+          return std::floor((e.bin + 1) * share) == std::floor(e.bin * share);
+        });
+    }
+    // The gradient screen judges a pixel by the rim's normal near it and its distance from the
+    // rim: an offset along that normal (toCircle^T times the mapped offset; toCircle is
+    // symmetric) as long as the mapped offset, the circle's radius plus that distance.
+    for (Sample& e : samples) {
+      const cv::Vec2d mapped = toCircle * cv::Vec2d(e.x, e.y);
+      const cv::Vec2d along = cv::normalize(toCircle * mapped) * cv::norm(mapped);
+      e.x = along[0];
+      e.y = along[1];
+    }
+  }
   if (noiseSigma > 0.0) {
     // After the thinning, so that a big rim pays only for the pixels it keeps.
     dropForeignGradients(samples, image, radius, noiseSigma,
                          cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
     if (samples.size() < 30) return std::nullopt;
   }
+  if (elliptic)  // the model's coordinates: the mapped offsets
+    for (Sample& e : samples) {
+      const cv::Vec2d mapped = toCircle * cv::Vec2d(e.column - centre.x, e.row - centre.y);
+      e.x = mapped[0];
+      e.y = mapped[1];
+    }
+  if (samples.size() < 30) return std::nullopt;
   // Tukey's constant, in robust sigmas of the grey residuals. Once the pixels near foreign
   // gradients are out, what is left for the weight are gross outliers (the cores of blobs far
   // from the rim, an occluder's face), so it can be close to least squares: c = 8 keeps 99.4%
@@ -524,7 +574,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // The equivalent Gaussian blur, PSF and pixel together: its variance across the rim is what
   // moves the 50% level inside a convex rim (below).
   const double blur = pixelModel ? step_profile::equivalentBlur(p(3)) : p(3);
-  const cv::Point2d c{centre.x + p(0), centre.y + p(1)};
+  const cv::Vec2d shift = elliptic ? toCircle.inv() * cv::Vec2d(p(0), p(1)) : cv::Vec2d(p(0), p(1));
+  const cv::Point2d c{centre.x + shift[0], centre.y + shift[1]};
   if (!p.allFinite() || blur < 0.2 || blur > 5.0 || p(2) <= 0.0 ||
       std::hypot(c.x - centre.x, c.y - centre.y) > maxShift || std::abs(p(2) - radius) > maxShift)
     return std::nullopt;

@@ -54,10 +54,18 @@ struct CircleProfileFit {
 // 0 = unknown) lets a clean, large rim use only the share of its pixels the precision needs.
 // Returns nothing when the fit does not converge to a plausible circle (moves farther than
 // `maxShift` pixels, blur outside (0.2, 5) px).
+//
+// An elliptic rim (rim_ellipse.hpp): `toCircle` maps offsets from the centre so that the rim
+// becomes a circle of `radius` (Ellipse::toCircle, area-preserving), and the model applies to
+// the mapped offsets. The centre comes back in the image; the radius is the mapped circle's, the
+// radius of the circle of the rim's area. The map changes the blur across the rim by the square
+// root of the axes' ratio either way (4% at axes 0.92 apart): a second harmonic around the rim,
+// which leaves the centre alone. Identity (the default): a circle, as above.
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
                                                  const std::vector<EdgePoint>& foreignPoints = {},
-                                                 double noiseSigma = 0.0, double maxShift = 1.0);
+                                                 double noiseSigma = 0.0, double maxShift = 1.0,
+                                                 const cv::Matx22d& toCircle = cv::Matx22d::eye());
 
 }  // namespace facet

@@ -99,7 +99,14 @@ void run(const CircleOptions& o) {
                        // judging a result needs to know which.
                        {"grey_refined", m.greyRefined},
                        {"blur", m.blur},
+                       {"elliptic", m.elliptic},
                        {"time_ms", ms}};
+    // An elliptic rim (a tilted view): its axes, in pixels, and the major one's direction in
+    // degrees counter-clockwise; centre and radius above are the ellipse's centre and the radius
+    // of the circle of its area.
+    if (m.elliptic)
+      out["ellipse"] = {
+          {"major", m.majorDiameter}, {"minor", m.minorDiameter}, {"angle", m.majorAxisDeg}};
     if (!world.is_null()) out["world"] = world;
     printJson(out);
   } else {
@@ -111,6 +118,10 @@ void run(const CircleOptions& o) {
                                 : "from the edge points only (grey-value fit did not converge)");
     if (m.greyRefined) std::cout << m.blur << " px";
     std::cout << "\n";
+    if (m.elliptic)
+      std::cout << "the rim is an ellipse: axes " << m.majorDiameter << " x " << m.minorDiameter
+                << " px, the major one at " << m.majorAxisDeg
+                << " deg; centre and radius are the ellipse's centre and the radius of its area\n";
     if (!world.is_null())
       std::cout << "in the plane: centre (" << world["x_mm"].get<double>() << ", "
                 << world["y_mm"].get<double>() << ") mm, diameter "

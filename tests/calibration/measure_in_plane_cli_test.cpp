@@ -196,13 +196,13 @@ TEST_F(MeasureInPlaneCli, CircleGivesTheDiscInThePlane) {
   EXPECT_GT(w["coverage_deg"].get<double>(), 300) << w.dump();
 }
 
-// A hole seen at 40 degrees, which the image refuses as a circle (its rim is an ellipse of
-// 0.77 : 1 there): `facet circle --calibration` measures and judges it in the plane and says so;
-// without the calibration the command fails as before.
+// A hole seen at 55 degrees, which the image refuses (its rim is an ellipse of 0.57 : 1 there,
+// its minor axis outside the annulus): `facet circle --calibration` measures and judges it in the
+// plane and says so; without the calibration the command fails as before.
 TEST_F(MeasureInPlaneCli, CircleMeasuresInThePlaneAHoleTheImageRefuses) {
   scene::PlaneScene steep;
   steep.camera = test::testCamera();
-  steep.placement = scene::lookAtPlane({40, 30}, 250, 40, 20, 10, steep.camera);
+  steep.placement = scene::lookAtPlane({40, 30}, 250, 55, 20, 10, steep.camera);
   steep.background = 30;
   steep.addPolygon({{-20, -20}, {100, -20}, {100, 80}, {-20, 80}}, 210);
   const cv::Point2d hole(45, 27);

@@ -2,10 +2,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -60,6 +62,46 @@ TEST_F(CircleCli, PrintsOneJsonObjectWithTheCircle) {
   EXPECT_GE(j.at("time_ms").get<double>(), 0.0);
   EXPECT_TRUE(j.at("grey_refined").get<bool>());
   EXPECT_NEAR(j.at("blur").get<double>(), 1.0, 0.3);  // the scene's PSF sigma, plus pixel size
+  EXPECT_FALSE(j.at("elliptic").get<bool>());
+  EXPECT_FALSE(j.contains("ellipse"));
+}
+
+TEST_F(CircleCli, AnEllipticRimReportsItsAxes) {
+  // A disc seen at a tilt: an ellipse with semi-axes 40 and 36 px, the major axis 30 degrees
+  // counter-clockwise on screen.
+  facet::scene::SceneSpec spec;
+  spec.size = {160, 140};
+  spec.background = 60;
+  spec.blurSigma = 1.0;
+  spec.noiseSigma = 2.0;
+  spec.subrows = 64;
+  facet::scene::Scene s(spec);
+  std::vector<cv::Point2d> outline;
+  const double t = -30.0 * CV_PI / 180.0;  // y down: counter-clockwise on screen is negative
+  for (int i = 0; i < 720; ++i) {
+    const double a = 2 * CV_PI * i / 720, u = 40.0 * std::cos(a), v = 36.0 * std::sin(a);
+    outline.push_back({centre_.x + u * std::cos(t) - v * std::sin(t),
+                       centre_.y + u * std::sin(t) + v * std::cos(t)});
+  }
+  s.addPolygon(outline, 170);
+  const std::string image = (dir_ / "ellipse.png").string();
+  s.write(image);
+  const CliRun r = facet("circle --image " + image +
+                         " --center 81,69 --radius 38 --polarity light_to_dark --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_TRUE(j.at("elliptic").get<bool>());
+  EXPECT_NEAR(j.at("x").get<double>(), centre_.x, 0.05);
+  EXPECT_NEAR(j.at("y").get<double>(), centre_.y, 0.05);
+  EXPECT_NEAR(j.at("radius").get<double>(), std::sqrt(40.0 * 36.0), 0.05);
+  EXPECT_NEAR(j.at("ellipse").at("major").get<double>(), 80.0, 0.1);
+  EXPECT_NEAR(j.at("ellipse").at("minor").get<double>(), 72.0, 0.1);
+  EXPECT_NEAR(j.at("ellipse").at("angle").get<double>(), 30.0, 0.5);
+  // The text form says so too.
+  const CliRun text =
+      facet("circle --image " + image + " --center 81,69 --radius 38 --polarity light_to_dark");
+  ASSERT_EQ(text.exitCode, 0) << text.err;
+  EXPECT_NE(text.out.find("the rim is an ellipse"), std::string::npos) << text.out;
 }
 
 TEST_F(CircleCli, MeasurementFailureIsAJsonErrorWithItsCause) {

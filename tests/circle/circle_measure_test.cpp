@@ -47,6 +47,23 @@ void expectCircle(const CircleMeasurement& m, cv::Point2d centre, double radius,
   EXPECT_EQ(static_cast<std::size_t>(m.inliers), m.inlierPoints.size());
   EXPECT_GE(m.roundness, 0.0);
   EXPECT_LT(m.roundness, 1.0);
+  EXPECT_FALSE(m.elliptic);  // a round rim is no ellipse
+  EXPECT_EQ(m.majorDiameter, m.diameter);
+  EXPECT_EQ(m.minorDiameter, m.diameter);
+}
+
+// The outline of an ellipse (720 vertices: within 0.001 px of it) with semi-axes a and b, the
+// major one `angleDeg` degrees below the image's x axis (y down).
+std::vector<cv::Point2d> ellipseOutline(cv::Point2d c, double a, double b, double angleDeg) {
+  const double t = angleDeg * std::numbers::pi / 180.0;
+  std::vector<cv::Point2d> outline;
+  for (int i = 0; i < 720; ++i) {
+    const double s = 2 * std::numbers::pi * i / 720;
+    const double u = a * std::cos(s), v = b * std::sin(s);
+    outline.push_back(
+        {c.x + u * std::cos(t) - v * std::sin(t), c.y + u * std::sin(t) + v * std::cos(t)});
+  }
+  return outline;
 }
 
 TEST(CircleMeasure, LightDiscAtSubpixelCentresFromAnOffsetStart) {
@@ -180,6 +197,54 @@ TEST(CircleMeasure, FitTooPoorOnAWavyRim) {
   ASSERT_TRUE(loose.status.ok()) << loose.status.message;
   EXPECT_GT(loose.roundness, 1.5);
   EXPECT_LT(loose.roundness, 3.5);
+}
+
+TEST(CircleMeasure, AnEllipticRimIsMeasuredAsItsEllipse) {
+  // A hole of radius 30 px on a plane viewed at a tilt of about 26 degrees: an ellipse with axes
+  // 30 and 27 px. A circle's 0.5 px band keeps the arcs that one circle matches, on one side.
+  Scene s(spec(120, 190));
+  const cv::Point2d c{60.37, 58.81};
+  s.addPolygon(ellipseOutline(c, 30.0, 27.0, 25.0), 60.0);
+  const cv::Mat image = s.render();
+  auto p = params(c + cv::Point2d(1.0, -0.7), 28.5, CirclePolarity::DarkToLight);
+  const auto m = measureCircle(image, p);
+  ASSERT_TRUE(m.status.ok()) << m.status.message;
+  EXPECT_TRUE(m.elliptic);
+  EXPECT_TRUE(m.greyRefined);
+  EXPECT_NEAR(m.centre.x, c.x, 0.02);
+  EXPECT_NEAR(m.centre.y, c.y, 0.02);
+  EXPECT_NEAR(m.radius, std::sqrt(30.0 * 27.0), 0.05);  // the circle of the ellipse's area
+  EXPECT_NEAR(m.majorDiameter, 60.0, 0.1);
+  EXPECT_NEAR(m.minorDiameter, 54.0, 0.1);
+  EXPECT_NEAR(m.majorAxisDeg, 155.0, 0.5);  // 25 degrees clockwise on screen
+  EXPECT_NEAR(m.roundness, 3.0, 0.3);       // the axes' difference
+  EXPECT_LT(m.rms, 0.1);                    // from the ellipse
+  EXPECT_GT(m.coverageDeg, 350.0);
+  // As a circle, the same rim's centre is off by a pixel or more along the minor axis.
+  p.measureEllipticRims = false;
+  const auto round = measureCircle(image, p);
+  if (round.status.ok()) {
+    EXPECT_FALSE(round.elliptic);
+    EXPECT_GT(std::hypot(round.centre.x - c.x, round.centre.y - c.y), 0.3);
+  }
+}
+
+TEST(CircleMeasure, ASlightlyEllipticRimKeepsItsGreyValueFitOnTheCentre) {
+  // Axes 0.6 px apart (a tilt of about 11 degrees at r = 30): every edge point lies within the
+  // circle's band, but the grey-value fit of a circle does not fit the rim (its sector screen
+  // drops the sectors the circle misses most), and moves the centre.
+  Scene s(spec(120, 60));
+  const cv::Point2d c{59.62, 60.27};
+  s.addPolygon(ellipseOutline(c, 30.3, 29.7, -40.0), 170.0);
+  const cv::Mat image = s.render();
+  const auto m = measureCircle(image, params(c, 30.0, CirclePolarity::LightToDark));
+  ASSERT_TRUE(m.status.ok()) << m.status.message;
+  EXPECT_TRUE(m.elliptic);
+  EXPECT_TRUE(m.greyRefined);
+  EXPECT_NEAR(m.centre.x, c.x, 0.01);
+  EXPECT_NEAR(m.centre.y, c.y, 0.01);
+  EXPECT_NEAR(m.majorDiameter - m.minorDiameter, 1.2, 0.1);
+  EXPECT_NEAR(m.majorAxisDeg, 40.0, 3.0);
 }
 
 TEST(CircleMeasure, BadInputIsAFlagWithAClearMessage) {

@@ -444,12 +444,12 @@ TEST_F(MeasuringSteps, OnATiltedPlaneABlobsAreaAndCentreAreThePlanes) {
   EXPECT_NEAR(value(out, "across_apart.distance").value, cv::norm(blobMm - boreMm), 0.005);
 }
 
-// On a plane seen at 40 degrees a bore is an ellipse of 0.77 : 1 in the image: the image's circle
-// tests refuse it (its 0.5 px band about a circle holds too little of the rim, or the circle
-// leaves the annulus; checked below with the step's own parameters). The circle step judges the
-// rim again in the plane, where it is round, and measures it there: its place within 0.005 mm.
+// On a plane seen at 62 degrees a bore is an ellipse of 0.47 : 1 in the image: flatter than the
+// image measures as an ellipse, and its 0.5 px band about a circle holds too little of the rim
+// (checked below with the step's own parameters). The circle step judges the rim again in the
+// plane, where it is round, and measures it there: its place within 0.005 mm.
 TEST_F(MeasuringSteps, OnASteepViewACircleTheImageRefusesIsMeasuredInThePlane) {
-  scene::PlaneScene s = tiltedView(40);
+  scene::PlaneScene s = tiltedView(62);
   const cv::Point2d boreMm(22, 16);
   s.addDisc(boreMm, 4, 40);
   const config::Calibration calibration = calibrationOf(s);
@@ -478,10 +478,39 @@ TEST_F(MeasuringSteps, OnASteepViewACircleTheImageRefusesIsMeasuredInThePlane) {
   EXPECT_NEAR(value(out, "bore.diameter").value, 8, 0.005);
 }
 
-// Round marks on a plane seen at 30 degrees are ellipses in the image, and the image's circle fit
-// keeps the arc a circle matches, off to one side (checked below: more than a pixel). The
-// fiducials step measures each mark in the plane: with the nominal marks at the images of the
-// true centres, the marks' spacing and the pose's offset are within 0.003 mm of the truth.
+// Without a plane calibration, a bore on a plane seen at 30 degrees is an ellipse in the image:
+// the circle step gives the ellipse's centre (within a fifth of a pixel of the image of the
+// bore's centre; as a circle it was more than a pixel off), the diameter of the circle of its
+// area, and says that the rim is an ellipse.
+TEST_F(MeasuringSteps, WithoutAPlaneATiltedBoreIsMeasuredAsItsEllipseAndSaysSo) {
+  scene::PlaneScene s = tiltedView(30);
+  const cv::Point2d boreMm(22, 16);
+  s.addDisc(boreMm, 4, 40);
+  const cv::Point2d b = s.imageOf(boreMm), nominal = b + cv::Point2d(0.4, -0.3);
+  config::Calibration scale;
+  scale.mmPerPixel = mappingOf(s).mmPerPixelAt(b);
+  std::ostringstream steps;
+  steps << "  - id: bore\n    kind: circle\n    centre: [" << nominal.x << ", " << nominal.y
+        << "]\n    nominal_diameter: 8\n    search_width: 2\n    polarity: dark_inside\n"
+        << "    checks:\n      x: {nominal: 0, tol_minus: 1, tol_plus: 1}\n"
+        << "      y: {nominal: 0, tol_minus: 1, tol_plus: 1}\n"
+        << "      diameter: {nominal: 8, tol_minus: 1, tol_plus: 1}\n";
+  const auto out = plate::inspect(dir_, steps.str(), s.render(), scale);
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  EXPECT_NEAR(value(out, "bore.x").value / scale.mmPerPixel, b.x - nominal.x, 0.2);
+  EXPECT_NEAR(value(out, "bore.y").value / scale.mmPerPixel, b.y - nominal.y, 0.2);
+  // The circle of the ellipse's area: at the plane's mean scale there (the square root of its
+  // area ratio) the bore's true diameter.
+  EXPECT_NEAR(value(out, "bore.diameter").value, 8, 0.01);
+  ASSERT_EQ(out.notes.size(), 1u);
+  EXPECT_NE(out.notes[0].find("the rim is an ellipse"), std::string::npos) << out.notes[0];
+}
+
+// Round marks on a plane seen at 30 degrees are ellipses in the image, and an ellipse's centre is
+// not the image of the circle's centre (checked below: a tenth of a pixel, 0.02 mm at this
+// scale); measured as circles, the marks would be more than a pixel off. The fiducials step
+// measures each mark in the plane: with the nominal marks at the images of the true centres, the
+// marks' spacing and the pose's offset are within 0.003 mm of the truth.
 TEST_F(MeasuringSteps, OnATiltedPlaneFiducialMarksAreMeasuredInThePlane) {
   scene::PlaneScene s = tiltedView(30);
   const cv::Point2d aMm(12, 9), bMm(32, 23);
@@ -491,7 +520,8 @@ TEST_F(MeasuringSteps, OnATiltedPlaneFiducialMarksAreMeasuredInThePlane) {
   const cv::Mat image = s.render();
   const cv::Point2d a = s.imageOf(aMm), b = s.imageOf(bMm);
   const WorldMapping plane = mappingOf(s);
-  double worst = 0;  // the image's own circle centre, px from the image of the mark's centre
+  // The image's own centres, px from the image of the mark's centre: as ellipses, as circles.
+  double worst = 0, worstAsCircle = 0;
   for (const cv::Point2d& c : {a, b}) {
     CircleMeasureParams p;
     p.centre = c;
@@ -500,9 +530,15 @@ TEST_F(MeasuringSteps, OnATiltedPlaneFiducialMarksAreMeasuredInThePlane) {
     p.polarity = CirclePolarity::DarkToLight;
     const CircleMeasurement m = measureCircle(image, p);
     ASSERT_TRUE(m.status.ok()) << m.status.message;
+    EXPECT_TRUE(m.elliptic);
     worst = std::max(worst, cv::norm(m.centre - c));
+    p.measureEllipticRims = false;
+    const CircleMeasurement round = measureCircle(image, p);
+    ASSERT_TRUE(round.status.ok()) << round.status.message;
+    worstAsCircle = std::max(worstAsCircle, cv::norm(round.centre - c));
   }
-  ASSERT_GT(worst, 1.0) << "the view no longer moves the image's circle off the mark's centre";
+  ASSERT_GT(worst, 0.05) << "the view no longer moves the ellipse's centre off the mark's centre";
+  EXPECT_GT(worstAsCircle, 1.0);
   const double spacing = cv::norm(bMm - aMm);
   std::ostringstream steps;
   steps << "  - id: marks\n    kind: fiducials\n    marks: [[" << a.x << ", " << a.y << "], ["

@@ -74,9 +74,9 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   part.overlay.circle(expected, std::max(1.0, p.radius - p.width), true, true);
   part.overlay.circle(expected, p.radius + p.width, true, true);
   std::string note;
-  // A hole seen at an angle is an ellipse in the image, which the image's circle tests may refuse
-  // (at 30 degrees of tilt, 2-3 holes in 8 in bench_plane_measures); the plane judges it by the
-  // same tests and measures it there.
+  // A hole seen at an angle is an ellipse in the image, which the image measures as one up to
+  // about 60 degrees of tilt and refuses beyond (or with a sector of it hidden); the plane judges
+  // a refused rim by the same tests and measures it there.
   PlaneCircleVerdict inPlane;
   if (plane) inPlane = measureCircleInPlane(part.grey, m, p, *plane);
   if (!inPlane.circle && !m.status.ok() && m.status.cause != CircleFailure::BadInput &&
@@ -118,6 +118,15 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
     r.point = plane->toImage(w->centreMm);
     part.overlay.circle(*r.point, w->diameterMm / 2 / scale, true);
   } else {
+    // A rim the image shows as an ellipse (a tilted view): its centre is right, its size is not
+    // one diameter. The line must learn that its scale holds only on average here.
+    if (m.elliptic)
+      r.note = (note.empty() ? "" : note + "; ") +
+               cv::format(
+                   "the rim is an ellipse (axes %.2f x %.2f px): the view is tilted; the "
+                   "diameter is that of a circle of its area (calibrate the measuring "
+                   "plane for the true one)",
+                   m.majorDiameter, m.minorDiameter);
     r.values["diameter"] = m.diameter;
     r.values["x"] = m.centre.x - expected.x;
     r.values["y"] = m.centre.y - expected.y;
