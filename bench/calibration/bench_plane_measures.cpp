@@ -7,11 +7,13 @@
 // radius 6 mm (blob), a dark bar 20 mm wide (caliper pair), a dark hole of radius 5 mm (circle:
 // centre, diameter, roundness; the baseline of centre and diameter is the rim's edge points
 // fitted in the plane, what facet measured before its grey-value fit there),
-// a straight dark edge 70 mm long 38 mm from the view's centre (line). Exact pixel coverage,
-// lens blur 0.7 px before pixel integration and none (the full run prints both), noise 2 grey
-// levels. The calibration is the
-// renderer's own camera and plane, so the table measures the measuring, not a calibration
-// (bench_calibration measures that).
+// a straight dark edge 70 mm long 38 mm from the view's centre (line). Without the plane: the
+// hole's image centre as the circle step gives it on an uncalibrated station (its defaults: an
+// elliptic rim measured as its ellipse), against the least-squares ellipse through the exact
+// image of the rim; baseline: the same measurement with the circle model alone. Exact pixel
+// coverage, lens blur 0.7 px before pixel integration and none (the full run prints both), noise 2
+// grey levels. The calibration is the renderer's own camera and plane, so the table measures the
+// measuring, not a calibration (bench_calibration measures that).
 //
 // Nothing in the tools was fitted to these scenes (the blob's interpolation step is set by its
 // error bound, the rest is geometry); the seeds are printed so that other draws can be run
@@ -27,6 +29,8 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#include <opencv2/imgproc.hpp>
 
 #include "algorithms/calibration/plane_blob.hpp"
 #include "algorithms/calibration/plane_circle.hpp"
@@ -68,7 +72,8 @@ struct Errors {
 
 struct TiltRow {
   Errors blobCentre, blobArea, pairMiddle, circleCentre, markCentre, circleDiameter, roundness,
-      straightness, lineOffset;
+      straightness, lineOffset, imageCentre;
+  int imageCircleOnly = 0;  // holes the circle model refused and the image measured as ellipses
   int missed = 0;
   int notRefined = 0;  // circles measured by their edge points alone (no grey fit in the plane)
   // Circles the image refused as circles (the baseline measures nothing), measured in the plane,
@@ -206,6 +211,29 @@ void measureScene(double tilt, double lensBlur, std::uint64_t seed, TiltRow& row
       row.roundness.add(w->roundnessMm, m.roundness * plane.mmPerPixelAt(m.centre));
     }
   }
+  // Without a plane: the hole's image centre, the circle step's defaults against the circle model
+  // alone, from the true image ellipse's centre.
+  {
+    std::vector<cv::Point2f> rim;
+    for (int k = 0; k < 720; ++k)
+      rim.emplace_back(s.imageOf(
+          hole + holeR * cv::Point2d(std::cos(k * CV_PI / 360), std::sin(k * CV_PI / 360))));
+    const cv::Point2d truth = cv::fitEllipse(rim).center;
+    CircleMeasureParams p;
+    p.centre = s.imageOf(hole) + cv::Point2d(0.6, -0.4);
+    p.radius = holeR / plane.mmPerPixelAt(p.centre);
+    p.width = 0.35 * p.radius;
+    p.polarity = CirclePolarity::DarkToLight;
+    const CircleMeasurement m = measureCircle(image, p);
+    p.measureEllipticRims = false;
+    const CircleMeasurement round = measureCircle(image, p);
+    if (!m.status.ok())
+      ++row.missed;
+    else if (!round.status.ok())
+      ++row.imageCircleOnly;
+    else
+      row.imageCentre.add(cv::norm(m.centre - truth), cv::norm(round.centre - truth));
+  }
   // Line: the straight edge (straightness 0; the rectangle centred on it: offset 0).
   {
     const cv::Point2d along = cv::Point2d(1, edgeSlope) / std::hypot(1.0, edgeSlope);
@@ -264,7 +292,8 @@ int main(int argc, char** argv) {
                     {"circle diameter, mm", &TiltRow::circleDiameter},
                     {"circle roundness, mm", &TiltRow::roundness},
                     {"line straightness, mm", &TiltRow::straightness},
-                    {"line offset, mm", &TiltRow::lineOffset}};
+                    {"line offset, mm", &TiltRow::lineOffset},
+                    {"image circle centre (no plane), px", &TiltRow::imageCentre}};
   int missed = 0, notRefined = 0;
   bool broken = false;
   for (const double blur : blurs) {
@@ -279,6 +308,9 @@ int main(int argc, char** argv) {
                      rows[t]);
       missed += rows[t].missed;
       notRefined += rows[t].notRefined;
+      if (rows[t].imageCircleOnly > 0)
+        std::printf("tilt %.0f: %d holes refused by the circle model, measured as ellipses\n",
+                    tilts[t], rows[t].imageCircleOnly);
       if (rows[t].planeOnly > 0)
         std::printf(
             "tilt %.0f: %d circles refused by the image as circles, measured in the plane "
@@ -297,7 +329,8 @@ int main(int argc, char** argv) {
       "baseline: blob centroid mapped, area x scale^2 there; the image's halfway point "
       "mapped; the circle's edge points fitted in the plane (facet before its grey-value fit "
       "there); the image circle's centre mapped (a fiducial mark); image roundness and "
-      "straightness x scale; the image line's ends mapped\n");
+      "straightness x scale; the image line's ends mapped; the image circle without the "
+      "ellipse\n");
   std::printf(
       "tool runs that measured nothing: %d; circles without the grey fit in the plane: %d\n",
       missed, notRefined);
