@@ -27,6 +27,12 @@ class MeasuringSteps : public ::testing::Test {
   InspectionOutcome inspect(const std::string& steps, const cv::Mat& image = plate::render()) {
     return plate::inspect(dir_, steps, image);
   }
+  // The overlay's outline of a rim: its one polygon of 72 points.
+  static std::vector<cv::Point2d> rimOutline(const InspectionOutcome& out) {
+    for (const auto& s : out.overlay.shapes)
+      if (s.kind == OverlayShape::Kind::Polygon && s.points.size() == 72) return s.points;
+    return {};
+  }
   static bool labelSays(const InspectionOutcome& out, const std::string& words) {
     for (const auto& s : out.overlay.shapes)
       if (s.kind == OverlayShape::Kind::Label && s.text.find(words) != std::string::npos)
@@ -476,6 +482,15 @@ TEST_F(MeasuringSteps, OnASteepViewACircleTheImageRefusesIsMeasuredInThePlane) {
   EXPECT_NEAR(value(out, "bore.x").value, boreMm.x - nominal.x, 0.005);
   EXPECT_NEAR(value(out, "bore.y").value, boreMm.y - nominal.y, 0.005);
   EXPECT_NEAR(value(out, "bore.diameter").value, 8, 0.005);
+  // The overlay draws the circle in the plane as the image shows it: on the rim's image.
+  const std::vector<cv::Point2d> outline = rimOutline(out);
+  ASSERT_EQ(outline.size(), 72u);
+  for (int i = 0; i < 72; ++i) {
+    const double t = 2 * CV_PI * i / 72;
+    EXPECT_LT(
+        cv::norm(outline[i] - s.imageOf(boreMm + 4.0 * cv::Point2d(std::cos(t), std::sin(t)))), 0.1)
+        << i;
+  }
 }
 
 // Without a plane calibration, a bore on a plane seen at 30 degrees is an ellipse in the image:
@@ -504,6 +519,21 @@ TEST_F(MeasuringSteps, WithoutAPlaneATiltedBoreIsMeasuredAsItsEllipseAndSaysSo) 
   EXPECT_NEAR(value(out, "bore.diameter").value, 8, 0.01);
   ASSERT_EQ(out.notes.size(), 1u);
   EXPECT_NE(out.notes[0].find("the rim is an ellipse"), std::string::npos) << out.notes[0];
+  // The overlay draws the ellipse: its outline's extent is the rim's image's.
+  const std::vector<cv::Point2d> outline = rimOutline(out);
+  ASSERT_EQ(outline.size(), 72u);
+  std::vector<cv::Point2d> rim;
+  for (int i = 0; i < 720; ++i)
+    rim.push_back(s.imageOf(
+        boreMm + 4.0 * cv::Point2d(std::cos(i * CV_PI / 360), std::sin(i * CV_PI / 360))));
+  const auto extent = [](const std::vector<cv::Point2d>& pts) {
+    cv::Vec4d e(pts[0].x, pts[0].y, pts[0].x, pts[0].y);  // left, top, right, bottom
+    for (const cv::Point2d& p : pts)
+      e = {std::min(e[0], p.x), std::min(e[1], p.y), std::max(e[2], p.x), std::max(e[3], p.y)};
+    return e;
+  };
+  const cv::Vec4d drawn = extent(outline), truth = extent(rim);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(drawn[k], truth[k], 0.3) << k;
 }
 
 // Round marks on a plane seen at 30 degrees are ellipses in the image, and an ellipse's centre is

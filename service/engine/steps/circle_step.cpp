@@ -3,6 +3,7 @@
 #include <cmath>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "algorithms/calibration/plane_circle.hpp"
 #include "algorithms/circle/disc_locator.hpp"
@@ -13,6 +14,34 @@
 #include "service/engine/steps/pose_fields.hpp"
 
 namespace facet::service {
+namespace {
+
+// The rim as the image shows it, for the overlay: 72 points of the circle in the plane mapped
+// into the image, or of the ellipse the image measured.
+std::vector<cv::Point2d> rimOutline(const WorldMapping& plane, const PlaneCircle& c) {
+  std::vector<cv::Point2d> outline;
+  for (int i = 0; i < 72; ++i) {
+    const double t = 2.0 * CV_PI * i / 72;
+    outline.push_back(
+        plane.toImage(c.centreMm + c.diameterMm / 2 * cv::Point2d(std::cos(t), std::sin(t))));
+  }
+  return outline;
+}
+
+std::vector<cv::Point2d> rimOutline(const CircleMeasurement& m) {
+  // The major axis counter-clockwise on screen, y down.
+  const double a = m.majorAxisDeg * CV_PI / 180;
+  const cv::Point2d major(std::cos(a), -std::sin(a)), minor(-major.y, major.x);
+  std::vector<cv::Point2d> outline;
+  for (int i = 0; i < 72; ++i) {
+    const double t = 2.0 * CV_PI * i / 72;
+    outline.push_back(m.centre + m.majorDiameter / 2 * std::cos(t) * major +
+                      m.minorDiameter / 2 * std::sin(t) * minor);
+  }
+  return outline;
+}
+
+}  // namespace
 
 using config::Quantity;
 
@@ -116,7 +145,7 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
     r.values["position"] = cv::norm(w->centreMm - nominal);
     r.values["roundness"] = w->roundnessMm;
     r.point = plane->toImage(w->centreMm);
-    part.overlay.circle(*r.point, w->diameterMm / 2 / scale, true);
+    part.overlay.polygon(rimOutline(*plane, *w), true);
   } else {
     // A rim the image shows as an ellipse (a tilted view): its centre is right, its size is not
     // one diameter. The line must learn that its scale holds only on average here.
@@ -133,7 +162,10 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
     r.values["position"] = cv::norm(m.centre - expected);
     r.values["roundness"] = m.roundness;
     r.point = m.centre;
-    part.overlay.circle(m.centre, m.radius, true);
+    if (m.elliptic)
+      part.overlay.polygon(rimOutline(m), true);
+    else
+      part.overlay.circle(m.centre, m.radius, true);
   }
   part.overlay.cross(*r.point, 4, true);
   return r;
