@@ -229,6 +229,22 @@ TEST(CircleMeasure, AnEllipticRimIsMeasuredAsItsEllipse) {
   }
 }
 
+TEST(CircleMeasure, AnEllipticRimWithASectorHiddenIsRefusedNotMeasuredAsACircle) {
+  // The tilted hole of the test above with a strip over a third of it: too little of the ellipse
+  // is left to measure it as one (300 degrees), and a circle through the arcs it matches would be
+  // pixels off. Refused, and said why.
+  Scene s(spec(120, 190));
+  const cv::Point2d c{60.37, 58.81};
+  s.addPolygon(ellipseOutline(c, 30.0, 27.0, 25.0), 60.0);
+  s.addPolygon({{0, 0}, {c.x - 12, 0}, {c.x - 12, 120}, {0, 120}}, 130.0, "occluder");
+  const auto m = measureCircle(
+      s.render(), params(c + cv::Point2d(1.0, -0.7), 28.5, CirclePolarity::DarkToLight));
+  EXPECT_FALSE(m.status.ok()) << "centre " << m.centre << ", " << m.inliers << " inliers";
+  EXPECT_EQ(m.status.cause, CircleFailure::FitTooPoor);
+  EXPECT_NE(m.status.message.find("the rim is an ellipse"), std::string::npos) << m.status.message;
+  EXPECT_NE(m.status.message.find("less than 300"), std::string::npos) << m.status.message;
+}
+
 TEST(CircleMeasure, ASlightlyEllipticRimKeepsItsGreyValueFitOnTheCentre) {
   // Axes 0.6 px apart (a tilt of about 11 degrees at r = 30): every edge point lies within the
   // circle's band, but the grey-value fit of a circle does not fit the rim (its sector screen
