@@ -29,18 +29,22 @@ class CircleCli : public ::testing::Test {
   void SetUp() override {
     dir_ = fs::temp_directory_path() / ("facet_circle_cli_" + std::to_string(::getpid()));
     fs::create_directories(dir_);
+    facet::scene::Scene s(sceneSpec());
+    s.addDisc(centre_, 40.3, 170);
+    image_ = (dir_ / "disc.png").string();
+    s.write(image_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  // The scenes' 160x140 view: a dark background, blur 1 px, noise 2.
+  static facet::scene::SceneSpec sceneSpec() {
     facet::scene::SceneSpec spec;
     spec.size = {160, 140};
     spec.background = 60;
     spec.blurSigma = 1.0;
     spec.noiseSigma = 2.0;
     spec.subrows = 64;
-    facet::scene::Scene s(spec);
-    s.addDisc(centre_, 40.3, 170);
-    image_ = (dir_ / "disc.png").string();
-    s.write(image_);
+    return spec;
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
   fs::path dir_;
   std::string image_;
@@ -69,13 +73,7 @@ TEST_F(CircleCli, PrintsOneJsonObjectWithTheCircle) {
 TEST_F(CircleCli, AnEllipticRimReportsItsAxes) {
   // A disc seen at a tilt: an ellipse with semi-axes 40 and 36 px, the major axis 30 degrees
   // counter-clockwise on screen.
-  facet::scene::SceneSpec spec;
-  spec.size = {160, 140};
-  spec.background = 60;
-  spec.blurSigma = 1.0;
-  spec.noiseSigma = 2.0;
-  spec.subrows = 64;
-  facet::scene::Scene s(spec);
+  facet::scene::Scene s(sceneSpec());
   std::vector<cv::Point2d> outline;
   const double t = -30.0 * CV_PI / 180.0;  // y down: counter-clockwise on screen is negative
   for (int i = 0; i < 720; ++i) {
