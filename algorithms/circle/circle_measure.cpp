@@ -24,11 +24,15 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 // it, degrees. Facet normals of a rim are radial within a few degrees even at 15 grey levels of
 // contrast (noise 2); unlike the test against the coarse centre, this one knows the circle.
 constexpr double kHypothesisToleranceDeg = 12.0;
-// The F statistic (2 and n - 5 degrees of freedom) beyond which an ellipse explains a rim's
-// points better than a circle by more than chance would once in a million measurements.
+// The F statistic beyond which an ellipse explains a rim's points better than a circle: twice
+// the value independent points (2 and n - 5 degrees of freedom) exceed once in a million
+// measurements, since edge points a pixel apart share most of their 5x5 Facet windows and clutter
+// near a rim leaves residuals with structure of their own (at 13.8, round rims of r = 10 px with
+// clutter blobs and a ramp took an ellipse in 6 scenes of 60; at 27.6 in 1). The same limit
+// screens the circle's residuals' second harmonic (chi-square, 2 degrees of freedom).
 constexpr double kEllipseF = 27.6;
 // The smallest ratio of an elliptic rim's axes measured as one: a circle viewed 60 degrees
-// from square on. A flatter ellipse is no view of a round feature.
+// from square on. A flatter rim is refused (on a calibrated station the plane judges it).
 constexpr double kMinAxesRatio = 0.5;
 // The least angle an elliptic rim's points must cover, degrees. On a rim with a sector missing
 // an ellipse's stretch and its centre trade off, and bumps of clutter within the inlier band

@@ -23,7 +23,9 @@
 //      fit repeated.
 //   5b. (default) when an ellipse explains the rim's points significantly better than the circle
 //      and takes in at least its inliers (a tilted view: rim_ellipse.hpp), the rim is that
-//      ellipse; step 6 then fits the blurred disc in the coordinates that make it a circle.
+//      ellipse; step 6 then fits the blurred disc in the coordinates that make it a circle. An
+//      ellipse that the circle's band cannot hold but that is not measurable here (under 300
+//      degrees of it visible, flatter than a 60 degree view) refuses the rim (FitTooPoor).
 // RMS, roundness, inliers and coverage always describe the edge points of step 5 (5b).
 //
 // Failures are reported as a cause and a message (Status<CircleFailure>), never as a bogus

@@ -358,13 +358,14 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
                          cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
     if (samples.size() < 30) return std::nullopt;
   }
-  if (elliptic)  // the model's coordinates: the mapped offsets
+  if (elliptic) {  // the model's coordinates: the mapped offsets
+    if (samples.size() < 30) return std::nullopt;
     for (Sample& e : samples) {
       const cv::Vec2d mapped = toCircle * cv::Vec2d(e.column - centre.x, e.row - centre.y);
       e.x = mapped[0];
       e.y = mapped[1];
     }
-  if (samples.size() < 30) return std::nullopt;
+  }
   // Tukey's constant, in robust sigmas of the grey residuals. Once the pixels near foreign
   // gradients are out, what is left for the weight are gross outliers (the cores of blobs far
   // from the rim, an occluder's face), so it can be close to least squares: c = 8 keeps 99.4%
