@@ -6,10 +6,11 @@
 // The circle measurement's robust fit keeps the edge points within 0.5 px of its circle. On an
 // elliptic rim whose axes differ by more than that band it keeps the arcs one circle matches,
 // on one side, and its centre moves along the minor axis: on a 29 px hole viewed at 20 degrees
-// (axes 2.3 px apart) 2.4 px off, while an ellipse through all the rim's points is within
-// 0.02 px of the true ellipse's centre. Here: whether the rim is an ellipse (the circle's
-// residuals carry a significant second harmonic, and an ellipse explains at least the circle's
-// points significantly better), and that ellipse.
+// (semi-axes 2.3 px apart) 2.4 px off, while an ellipse through all the rim's points is within
+// 0.02 px of the true ellipse's centre. Here: the ellipse, its distance and normal, the map that
+// makes it a circle, and the tests that tell it from a circle (the second harmonic of the
+// circle's residuals, the F statistic of the ellipse against the circle); circle_measure.cpp
+// decides with them.
 
 #include <optional>
 #include <vector>
