@@ -106,6 +106,30 @@ TEST(RimEllipse, PointsOffTheRimOrAgainstItsNormalStayOut) {
   EXPECT_NEAR(fit->ellipse.centre.y(), truth.centre.y(), 0.01);
 }
 
+TEST(RimEllipse, DegeneratePointsGiveNoEllipse) {
+  // Collinear points, one point repeated, too few points, a hyperbola's branch: no ellipse, and
+  // nothing that is not a number.
+  std::vector<Eigen::Vector2d> line, same, few, hyperbola, normals;
+  for (int i = 0; i < 40; ++i) {
+    line.emplace_back(10.0 + i, 20.0 + 0.5 * i);
+    same.emplace_back(33.3, 44.4);
+    const double t = -1.0 + i / 20.0;
+    hyperbola.emplace_back(50.0 + 10.0 * std::cosh(t), 50.0 + 10.0 * std::sinh(t));
+    normals.emplace_back(1.0, 0.0);
+  }
+  few.assign(line.begin(), line.begin() + 5);
+  const double cosTol = std::cos(12 * kPi / 180);
+  EXPECT_FALSE(fitRimEllipse(line, normals, line, 0.5, cosTol));
+  EXPECT_FALSE(fitRimEllipse(same, normals, same, 0.5, cosTol));
+  EXPECT_FALSE(fitRimEllipse(few, normals, few, 0.5, cosTol));
+  const auto h = fitRimEllipse(hyperbola, normals, hyperbola, 0.5, cosTol);
+  if (h) {  // the best ellipse through a hyperbola's branch, if any, is a finite one
+    EXPECT_TRUE(std::isfinite(h->ellipse.major) && std::isfinite(h->ellipse.minor));
+    EXPECT_GE(h->ellipse.major, h->ellipse.minor);
+  }
+  EXPECT_EQ(secondHarmonicChiSquare(few, {{0, 0}, 1.0}), 0.0);
+}
+
 TEST(RimEllipse, TheSecondHarmonicTellsAnEllipseFromACircle) {
   // A round rim with noise: the statistic stays within chance (27.6 is exceeded once in a
   // million); the same rim 0.2 px elliptic (axes 30.1 and 29.9) is far beyond it.
