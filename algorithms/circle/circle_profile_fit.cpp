@@ -327,9 +327,17 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   }
   if (elliptic) {
     // The band about the elliptic rim (the image annulus holds it with margins) and, as for a
-    // circle, a big clean rim's narrower band in an evenly spread share of the bins.
+    // circle, a big clean rim's narrower band in an evenly spread share of the bins: judged on
+    // the offsets mapped once into the circle's coordinates.
+    for (Sample& e : samples) {
+      const cv::Vec2d mapped = toCircle * cv::Vec2d(e.x, e.y);
+      e.x = mapped[0];
+      e.y = mapped[1];
+    }
     auto outside = [&](double limit) {
-      return [&, limit](const Sample& e) { return std::abs(mappedDistance(e.x, e.y)) > limit; };
+      return [&, limit](const Sample& e) {
+        return std::abs(std::sqrt(e.x * e.x + e.y * e.y) - radius) > limit;
+      };
     };
     std::erase_if(samples, outside(halfBand));
     const double snr = noiseSigma > 0.0 ? p(7) / noiseSigma : 0.0;
@@ -346,7 +354,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     // rim: an offset along that normal (toCircle^T times the mapped offset; toCircle is
     // symmetric) as long as the mapped offset, the circle's radius plus that distance.
     for (Sample& e : samples) {
-      const cv::Vec2d mapped = toCircle * cv::Vec2d(e.x, e.y);
+      const cv::Vec2d mapped(e.x, e.y);
       const cv::Vec2d along = cv::normalize(toCircle * mapped) * cv::norm(mapped);
       e.x = along[0];
       e.y = along[1];

@@ -18,27 +18,27 @@ namespace {
 
 // The rim as the image shows it, for the overlay: 72 points of the circle in the plane mapped
 // into the image, or of the ellipse the image measured.
-std::vector<cv::Point2d> rimOutline(const WorldMapping& plane, const PlaneCircle& c) {
+template <typename PointAt>
+std::vector<cv::Point2d> rimOutline(PointAt pointAt) {
   std::vector<cv::Point2d> outline;
-  for (int i = 0; i < 72; ++i) {
-    const double t = 2.0 * CV_PI * i / 72;
-    outline.push_back(
-        plane.toImage(c.centreMm + c.diameterMm / 2 * cv::Point2d(std::cos(t), std::sin(t))));
-  }
+  for (int i = 0; i < 72; ++i) outline.push_back(pointAt(2.0 * CV_PI * i / 72));
   return outline;
+}
+
+std::vector<cv::Point2d> rimOutline(const WorldMapping& plane, const PlaneCircle& c) {
+  return rimOutline([&](double t) {
+    return plane.toImage(c.centreMm + c.diameterMm / 2 * cv::Point2d(std::cos(t), std::sin(t)));
+  });
 }
 
 std::vector<cv::Point2d> rimOutline(const CircleMeasurement& m) {
   // The major axis counter-clockwise on screen, y down.
   const double a = m.majorAxisDeg * CV_PI / 180;
   const cv::Point2d major(std::cos(a), -std::sin(a)), minor(-major.y, major.x);
-  std::vector<cv::Point2d> outline;
-  for (int i = 0; i < 72; ++i) {
-    const double t = 2.0 * CV_PI * i / 72;
-    outline.push_back(m.centre + m.majorDiameter / 2 * std::cos(t) * major +
-                      m.minorDiameter / 2 * std::sin(t) * minor);
-  }
-  return outline;
+  return rimOutline([&](double t) {
+    return m.centre + m.majorDiameter / 2 * std::cos(t) * major +
+           m.minorDiameter / 2 * std::sin(t) * minor;
+  });
 }
 
 }  // namespace
