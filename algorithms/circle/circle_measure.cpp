@@ -41,6 +41,19 @@ constexpr double kMinAxesRatio = 0.5;
 // r = 10 px and moved their centres by up to 0.5 px. On a nearly whole rim the second harmonic
 // is all but independent of the centre.
 constexpr double kMinEllipseCoverageDeg = 300.0;
+// The second harmonic's chi-square (2 degrees of freedom) in the grey-value fit beyond which the
+// rim is not round (fitRimGreyValues): chance alone exceeds it once in a million measurements.
+constexpr double kGreyEllipseChiSquare = 27.6;
+// How far from round (a Wald test, chi-square with 2 degrees of freedom) the grey values must
+// fit the ellipse of a partly hidden rim that the edge points found but could not accept, when
+// a circle's grey fit failed there: twice the limit above, since that ellipse's sectors can hold
+// clutter the grey fit's screens let pass. On bench_elliptic_rims' round rims of r = 10 px (30%
+// hidden, clutter blobs beside the rim) such ellipses reached 27; rims of axes 0.9 apart scored
+// 300 and more.
+constexpr double kPartialEllipseChiSquare = 55.2;
+// An ellipse's shape whose last grey-value step is still this far from zero (chi-square, 2
+// degrees of freedom: four standard deviations) has not converged: the rim is refused.
+constexpr double kUnsettledShapeChiSquare = 16.0;
 
 using circle_fit::Circle;
 using circle_fit::circleThrough;
@@ -219,6 +232,10 @@ std::vector<EdgePoint> foreignEdges(const std::vector<EdgePoint>& edges, double 
 struct RimShape {
   std::optional<rim_ellipse::Fit> fit;
   std::string refusal;
+  // `fit` is an ellipse that passed every test but the coverage: the grey values decide
+  // (fitRimGreyValues), `refusal` (or the circle, when empty) stands if they cannot.
+  bool partial = false;
+  [[nodiscard]] bool adopted() const { return fit && !partial; }
 };
 
 // The ellipse is the rim when it takes in at least the circle's points, explains them
@@ -242,19 +259,20 @@ RimShape rimShape(const std::vector<Eigen::Vector2d>& pts,
     if (!fit || fit->inliers.size() < in.size() || !(fit->fStatistic > kEllipseF)) return {};
     const rim_ellipse::Ellipse& e = fit->ellipse;
     const double coverage = coverageDeg(fit->inliers, Circle{e.centre, e.meanRadius()});
-    if (e.major <= params.radius + params.width && e.minor >= params.radius - params.width &&
-        (e.centre - c0).norm() <= params.width && e.minor >= kMinAxesRatio * e.major &&
-        coverage >= kMinEllipseCoverageDeg)
-      return {std::move(fit), ""};
+    const bool shapeFits =
+        e.major <= params.radius + params.width && e.minor >= params.radius - params.width &&
+        (e.centre - c0).norm() <= params.width && e.minor >= kMinAxesRatio * e.major;
+    if (shapeFits && coverage >= kMinEllipseCoverageDeg) return {std::move(fit), "", false};
+    const bool partial = shapeFits && coverage >= params.minCoverageDeg;
     // Refused only when the circle cannot have held this ellipse (its band of +-ransacThreshold
     // holds a rim whose axes differ by less than twice that) and the points it left out are as
     // many as a measurement needs: otherwise they are clutter the ellipse bent to (a round rim of
     // r = 10 px with clutter and an occluder in bench_circle: 9 points more, axes 1.3 px apart).
     const std::size_t more = fit->inliers.size() - in.size();
-    if (4 * more < in.size() || static_cast<int>(more) < params.minInliers ||
-        e.major - e.minor <= 2.0 * params.ransacThreshold)
-      return {};
-    return {std::nullopt,
+    const bool refuse = 4 * more >= in.size() && static_cast<int>(more) >= params.minInliers &&
+                        e.major - e.minor > 2.0 * params.ransacThreshold;
+    if (!refuse) return partial ? RimShape{std::move(fit), "", true} : RimShape{};
+    return {partial ? std::move(fit) : std::nullopt,
             cv::format("the rim is an ellipse (axes %.2f x %.2f px, %zu of its edge points, a "
                        "circle fits %zu) that this view does not let measure: %s",
                        2 * e.major, 2 * e.minor, fit->inliers.size(), in.size(),
@@ -262,15 +280,200 @@ RimShape rimShape(const std::vector<Eigen::Vector2d>& pts,
                            ? cv::format("its points cover %.0f degrees, less than %.0f", coverage,
                                         kMinEllipseCoverageDeg)
                                  .c_str()
-                           : "it is flatter than a view at 60 degrees or leaves the annulus")};
+                           : "it is flatter than a view at 60 degrees or leaves the annulus"),
+            partial};
   };
   RimShape shape =
       judge(rim_ellipse::fitRimEllipse(pts, normals, in, params.ransacThreshold, cosHyp));
   // Grown from a circle that locked onto one side of the rim, the ellipse can stay there; from
-  // all the rim's candidates it starts from the whole rim.
-  if (!shape.fit && shape.refusal.empty() && leftOut)
-    shape = judge(rim_ellipse::fitRimEllipse(pts, normals, pts, params.ransacThreshold, cosHyp));
+  // all the rim's candidates it starts from the whole rim. A partial ellipse gives way to a
+  // whole one or to one that takes in more points.
+  if (leftOut && !shape.adopted() && (shape.partial || shape.refusal.empty())) {
+    RimShape second = judge(rim_ellipse::fitRimEllipse(
+        pts, normals, rim_ellipse::ellipseConsensus(pts, normals, params.ransacThreshold, cosHyp),
+        params.ransacThreshold, cosHyp));
+    if (second.adopted() || !shape.fit ||
+        (second.fit && second.fit->inliers.size() > shape.fit->inliers.size()))
+      shape = std::move(second);
+  }
   return shape;
+}
+
+// The grey-value stage of a measurement: its fit, the rim's shape it was fitted with (an ellipse,
+// or none: a circle), the rim points that chose its sectors, and a refusal when the grey values
+// say the rim is not round and no ellipse fits them.
+struct GreyRim {
+  std::optional<CircleProfileFit> fit;
+  std::optional<rim_ellipse::Ellipse> shape;
+  std::vector<cv::Point2d> rim;
+  std::string refusal;
+};
+
+// The shape step's size in its own standard deviations, squared (a Wald statistic).
+double stepChiSquare(const CircleProfileFit& fit) {
+  return (fit.shapeStep.t() * fit.shapeInformation * fit.shapeStep)(0);
+}
+
+// A shape is settled when its next step moves the rim by less than 1e-3 px or by less than the
+// step's standard deviation. A big rim's fit keeps a share of its band's pixels, a different
+// share for each shape: there the steps stay at a standard deviation or so, each one a
+// different sample's noise (r = 100 px, axes 0.97 apart: 0.5 to 3 in chi-square, 5e-3 px).
+bool settled(const CircleProfileFit& fit) {
+  return fit.radius * cv::norm(fit.shapeStep) < 1e-3 || stepChiSquare(fit) < 1.0;
+}
+
+// The grey-value fit of a rim from `shape` (an ellipse, or none: a circle) and the rim points
+// `rim` that choose its sectors. The grey fit only uses the sectors the rim points cover, and
+// clutter that pulls the edge points' circle can push a clean arc of the rim out of the inliers
+// (or out as a stray arc): at r = 10 px a lost third of the rim cost 0.1 px. The grey fit is
+// several times more precise, so rim points within the RANSAC threshold of it are re-collected,
+// and the grey fit is repeated when they are more than before. An ellipse's shape is fitted to
+// the grey values too: the fit's step of the shape is taken and the fit repeated until the step
+// is settled (the edge points' ellipse on a partly hidden rim of r = 10 px was up to a pixel off
+// in its centre); a shape whose last step is still far beyond its noise
+// (kUnsettledShapeChiSquare) is refused. `judgeShape`: a circle's fit also tests for a second
+// harmonic.
+GreyRim fitGreyRim(const cv::Mat& image, const CircleMeasurement& m,
+                   const std::vector<Eigen::Vector2d>& rimCandidates, Circle around,
+                   std::optional<rim_ellipse::Ellipse> shape, std::vector<cv::Point2d> rim,
+                   bool judgeShape, const CircleMeasureParams& params, double cosTol) {
+  GreyRim best;
+  bool reshaped = false;
+  for (int round = 0, rounds = shape ? 8 : 2; round < rounds; ++round) {
+    const auto fit = fitCircleProfile(
+        image, {around.centre.x(), around.centre.y()}, around.radius, rim,
+        foreignEdges(m.annulusEdges, m.highThreshold, around, shape, m.rimSign, cosTol),
+        m.noiseSigma, reshaped ? 2.0 : 1.0, shape ? shape->toCircle() : cv::Matx22d::eye(),
+        judgeShape || shape.has_value());
+    if (!fit) break;
+    best = {fit, shape, rim, ""};
+    around = {Eigen::Vector2d{fit->centre.x, fit->centre.y}, fit->radius};
+    if (shape) {
+      const double scale = fit->radius / shape->meanRadius();
+      shape->centre = around.centre;
+      shape->major *= scale;
+      shape->minor *= scale;
+      best.shape = shape;
+    }
+    std::vector<cv::Point2d> collected;
+    for (const auto& p : rimCandidates)
+      if (std::abs(shape ? rim_ellipse::residual(*shape, p) : residual(around, p)) <=
+          params.ransacThreshold)
+        collected.emplace_back(p.x(), p.y());
+    const bool more = collected.size() > rim.size();
+    if (more) rim = std::move(collected);
+    const bool reshape = shape && !settled(*fit);
+    if (reshape) shape = rim_ellipse::reshaped(*shape, fit->shapeStep[0], fit->shapeStep[1]);
+    reshaped = reshaped || reshape;
+    if (!more && !reshape) return best;
+  }
+  if (best.shape && stepChiSquare(*best.fit) > kUnsettledShapeChiSquare)
+    best.refusal = cv::format(
+        "the rim's grey values fit no ellipse: its shape did not settle (the last step moved "
+        "the rim by %.3f px, %.1f of its standard deviations)",
+        best.fit->radius * cv::norm(best.fit->shapeStep), std::sqrt(stepChiSquare(*best.fit)));
+  return best;
+}
+
+// The grey-value stage of a measurement (fitGreyRim) with its judgement of the rim's shape
+// (`judgeShape`). The edge points' ellipse, if they found one (`ellipse`), is fitted as such.
+// Else the circle is fitted, and a second harmonic in its fit (CircleProfileFit::secondHarmonic
+// beyond kGreyEllipseChiSquare; on bench_circle's round rims, both blur models, every case, its
+// chi-square stayed below 16 in 2,460 measurements) makes the rim an ellipse, refined in the
+// grey values from the circle's fit's own step and from the ellipse the edge points fitted
+// significantly better than the circle but could not accept (a sector of the rim hidden:
+// `candidate`); of the two, the one more of the rim's edge points lie on is kept. Without a
+// candidate the ellipse is kept only on a nearly whole rim (kMinEllipseCoverageDeg: on part of a
+// rim an ellipse's stretch and centre trade off). When no ellipse is kept the rim is refused.
+// When the circle's fit fails, the candidate is fitted instead and kept if the grey values fit
+// it clearly not round (kPartialEllipseChiSquare).
+GreyRim fitRimGreyValues(const cv::Mat& image, const CircleMeasurement& m,
+                         const std::vector<Eigen::Vector2d>& rimCandidates, const Circle& circle,
+                         const std::optional<rim_ellipse::Ellipse>& ellipse,
+                         const std::optional<rim_ellipse::Fit>& candidate, bool judgeShape,
+                         const CircleMeasureParams& params, double cosTol) {
+  auto fit = [&](const Circle& around, const std::optional<rim_ellipse::Ellipse>& shape,
+                 std::vector<cv::Point2d> rim) {
+    return fitGreyRim(image, m, rimCandidates, around, shape, std::move(rim), judgeShape, params,
+                      cosTol);
+  };
+  if (ellipse || !judgeShape) return fit(circle, ellipse, m.inlierPoints);
+  auto fromCandidate = [&] {
+    std::vector<cv::Point2d> rim;
+    for (const auto& p : candidate->inliers) rim.emplace_back(p.x(), p.y());
+    const rim_ellipse::Ellipse& e = candidate->ellipse;
+    return fit({e.centre, e.meanRadius()}, e, std::move(rim));
+  };
+  GreyRim round = fit(circle, std::nullopt, m.inlierPoints);
+  if (!round.fit) {
+    if (!candidate) return round;
+    GreyRim oval = fromCandidate();
+    if (!oval.fit || !oval.refusal.empty()) return round;
+    const cv::Vec2d v = rim_ellipse::stretchOf(*oval.shape);
+    return (v.t() * oval.fit->shapeInformation * v)(0) > kPartialEllipseChiSquare ? oval : round;
+  }
+  if (!(round.fit->secondHarmonic > kGreyEllipseChiSquare)) return round;
+  // The ellipse from the circle's fit's step, and from the candidate when there is one: each
+  // start has its own basins (r = 10 px, 30% hidden: the candidate's shape a pixel off at axes
+  // 0.97 apart, the step's at 0.9), so both are refined and the one that more of the rim's edge
+  // points lie on is kept.
+  auto support = [&](const GreyRim& oval) -> std::vector<Eigen::Vector2d> {
+    std::vector<Eigen::Vector2d> on;
+    if (oval.fit)
+      for (const auto& p : rimCandidates)
+        if (std::abs(rim_ellipse::residual(*oval.shape, p)) <= params.ransacThreshold)
+          on.push_back(p);
+    return on;
+  };
+  const cv::Vec2d step = round.fit->shapeStep;
+  const Circle fitted{{round.fit->centre.x, round.fit->centre.y}, round.fit->radius};
+  GreyRim oval =
+      fit(fitted,
+          rim_ellipse::reshaped({fitted.centre, fitted.radius, fitted.radius, {1.0, 0.0}}, step[0],
+                                step[1]),
+          round.rim);
+  std::vector<Eigen::Vector2d> on = support(oval);
+  if (candidate) {
+    GreyRim other = fromCandidate();
+    std::vector<Eigen::Vector2d> onOther = support(other);
+    if (onOther.size() > on.size()) {
+      oval = std::move(other);
+      on = std::move(onOther);
+    }
+    if (oval.fit) return oval;
+  } else if (oval.fit && coverageDeg(on, {oval.shape->centre, oval.shape->meanRadius()}) >=
+                             kMinEllipseCoverageDeg) {
+    return oval;
+  }
+  round.refusal = cv::format(
+      "the rim's grey values are not those of a circle (their second harmonic's chi-square "
+      "%.0f, more than %.1f) and no ellipse fitted to them could be kept",
+      round.fit->secondHarmonic, kGreyEllipseChiSquare);
+  return round;
+}
+
+// The rim's points and what they say of its fit: inliers, RMS from the rim's shape (the
+// ellipse's, else the circle's), roundness (radial, about the circle), coverage (from `angles`,
+// the inliers' sorted angles about the circle, when they are at hand) and the centre.
+void describeRim(CircleMeasurement& m, const std::vector<Eigen::Vector2d>& in, const Circle& circle,
+                 const std::optional<rim_ellipse::Ellipse>& ellipse,
+                 const std::vector<double>* angles) {
+  m.inliers = static_cast<int>(in.size());
+  m.inlierPoints.clear();
+  m.inlierPoints.reserve(in.size());
+  double sum2 = 0, lo = 0, hi = 0;
+  for (const auto& p : in) {
+    const double r = residual(circle, p);  // radial: the roundness
+    const double off = ellipse ? rim_ellipse::residual(*ellipse, p) : r;
+    sum2 += off * off;
+    lo = std::min(lo, r);
+    hi = std::max(hi, r);
+    m.inlierPoints.emplace_back(p.x(), p.y());
+  }
+  m.rms = in.empty() ? 0.0 : std::sqrt(sum2 / static_cast<double>(in.size()));
+  m.roundness = hi - lo;
+  m.coverageDeg = angles ? coverageDeg(*angles, circle.radius) : coverageDeg(in, circle);
+  m.centre = {circle.centre.x(), circle.centre.y()};
 }
 
 // Edge point relative to the expected centre, with its radial alignment.
@@ -422,35 +625,23 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   // the arcs it matches, on one side, and its centre moves along the minor axis (rim_ellipse.hpp).
   // Its centre and the circle of its area are then the result.
   std::optional<rim_ellipse::Ellipse> ellipse;
+  std::optional<rim_ellipse::Fit> candidate;  // for the grey values to judge
   std::string ellipseRefusal;
   if (params.measureEllipticRims) {
     RimShape shape = rimShape(rimCandidates, bestNormals, in, *fitted, params, cosHyp);
-    if (shape.fit) {
+    if (shape.adopted()) {
       ellipse = shape.fit->ellipse;
       in = std::move(shape.fit->inliers);
+    } else if (shape.partial) {
+      candidate = std::move(shape.fit);
     }
     ellipseRefusal = std::move(shape.refusal);
   }
   const Circle circle = ellipse ? Circle{ellipse->centre, ellipse->meanRadius()} : *fitted;
-  m.inliers = static_cast<int>(in.size());
   m.annulusEdges = std::move(edges.points);
   m.rimSign = rimSign;
   m.noiseSigma = edges.noiseSigma;
-  m.inlierPoints.reserve(in.size());
-  double sum2 = 0, lo = 0, hi = 0;
-  for (const auto& p : in) {
-    const double r = residual(circle, p);  // radial: the roundness
-    const double off = ellipse ? rim_ellipse::residual(*ellipse, p) : r;
-    sum2 += off * off;
-    lo = std::min(lo, r);
-    hi = std::max(hi, r);
-    m.inlierPoints.emplace_back(p.x(), p.y());
-  }
-  m.rms = in.empty() ? 0.0 : std::sqrt(sum2 / static_cast<double>(in.size()));
-  m.roundness = hi - lo;
-  m.coverageDeg =
-      anglesFinal && !ellipse ? coverageDeg(angles, circle.radius) : coverageDeg(in, circle);
-  m.centre = {circle.centre.x(), circle.centre.y()};
+  describeRim(m, in, circle, ellipse, anglesFinal && !ellipse ? &angles : nullptr);
   const double bias = params.correctRadiusBias ? params.radiusBiasK / circle.radius : 0.0;
   m.radius = circle.radius + bias;
   m.diameter = 2.0 * m.radius;
@@ -459,55 +650,67 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
     return failed(m, CircleFailure::TooFewPoints,
                   std::to_string(m.inliers) + " inliers, fewer than the " +
                       std::to_string(params.minInliers) + " required");
-  if (!ellipseRefusal.empty()) return failed(m, CircleFailure::FitTooPoor, ellipseRefusal);
-  if (m.coverageDeg < params.minCoverageDeg)
-    return failed(m, CircleFailure::CoverageTooSmall,
-                  "the inliers cover " + readable(m.coverageDeg) + " degrees, less than " +
-                      readable(params.minCoverageDeg));
-  if (m.rms > params.maxRms)
-    return failed(m, CircleFailure::FitTooPoor,
-                  "the fit's rms " + readable(m.rms) + " px exceeds " + readable(params.maxRms));
+  // An ellipse the edge points alone cannot judge waits for the grey values' judgement.
+  const bool greyJudge = params.refineWithGreyValues && params.measureEllipticRims;
+  const bool judgedByGrey = candidate && greyJudge;
+  if (!ellipseRefusal.empty() && !judgedByGrey)
+    return failed(m, CircleFailure::FitTooPoor, ellipseRefusal);
+  auto rimFails = [&]() -> std::optional<CircleMeasurement> {
+    if (m.coverageDeg < params.minCoverageDeg)
+      return failed(m, CircleFailure::CoverageTooSmall,
+                    "the inliers cover " + readable(m.coverageDeg) + " degrees, less than " +
+                        readable(params.minCoverageDeg));
+    if (m.rms > params.maxRms)
+      return failed(m, CircleFailure::FitTooPoor,
+                    "the fit's rms " + readable(m.rms) + " px exceeds " + readable(params.maxRms));
+    return std::nullopt;
+  };
+  if (!judgedByGrey)
+    if (auto fails = rimFails()) return std::move(*fails);
 
   if (params.refineWithGreyValues) {
-    const cv::Matx22d toCircle = ellipse ? ellipse->toCircle() : cv::Matx22d::eye();
-    auto fine = fitCircleProfile(
-        image, m.centre, circle.radius, m.inlierPoints,
-        foreignEdges(m.annulusEdges, m.highThreshold, circle, ellipse, rimSign, cosTol),
-        edges.noiseSigma, 1.0, toCircle);
-    // The grey fit only uses the sectors the inliers cover, and clutter that pulls the edge
-    // points' circle can push a clean arc of the rim out of the inliers (or out as a stray arc):
-    // at r = 10 px a lost third of the rim cost 0.1 px. The grey fit is several times more
-    // precise, so rim points within the RANSAC threshold of it are re-collected, and the grey
-    // fit is repeated when they are more than the inliers.
-    if (fine) {
-      const Circle refined{Eigen::Vector2d{fine->centre.x, fine->centre.y}, fine->radius};
-      std::optional<rim_ellipse::Ellipse> refinedEllipse = ellipse;
-      if (ellipse) {
-        const double scale = fine->radius / ellipse->meanRadius();
-        refinedEllipse->centre = refined.centre;
-        refinedEllipse->major *= scale;
-        refinedEllipse->minor *= scale;
+    const GreyRim grey = fitRimGreyValues(image, m, rimCandidates, circle, ellipse, candidate,
+                                          params.measureEllipticRims, params, cosTol);
+    if (!grey.refusal.empty()) return failed(m, CircleFailure::FitTooPoor, grey.refusal);
+    if (grey.fit) {
+      ellipseRefusal.clear();  // the grey values judged the rim
+      if (grey.shape && !ellipse) {
+        // The rim became an ellipse in the grey values: its points are the ellipse's.
+        std::vector<Eigen::Vector2d> onEllipse;
+        for (const auto& p : rimCandidates)
+          if (std::abs(rim_ellipse::residual(*grey.shape, p)) <= params.ransacThreshold)
+            onEllipse.push_back(p);
+        describeRim(m, onEllipse, {grey.shape->centre, grey.shape->meanRadius()}, grey.shape,
+                    nullptr);
       }
-      std::vector<cv::Point2d> rim;
-      for (const auto& p : rimCandidates)
-        if (std::abs(ellipse ? rim_ellipse::residual(*refinedEllipse, p) : residual(refined, p)) <=
-            params.ransacThreshold)
-          rim.emplace_back(p.x(), p.y());
-      if (rim.size() > m.inlierPoints.size())
-        if (auto again = fitCircleProfile(image, fine->centre, fine->radius, rim,
-                                          foreignEdges(m.annulusEdges, m.highThreshold, refined,
-                                                       refinedEllipse, rimSign, cosTol),
-                                          edges.noiseSigma, 1.0, toCircle))
-          fine = again;
-    }
-    if (fine) {
-      m.centre = fine->centre;
-      m.radius = fine->radius;
+      ellipse = grey.shape;
+      if (judgedByGrey)
+        if (auto fails = rimFails()) return std::move(*fails);
+      m.centre = grey.fit->centre;
+      m.radius = grey.fit->radius;
       m.diameter = 2.0 * m.radius;
-      m.blur = fine->blur;
+      m.blur = grey.fit->blur;
       m.greyRefined = true;
     }
   }
+  if (!ellipseRefusal.empty()) return failed(m, CircleFailure::FitTooPoor, ellipseRefusal);
+  if (judgedByGrey && !m.greyRefined)
+    return failed(
+        m, CircleFailure::FitTooPoor,
+        cv::format("the rim's edge points fit an ellipse (axes %.2f x %.2f px) better than a "
+                   "circle, on too little of the rim to accept it, and no grey-value fit told "
+                   "which it is",
+                   2 * candidate->ellipse.major, 2 * candidate->ellipse.minor));
+  // The edge points' tests of an ellipse (rimShape), for one the grey values made.
+  if (ellipse && (ellipse->minor < kMinAxesRatio * ellipse->major ||
+                  ellipse->major > params.radius + params.width ||
+                  ellipse->minor < params.radius - params.width))
+    return failed(m, CircleFailure::FitTooPoor,
+                  cv::format("the rim is an ellipse (axes %.2f x %.2f px) %s", 2 * ellipse->major,
+                             2 * ellipse->minor,
+                             ellipse->minor < kMinAxesRatio * ellipse->major
+                                 ? "flatter than a view at 60 degrees"
+                                 : "that leaves the search annulus"));
   // The axes, scaled as the radius was from the ellipse's mean (the edge points' bias, the grey
   // fit); both the diameter on a round rim.
   m.majorDiameter = m.minorDiameter = m.diameter;

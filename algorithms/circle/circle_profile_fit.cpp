@@ -162,7 +162,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
                                                  const std::vector<cv::Point2d>& rimPoints,
                                                  const std::vector<EdgePoint>& foreignPoints,
                                                  double noiseSigma, double maxShift,
-                                                 const cv::Matx22d& toCircle) {
+                                                 const cv::Matx22d& toCircle, bool fitRimShape) {
   if (image.empty() || radius <= 1.0 || rimPoints.size() < 3) return std::nullopt;
 
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
@@ -594,6 +594,52 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   fit.radius = p(2) + blur * blur / (2.0 * p(2));
   fit.noise = sigma;
   fit.pixels = static_cast<int>(samples.size());
+  if (fitRimShape) {
+    // |exp(S) u| = rho + (a (x^2 - y^2) + 2 c x y) / rho to first order: the columns of a and c
+    // are d/drho's (minus d/dR's) times those factors. Their score and step against the free
+    // parameters' fit, the latter's block eliminated (the Schur complement), as the ramp's above:
+    // the block is the last step's and the free parameters' own score is taken as zero (the
+    // solve has converged), so that one pass over the band computes the rest.
+    Eigen::VectorXd harmonicA(static_cast<Eigen::Index>(m)), harmonicC(harmonicA.size());
+    for (Eigen::Index i = 0; i < harmonicA.size(); ++i) {
+      const double ex = px(i) - p(0), ey = py(i) - p(1);
+      const double perRho = -jac(i, 2) / std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
+      harmonicA(i) = perRho * (ex * ex - ey * ey);
+      harmonicC(i) = perRho * 2.0 * ex * ey;
+    }
+    const std::array<int, 8> free{0, 1, 2, 3, 4, 7, 5, 6};
+    const int k = withRamp ? 8 : 6;
+    Eigen::MatrixXd hho(2, k), hoo(k, k);
+    Eigen::Vector2d score;
+    Eigen::Matrix2d hhh;
+    // At most 8 columns a pass: the harmonics and six of the others, then the ramp's two.
+    for (int first = 0; first < k; first += 6) {
+      const int count = std::min(6, k - first);
+      std::array<const double*, 8> columns{harmonicA.data(), harmonicC.data()};
+      for (int v = 0; v < count; ++v) columns[2 + v] = jac.col(free[first + v]).data();
+      std::array<double, 64> h{};
+      std::array<double, 8> g{};
+      const auto width = static_cast<std::size_t>(2 + count);
+      weightedNormalEquationsLeadingPair({columns.data(), width}, weight.data(), r.data(),
+                                         static_cast<std::ptrdiff_t>(m), h.data(), g.data());
+      for (int u = 0; u < 2; ++u) {
+        score(u) = g[u];
+        for (int v = 0; v < 2; ++v) hhh(u, v) = h[u * width + v];
+        for (int v = 0; v < count; ++v) hho(u, first + v) = h[u * width + 2 + v];
+      }
+    }
+    for (int u = 0; u < k; ++u)
+      for (int v = 0; v < k; ++v) hoo(u, v) = jtj(free[u], free[v]);
+    const Eigen::Matrix2d schur = hhh - hho * hoo.ldlt().solve(hho.transpose());
+    const Eigen::Vector2d step = schur.ldlt().solve(score);
+    const double variance = std::max(sigma * sigma, 1e-12);
+    fit.secondHarmonic = score.dot(step) / variance;
+    if (step.allFinite()) {
+      fit.shapeStep = {step(0), step(1)};
+      fit.shapeInformation = {schur(0, 0) / variance, schur(0, 1) / variance,
+                              schur(1, 0) / variance, schur(1, 1) / variance};
+    }
+  }
   return fit;
 }
 

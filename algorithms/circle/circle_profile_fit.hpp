@@ -29,6 +29,7 @@
 // Gaussian misfits it by several grey levels at high contrast. `blur` reports the equivalent
 // Gaussian sqrt(s^2 + 1/12) either way.
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -44,6 +45,15 @@ struct CircleProfileFit {
   double blur = 0.0;    // fitted s (the equivalent Gaussian, PSF and pixel together), pixels
   double noise = 0.0;   // robust sigma of the grey residuals, grey levels (8-bit scale)
   int pixels = 0;       // pixels used
+  // Only when asked for (fitRimShape), else NaN and zero. The rim's distance from the centre
+  // with a second harmonic, in the model's coordinates u (the mapped offsets): |exp(S) u| with
+  // S = [[a, c], [c, -a]], an ellipse close to the fitted circle. `secondHarmonic`: the score
+  // test of (a, c) at this fit, chi-square with 2 degrees of freedom; `shapeStep`: their
+  // Gauss-Newton step (a, c) with the other parameters fitted along; `shapeInformation`: the
+  // inverse of that step's covariance (a Wald test of a shape v: v^T shapeInformation v).
+  double secondHarmonic = std::numeric_limits<double>::quiet_NaN();
+  cv::Vec2d shapeStep{0.0, 0.0};
+  cv::Matx22d shapeInformation = cv::Matx22d::zeros();
 };
 
 // `image`: CV_8UC1 or CV_16UC1. `centre`, `radius`: the geometric fit of the edge points.
@@ -61,11 +71,17 @@ struct CircleProfileFit {
 // radius of the circle of the rim's area. The map changes the blur across the rim by the square
 // root of the axes' ratio either way (4% at axes 0.92 apart): a second harmonic around the rim,
 // which leaves the centre alone. Identity (the default): a circle, as above.
+//
+// `fitRimShape`: also test the fitted rim for a second harmonic and give the step that fits it
+// (CircleProfileFit::secondHarmonic, shapeStep): the grey values' own judgement of whether the
+// rim is an ellipse, and of which, far more sensitive than the edge points' (the pixels near the
+// rim weigh in) and blind to the pixels screened out as clutter. One more pass over the band.
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
                                                  double radius,
                                                  const std::vector<cv::Point2d>& rimPoints,
                                                  const std::vector<EdgePoint>& foreignPoints = {},
                                                  double noiseSigma = 0.0, double maxShift = 1.0,
-                                                 const cv::Matx22d& toCircle = cv::Matx22d::eye());
+                                                 const cv::Matx22d& toCircle = cv::Matx22d::eye(),
+                                                 bool fitRimShape = false);
 
 }  // namespace facet

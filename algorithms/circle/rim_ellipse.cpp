@@ -6,6 +6,8 @@
 
 #include <Eigen/Dense>
 
+#include "algorithms/geometry/ransac.hpp"
+
 namespace facet::rim_ellipse {
 namespace {
 
@@ -122,6 +124,29 @@ cv::Matx22d Ellipse::toCircle() const {
           along * s * s + across * c * c};
 }
 
+Ellipse reshaped(const Ellipse& e, double a, double c) {
+  // exp(S) = cosh t I + sinh t / t S, t = sqrt(a^2 + c^2) (S^2 = t^2 I); its determinant is 1.
+  const double t = std::hypot(a, c);
+  const double ch = std::cosh(t), sh = t > 1e-12 ? std::sinh(t) / t : 1.0;
+  Eigen::Matrix2d step, map;
+  step << ch + sh * a, sh * c, sh * c, ch - sh * a;
+  const cv::Matx22d m = e.toCircle();
+  map << m(0, 0), m(0, 1), m(1, 0), m(1, 1);
+  // The symmetric factor of step * map: the square root of (step map)^T (step map). Its smaller
+  // eigenvalue's direction is shrunk most on the way to the circle: the major axis.
+  const Eigen::Matrix2d product = step * map;
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> gram(product.transpose() * product);
+  const double shrink = std::sqrt(gram.eigenvalues()(0)), grow = std::sqrt(gram.eigenvalues()(1));
+  const double radius = e.meanRadius();  // shrink * grow = 1: the map keeps areas
+  return {e.centre, radius / shrink, radius / grow, gram.eigenvectors().col(0).normalized()};
+}
+
+cv::Vec2d stretchOf(const Ellipse& e) {
+  // toCircle's eigenvalues: sqrt(minor / major) along the major axis, its inverse across.
+  const double along = 0.5 * std::log(e.minor / e.major), c = e.axis.x(), s = e.axis.y();
+  return {along * (c * c - s * s), along * 2.0 * c * s};
+}
+
 double residual(const Ellipse& e, const Eigen::Vector2d& p) {
   const Level l = levelAt(e, p);
   return distanceOf(l, l.gradient.norm());
@@ -205,6 +230,36 @@ std::optional<Fit> fitRimEllipse(const std::vector<Eigen::Vector2d>& pts,
   }
   fit.inliers = std::move(fitted);
   return fit;
+}
+
+std::vector<Eigen::Vector2d> ellipseConsensus(const std::vector<Eigen::Vector2d>& pts,
+                                              const std::vector<Eigen::Vector2d>& normals,
+                                              double threshold, double cosTolerance) {
+  constexpr std::size_t kSample = 6;  // the direct fit's least number of points
+  std::vector<Eigen::Vector2d> sample(kSample);
+  auto agrees = [&](const Ellipse& e, std::size_t i) {
+    const Level l = levelAt(e, pts[i]);
+    const double length = l.gradient.norm();
+    return normals[i].dot(l.gradient) >= cosTolerance * length ? std::abs(distanceOf(l, length))
+                                                               : HUGE_VAL;
+  };
+  auto fit = [&](const std::vector<std::size_t>& drawn) -> std::optional<Ellipse> {
+    for (std::size_t k = 0; k < kSample; ++k) sample[k] = pts[drawn[k]];
+    std::optional<Ellipse> e = fitEllipse(sample);
+    // A sample whose own points' gradients the ellipse does not follow is not the rim.
+    if (e)
+      for (std::size_t k : drawn)
+        if (!(agrees(*e, k) <= threshold)) return std::nullopt;
+    return e;
+  };
+  RansacParams params;
+  params.inlierThreshold = threshold;
+  params.maxIterations = 300;
+  const auto found = ransac<Ellipse>(pts.size(), kSample, fit, agrees, params);
+  std::vector<Eigen::Vector2d> consensus;
+  if (!found || found->inliers.size() < kSample) return consensus;
+  for (std::size_t i : found->inliers) consensus.push_back(pts[i]);
+  return consensus;
 }
 
 }  // namespace facet::rim_ellipse

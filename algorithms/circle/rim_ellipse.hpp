@@ -34,6 +34,15 @@ struct Ellipse {
   [[nodiscard]] cv::Matx22d toCircle() const;
 };
 
+// The ellipse whose map to the circle is exp(S) toCircle() (made symmetric again: a rotation
+// after it leaves every mapped distance as it is), S = [[a, c], [c, -a]]: `e` reshaped by a
+// step of the grey-value fit (CircleProfileFit::shapeStep). Same centre and mean radius.
+Ellipse reshaped(const Ellipse& e, double a, double c);
+
+// The (a, c) of exp([[a, c], [c, -a]]) = e.toCircle(): how far the ellipse is from round, in
+// the parameters of reshaped (zero for a circle).
+cv::Vec2d stretchOf(const Ellipse& e);
+
 // Signed distance of p from the ellipse, positive outside; first order in the distance (the
 // ellipse's implicit function over its gradient), exact on the axes.
 double residual(const Ellipse& e, const Eigen::Vector2d& p);
@@ -65,5 +74,15 @@ std::optional<Fit> fitRimEllipse(const std::vector<Eigen::Vector2d>& pts,
                                  const std::vector<Eigen::Vector2d>& normals,
                                  const std::vector<Eigen::Vector2d>& seed, double threshold,
                                  double cosTolerance);
+
+// A seed for fitRimEllipse where no circle's points make one: the points of `pts` (as there)
+// that agree with the best of ellipses through random sets of six of them (RANSAC, adaptive, at
+// most 300 sets). A circle locked onto arcs of a partly hidden elliptic rim, or all the rim's
+// candidates with an occluder's border among them, can grow into an ellipse that holds only
+// part of the rim; the consensus of sampled ellipses starts on the whole visible rim. Empty
+// when no sampled ellipse takes in six points.
+std::vector<Eigen::Vector2d> ellipseConsensus(const std::vector<Eigen::Vector2d>& pts,
+                                              const std::vector<Eigen::Vector2d>& normals,
+                                              double threshold, double cosTolerance);
 
 }  // namespace facet::rim_ellipse

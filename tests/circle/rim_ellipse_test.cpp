@@ -1,5 +1,6 @@
 // The elliptic rim: the ellipse grown from the arcs a circle kept, its distance and normal, the
 // map that makes it a circle, and the second-harmonic test that tells an ellipse from a circle.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -138,6 +139,72 @@ TEST(RimEllipse, TheSecondHarmonicTellsAnEllipseFromACircle) {
   const circle_fit::Circle circle{{100.3, 90.8}, 30.0};
   EXPECT_LT(secondHarmonicChiSquare(rimOf(round, 180).points, circle), 27.6);
   EXPECT_GT(secondHarmonicChiSquare(rimOf(oval, 180).points, circle), 100.0);
+}
+
+TEST(RimEllipse, ReshapingComposesWithTheMapAndItsStretchUndoesIt) {
+  // A circle reshaped by (a, c) has exactly that stretch; an ellipse reshaped by minus its own
+  // stretch is the circle of its area, about the same centre.
+  const Ellipse circle{{50.5, 60.25}, 20.0, 20.0, {1.0, 0.0}};
+  const Ellipse e = reshaped(circle, 0.03, -0.02);
+  const cv::Vec2d v = stretchOf(e);
+  EXPECT_NEAR(v[0], 0.03, 1e-12);
+  EXPECT_NEAR(v[1], -0.02, 1e-12);
+  EXPECT_NEAR(e.meanRadius(), 20.0, 1e-12);
+  EXPECT_GT(e.major, e.minor);
+  const Ellipse t = tilted();
+  const cv::Vec2d s = stretchOf(t);
+  const Ellipse back = reshaped(t, -s[0], -s[1]);
+  EXPECT_NEAR(back.major, t.meanRadius(), 1e-9);
+  EXPECT_NEAR(back.minor, t.meanRadius(), 1e-9);
+  EXPECT_EQ(back.centre, t.centre);
+  // Reshaping by nothing changes nothing.
+  const Ellipse same = reshaped(t, 0.0, 0.0);
+  EXPECT_NEAR(same.major, 30.0, 1e-9);
+  EXPECT_NEAR(same.minor, 27.0, 1e-9);
+  EXPECT_NEAR(std::abs(same.axis.dot(t.axis)), 1.0, 1e-12);
+}
+
+TEST(RimEllipse, TheConsensusOfSampledEllipsesKeepsTheRimBesideABorderAndClutter) {
+  // 70% of the rim visible (what an occluding strip leaves), the strip's straight border with
+  // gradients pointing away from the centre, clutter points scattered over the annulus: the
+  // consensus holds the visible rim and nothing else.
+  const Ellipse truth = tilted();
+  Rim rim;
+  {
+    const Rim whole = rimOf(truth, 360);
+    for (std::size_t i = 0; i < whole.points.size(); ++i)
+      if (i < 252) {
+        rim.points.push_back(whole.points[i]);
+        rim.normals.push_back(whole.normals[i]);
+      }
+  }
+  const std::size_t onRim = rim.points.size();
+  const Eigen::Vector2d along = truth.axis, across{-truth.axis.y(), truth.axis.x()};
+  for (int i = -20; i <= 20; ++i) {  // the border, 24 px from the centre
+    rim.points.push_back(truth.centre - 24.0 * along + 0.7 * i * across);
+    rim.normals.push_back(-along);
+  }
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int i = 0; i < 60; ++i) {
+    const double a = 2 * kPi * u(rng), r = 22.0 + 12.0 * u(rng), g = 2 * kPi * u(rng);
+    rim.points.push_back(truth.centre + r * Eigen::Vector2d(std::cos(a), std::sin(a)));
+    rim.normals.emplace_back(std::cos(g), std::sin(g));
+  }
+  const auto consensus = ellipseConsensus(rim.points, rim.normals, 0.5, std::cos(12 * kPi / 180));
+  std::size_t fromRim = 0, other = 0;
+  for (const auto& p : consensus) {
+    const auto it = std::find(rim.points.begin(), rim.points.end(), p);
+    (static_cast<std::size_t>(it - rim.points.begin()) < onRim ? fromRim : other) += 1;
+  }
+  EXPECT_GE(fromRim, onRim * 95 / 100);
+  EXPECT_LE(other, 3u);  // a clutter point can fall within 0.5 px of the rim by chance
+  const auto fit = fitRimEllipse(rim.points, rim.normals, consensus, 0.5, std::cos(12 * kPi / 180));
+  ASSERT_TRUE(fit);
+  EXPECT_NEAR(fit->ellipse.centre.x(), truth.centre.x(), 0.02);
+  EXPECT_NEAR(fit->ellipse.centre.y(), truth.centre.y(), 0.02);
+  EXPECT_NEAR(fit->ellipse.major, 30.0, 0.02);
+  EXPECT_NEAR(fit->ellipse.minor, 27.0, 0.02);
 }
 
 }  // namespace
