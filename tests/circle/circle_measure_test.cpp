@@ -201,28 +201,30 @@ TEST(CircleMeasure, FitTooPoorOnAWavyRim) {
   EXPECT_LT(loose.roundness, 3.5);
 }
 
-TEST(CircleMeasure, AnEllipticRimIsMeasuredAsItsEllipse) {
-  // A hole of radius 30 px on a plane viewed at a tilt of about 26 degrees: an ellipse with axes
-  // 30 and 27 px. A circle's 0.5 px band keeps the arcs that one circle matches, on one side.
+// A hole of radius 30 px on a plane viewed at a tilt of about 26 degrees: an ellipse with axes
+// 30 and 27 px, the major one 25 degrees clockwise on screen, about `c`; with `hidden`, a strip
+// over a third of it.
+cv::Mat tiltedHole(cv::Point2d c, bool hidden) {
   Scene s(spec(120, 190));
-  const cv::Point2d c{60.37, 58.81};
   s.addPolygon(ellipseOutline(c, 30.0, 27.0, 25.0), 60.0);
-  const cv::Mat image = s.render();
-  auto p = params(c + cv::Point2d(1.0, -0.7), 28.5, CirclePolarity::DarkToLight);
-  const auto m = measureCircle(image, p);
+  if (hidden) s.addPolygon({{0, 0}, {c.x - 12, 0}, {c.x - 12, 120}, {0, 120}}, 130.0, "occluder");
+  return s.render();
+}
+
+// The tilted hole measured as its ellipse, centre within `tolerance` px.
+void expectTheTiltedHole(const CircleMeasurement& m, cv::Point2d c, double tolerance) {
   ASSERT_TRUE(m.status.ok()) << m.status.message;
   EXPECT_TRUE(m.elliptic);
   EXPECT_TRUE(m.greyRefined);
-  EXPECT_NEAR(m.centre.x, c.x, 0.02);
-  EXPECT_NEAR(m.centre.y, c.y, 0.02);
-  EXPECT_NEAR(m.radius, std::sqrt(30.0 * 27.0), 0.05);  // the circle of the ellipse's area
+  EXPECT_NEAR(m.centre.x, c.x, tolerance);
+  EXPECT_NEAR(m.centre.y, c.y, tolerance);
   EXPECT_NEAR(m.majorDiameter, 60.0, 0.1);
   EXPECT_NEAR(m.minorDiameter, 54.0, 0.1);
   EXPECT_NEAR(m.majorAxisDeg, 155.0, 0.5);  // 25 degrees clockwise on screen
-  EXPECT_NEAR(m.roundness, 3.0, 0.3);       // the axes' difference
-  EXPECT_LT(m.rms, 0.1);                    // from the ellipse
-  EXPECT_GT(m.coverageDeg, 350.0);
-  // As a circle, the same rim's centre is off by a pixel or more along the minor axis.
+}
+
+// The circle model (measureEllipticRims off) on the tilted hole: refused, or off the centre.
+void expectTheCircleModelOff(const cv::Mat& image, CircleMeasureParams p, cv::Point2d c) {
   p.measureEllipticRims = false;
   const auto round = measureCircle(image, p);
   if (round.status.ok()) {
@@ -231,33 +233,33 @@ TEST(CircleMeasure, AnEllipticRimIsMeasuredAsItsEllipse) {
   }
 }
 
-TEST(CircleMeasure, AnEllipticRimWithASectorHiddenIsMeasuredAsItsEllipse) {
-  // The tilted hole of the test above with a strip over a third of it. The edge points' ellipse
-  // covers too little of the rim to be accepted on their word (300 degrees), a circle through
-  // the arcs it matches is pixels off; the circle's grey-value fit finds the second harmonic,
-  // and the ellipse refined in the grey values is the rim.
-  Scene s(spec(120, 190));
+TEST(CircleMeasure, AnEllipticRimIsMeasuredAsItsEllipse) {
+  // A circle's 0.5 px band keeps the arcs of this rim that one circle matches, on one side.
   const cv::Point2d c{60.37, 58.81};
-  s.addPolygon(ellipseOutline(c, 30.0, 27.0, 25.0), 60.0);
-  s.addPolygon({{0, 0}, {c.x - 12, 0}, {c.x - 12, 120}, {0, 120}}, 130.0, "occluder");
-  const cv::Mat image = s.render();
-  auto p = params(c + cv::Point2d(1.0, -0.7), 28.5, CirclePolarity::DarkToLight);
+  const cv::Mat image = tiltedHole(c, false);
+  const auto p = params(c + cv::Point2d(1.0, -0.7), 28.5, CirclePolarity::DarkToLight);
   const auto m = measureCircle(image, p);
-  ASSERT_TRUE(m.status.ok()) << m.status.message;
-  EXPECT_TRUE(m.elliptic);
-  EXPECT_TRUE(m.greyRefined);
+  expectTheTiltedHole(m, c, 0.02);
+  EXPECT_NEAR(m.radius, std::sqrt(30.0 * 27.0), 0.05);  // the circle of the ellipse's area
+  EXPECT_NEAR(m.roundness, 3.0, 0.3);                   // the axes' difference
+  EXPECT_LT(m.rms, 0.1);                                // from the ellipse
+  EXPECT_GT(m.coverageDeg, 350.0);
+  // As a circle, the same rim's centre is off by a pixel or more along the minor axis.
+  expectTheCircleModelOff(image, p, c);
+}
+
+TEST(CircleMeasure, AnEllipticRimWithASectorHiddenIsMeasuredAsItsEllipse) {
+  // The tilted hole with a strip over a third of it. The edge points' ellipse covers too little
+  // of the rim to be accepted on their word (300 degrees), a circle through the arcs it matches
+  // is pixels off; the circle's grey-value fit finds the second harmonic, and the ellipse
+  // refined in the grey values is the rim.
+  const cv::Point2d c{60.37, 58.81};
+  const cv::Mat image = tiltedHole(c, true);
+  const auto p = params(c + cv::Point2d(1.0, -0.7), 28.5, CirclePolarity::DarkToLight);
+  const auto m = measureCircle(image, p);
+  expectTheTiltedHole(m, c, 0.03);
   EXPECT_LT(m.coverageDeg, 300.0);
-  EXPECT_NEAR(m.centre.x, c.x, 0.03);
-  EXPECT_NEAR(m.centre.y, c.y, 0.03);
-  EXPECT_NEAR(m.majorDiameter, 60.0, 0.1);
-  EXPECT_NEAR(m.minorDiameter, 54.0, 0.1);
-  EXPECT_NEAR(m.majorAxisDeg, 155.0, 0.5);
-  // The circle model refuses it or is pixels off.
-  p.measureEllipticRims = false;
-  const auto round = measureCircle(image, p);
-  if (round.status.ok()) {
-    EXPECT_GT(std::hypot(round.centre.x - c.x, round.centre.y - c.y), 0.3);
-  }
+  expectTheCircleModelOff(image, p, c);
 }
 
 TEST(CircleMeasure, ASlightlyEllipticRimKeepsItsGreyValueFitOnTheCentre) {
