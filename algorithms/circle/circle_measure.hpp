@@ -23,10 +23,15 @@
 //      fit repeated.
 //   5b. (default) when an ellipse explains the rim's points significantly better than the circle
 //      and takes in at least its inliers (a tilted view: rim_ellipse.hpp), the rim is that
-//      ellipse; step 6 then fits the blurred disc in the coordinates that make it a circle. An
-//      ellipse that the circle's band cannot hold but that is not measurable here (under 300
-//      degrees of it visible, flatter than a 60 degree view) refuses the rim (FitTooPoor).
-// RMS, roundness, inliers and coverage always describe the edge points of step 5 (5b).
+//      ellipse; step 6 then fits the blurred disc in the coordinates that make it a circle and
+//      refits the ellipse's shape to the grey values too. With a sector of the rim hidden (under
+//      300 degrees of it visible) the edge points alone cannot tell such an ellipse from a circle
+//      with clutter beside it: step 6 judges, its circle's grey fit testing for a second
+//      harmonic (an ellipse) and the ellipse then fitted there; a rim whose grey values are not
+//      a circle's and whose ellipse cannot be fitted (or is flatter than a 60 degree view, or
+//      leaves the annulus) is refused (FitTooPoor).
+// RMS, roundness, inliers and coverage always describe the edge points of step 5 (5b): those of
+// the ellipse when the rim is one.
 //
 // Failures are reported as a cause and a message (Status<CircleFailure>), never as a bogus
 // circle: when `status.ok()` is false the centre, radius and diameter are NaN.
@@ -99,8 +104,9 @@ struct CircleMeasureParams {
   bool correctRadiusBias = true;
   // A rim the image shows as an ellipse (a round feature on a plane viewed at a tilt, off the
   // lens's axis, or an oval part) is measured as that ellipse when one explains the rim's edge
-  // points significantly better than a circle (rim_ellipse.hpp). Off: always a circle, whose
-  // robust fit keeps only the arcs one circle matches on such a rim. Default on.
+  // points significantly better than a circle (rim_ellipse.hpp), or the circle's grey-value fit
+  // finds the ellipse's second harmonic. Off: always a circle, whose robust fit keeps only the
+  // arcs one circle matches on such a rim, and no grey-value test of the shape. Default on.
   bool measureEllipticRims = true;
   // Curvature-bias constant k of the edge-point fit, pixels^2 (bias = -k / r). The default was
   // measured with the Facet 5x5 operator on discs blurred with a Gaussian PSF of sigma 1 px
