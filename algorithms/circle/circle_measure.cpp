@@ -340,7 +340,7 @@ GreyRim fitGreyRim(const cv::Mat& image, const CircleMeasurement& m,
                    bool judgeShape, const CircleMeasureParams& params, double cosTol) {
   GreyRim best;
   bool reshaped = false;
-  for (int round = 0, rounds = shape ? 8 : 2; round < rounds; ++round) {
+  for (int round = 0, rounds = shape ? 12 : 2; round < rounds; ++round) {
     const auto fit = fitCircleProfile(
         image, {around.centre.x(), around.centre.y()}, around.radius, rim,
         foreignEdges(m.annulusEdges, m.highThreshold, around, shape, m.rimSign, cosTol),
@@ -448,7 +448,12 @@ GreyRim fitRimGreyValues(const cv::Mat& image, const CircleMeasurement& m,
   if (candidate) {
     GreyRim other = fromCandidate();
     std::vector<Eigen::Vector2d> onOther = support(other);
-    if (onOther.size() > on.size()) {
+    // A settled shape before one that is not, then the one more edge points lie on.
+    const bool otherFirst =
+        other.fit &&
+        (!oval.fit || (other.refusal.empty() != oval.refusal.empty() ? other.refusal.empty()
+                                                                     : onOther.size() > on.size()));
+    if (otherFirst) {
       oval = std::move(other);
       on = std::move(onOther);
     }
