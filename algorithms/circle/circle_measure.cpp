@@ -301,14 +301,23 @@ RimShape rimShape(const std::vector<Eigen::Vector2d>& pts,
 }
 
 // The grey-value stage of a measurement: its fit, the rim's shape it was fitted with (an ellipse,
-// or none: a circle), the rim points that chose its sectors, and a refusal when the grey values
-// say the rim is not round and no ellipse fits them.
+// or none: a circle), the rim points that chose its sectors, the rim's edge points within the
+// RANSAC threshold of the fitted shape, and a refusal when the grey values say the rim is not
+// round and no ellipse fits them.
 struct GreyRim {
   std::optional<CircleProfileFit> fit;
   std::optional<rim_ellipse::Ellipse> shape;
   std::vector<cv::Point2d> rim;
+  std::vector<Eigen::Vector2d> on;
   std::string refusal;
 };
+
+std::vector<cv::Point2d> imagePoints(const std::vector<Eigen::Vector2d>& pts) {
+  std::vector<cv::Point2d> out;
+  out.reserve(pts.size());
+  for (const auto& p : pts) out.emplace_back(p.x(), p.y());
+  return out;
+}
 
 // The shape step's size in its own standard deviations, squared (a Wald statistic).
 double stepChiSquare(const CircleProfileFit& fit) {
@@ -347,22 +356,21 @@ GreyRim fitGreyRim(const cv::Mat& image, const CircleMeasurement& m,
         m.noiseSigma, reshaped ? 2.0 : 1.0, shape ? shape->toCircle() : cv::Matx22d::eye(),
         judgeShape || shape.has_value());
     if (!fit) break;
-    best = {fit, shape, rim, ""};
     around = {Eigen::Vector2d{fit->centre.x, fit->centre.y}, fit->radius};
     if (shape) {
       const double scale = fit->radius / shape->meanRadius();
       shape->centre = around.centre;
       shape->major *= scale;
       shape->minor *= scale;
-      best.shape = shape;
     }
-    std::vector<cv::Point2d> collected;
+    std::vector<Eigen::Vector2d> on;
     for (const auto& p : rimCandidates)
       if (std::abs(shape ? rim_ellipse::residual(*shape, p) : residual(around, p)) <=
           params.ransacThreshold)
-        collected.emplace_back(p.x(), p.y());
-    const bool more = collected.size() > rim.size();
-    if (more) rim = std::move(collected);
+        on.push_back(p);
+    best = {fit, shape, rim, on, ""};
+    const bool more = on.size() > rim.size();
+    if (more) rim = imagePoints(on);
     const bool reshape = shape && !settled(*fit);
     if (reshape) shape = rim_ellipse::reshaped(*shape, fit->shapeStep[0], fit->shapeStep[1]);
     reshaped = reshaped || reshape;
@@ -400,16 +408,16 @@ GreyRim fitRimGreyValues(const cv::Mat& image, const CircleMeasurement& m,
   };
   if (ellipse || !judgeShape) return fit(circle, ellipse, m.inlierPoints);
   auto fromCandidate = [&] {
-    std::vector<cv::Point2d> rim;
-    for (const auto& p : candidate->inliers) rim.emplace_back(p.x(), p.y());
     const rim_ellipse::Ellipse& e = candidate->ellipse;
-    return fit({e.centre, e.meanRadius()}, e, std::move(rim));
+    return fit({e.centre, e.meanRadius()}, e, imagePoints(candidate->inliers));
   };
   // The circle is judged on the candidate's sectors too: on its own it chose the sectors it
   // fits (a circle locked onto arcs of an elliptic rim sees no harmonic there).
   std::vector<cv::Point2d> sectors = m.inlierPoints;
-  if (candidate)
-    for (const auto& p : candidate->inliers) sectors.emplace_back(p.x(), p.y());
+  if (candidate) {
+    const std::vector<cv::Point2d> more = imagePoints(candidate->inliers);
+    sectors.insert(sectors.end(), more.begin(), more.end());
+  }
   GreyRim round = fit(circle, std::nullopt, std::move(sectors));
   if (!round.fit) {
     if (!candidate) return round;
@@ -429,14 +437,6 @@ GreyRim fitRimGreyValues(const cv::Mat& image, const CircleMeasurement& m,
   // start has its own basins (r = 10 px, 30% hidden: the candidate's shape a pixel off at axes
   // 0.97 apart, the step's at 0.9), so both are refined and the one that more of the rim's edge
   // points lie on is kept.
-  auto support = [&](const GreyRim& oval) -> std::vector<Eigen::Vector2d> {
-    std::vector<Eigen::Vector2d> on;
-    if (oval.fit)
-      for (const auto& p : rimCandidates)
-        if (std::abs(rim_ellipse::residual(*oval.shape, p)) <= params.ransacThreshold)
-          on.push_back(p);
-    return on;
-  };
   const cv::Vec2d step = round.fit->shapeStep;
   const Circle fitted{{round.fit->centre.x, round.fit->centre.y}, round.fit->radius};
   GreyRim oval =
@@ -444,21 +444,16 @@ GreyRim fitRimGreyValues(const cv::Mat& image, const CircleMeasurement& m,
           rim_ellipse::reshaped({fitted.centre, fitted.radius, fitted.radius, {1.0, 0.0}}, step[0],
                                 step[1]),
           round.rim);
-  std::vector<Eigen::Vector2d> on = support(oval);
   if (candidate) {
     GreyRim other = fromCandidate();
-    std::vector<Eigen::Vector2d> onOther = support(other);
     // A settled shape before one that is not, then the one more edge points lie on.
     const bool otherFirst =
-        other.fit &&
-        (!oval.fit || (other.refusal.empty() != oval.refusal.empty() ? other.refusal.empty()
-                                                                     : onOther.size() > on.size()));
-    if (otherFirst) {
-      oval = std::move(other);
-      on = std::move(onOther);
-    }
+        other.fit && (!oval.fit || (other.refusal.empty() != oval.refusal.empty()
+                                        ? other.refusal.empty()
+                                        : other.on.size() > oval.on.size()));
+    if (otherFirst) oval = std::move(other);
     if (oval.fit) return oval;
-  } else if (oval.fit && coverageDeg(on, {oval.shape->centre, oval.shape->meanRadius()}) >=
+  } else if (oval.fit && coverageDeg(oval.on, {oval.shape->centre, oval.shape->meanRadius()}) >=
                              kMinEllipseCoverageDeg) {
     return oval;
   }
@@ -696,11 +691,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
       if (grey.shape) ellipseRefusal.clear();
       if (grey.shape && !ellipse) {
         // The rim became an ellipse in the grey values: its points are the ellipse's.
-        std::vector<Eigen::Vector2d> onEllipse;
-        for (const auto& p : rimCandidates)
-          if (std::abs(rim_ellipse::residual(*grey.shape, p)) <= params.ransacThreshold)
-            onEllipse.push_back(p);
-        describeRim(m, onEllipse, {grey.shape->centre, grey.shape->meanRadius()}, grey.shape,
+        describeRim(m, grey.on, {grey.shape->centre, grey.shape->meanRadius()}, grey.shape,
                     nullptr);
       }
       ellipse = grey.shape;
