@@ -216,6 +216,13 @@ PlaneCircleVerdict measureCircleInPlane(const cv::Mat& image, const CircleMeasur
   if (!m.status.ok() && !refusedAsImageCircle(m)) return verdict;
   verdict.judgedInPlane = !m.status.ok();
   verdict.circle = circleInPlane(image, m, mapping);
+  // A clipped rim the grey values could not fit in the plane: its edge points alone are off.
+  if (verdict.circle && !verdict.circle->greyRefined)
+    if (std::string why = clippedRimRefusal(m, image.depth()); !why.empty()) {
+      verdict.refusal = std::move(why);
+      verdict.circle.reset();
+      return verdict;
+    }
   if (verdict.circle && verdict.judgedInPlane) {
     verdict.refusal = refusalInPlane(*verdict.circle, params, mapping);
     if (!verdict.refusal.empty()) verdict.circle.reset();

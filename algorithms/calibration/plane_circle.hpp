@@ -72,12 +72,15 @@ struct PlaneCircleVerdict {
   // The image refused the rim as a circle (refusedAsImageCircle), so the plane judged it: it
   // accepted it (circle set) or refused it too (`refusal` says why, when the rim mapped at all).
   bool judgedInPlane = false;
+  // Why the plane refused the rim; also, for any measurement, a rim the sensor clipped that the
+  // grey values could not fit in the plane (clippedRimRefusal).
   std::string refusal;
 };
 
 // The circle of a measurement made with `params`, in the plane: circleInPlane for a measurement
 // that succeeded; for one the image refusedAsImageCircle, circleInPlane judged by refusalInPlane.
-// No circle for other failures, and when the rim does not map into the plane.
+// No circle for other failures, when the rim does not map into the plane, and when the sensor
+// clipped the rim and the grey values could not fit it there (`refusal` says so).
 PlaneCircleVerdict measureCircleInPlane(const cv::Mat& image, const CircleMeasurement& measurement,
                                         const CircleMeasureParams& params,
                                         const WorldMapping& mapping);

@@ -6,12 +6,14 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <utility>
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/calibration/plane_patch.hpp"
+#include "algorithms/circle/censored_pixels.hpp"
 #include "algorithms/circle/rim_band.hpp"
 #include "algorithms/circle/step_profile.hpp"
 #include "algorithms/circle/weighted_normal_equations.hpp"
@@ -290,8 +292,12 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   Eigen::Index n = 0;
   Eigen::VectorXd r, rTry, weight;
   Columns jac, jacTry;
+  CensoredPixels clipped;  // fitted as the sensor clipped them (censored_pixels.hpp)
+  auto span = [&](Eigen::VectorXd& v) { return std::span<double>(v.data(), v.size()); };
   auto loadBand = [&] {
     n = band.size();
+    clipped = CensoredPixels({band.grey.data(), static_cast<std::size_t>(n)},
+                             rim_band::clipLevel(image.depth()));
     r.resize(n), rTry.resize(n);
     weight.setOnes(n);
     for (Columns* j : {&jac, &jacTry}) {
@@ -315,13 +321,13 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
     return (weight.array() * res.array().square()).sum();
   };
   auto tukeyWeights = [&] {
-    const double sigma =
-        std::max(rim_band::robustSigma({r.data(), static_cast<std::size_t>(n)}), 0.25);
+    const double sigma = std::max(clipped.robustSigma(span(r)), 0.25);
     const double c = tukeyC * sigma;
     for (Eigen::Index i = 0; i < n; ++i) {
       const double u = std::abs(r(i)) / c;
       weight(i) = u >= 1.0 ? 0.0 : (1 - u * u) * (1 - u * u);
     }
+    clipped.unweight(span(r), span(weight));
     return sigma;
   };
   Matrix8 jtj;
@@ -355,6 +361,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
     LevenbergMarquardtCallbacks problem{
         [&](const Vector8& v) {
           evaluate(v, r, jac);
+          clipped.censor(span(r));
           return cost(r);
         },
         [&](int, const Vector8&, Matrix8& h, Vector8& g, double& current) {
@@ -372,6 +379,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
         [&](const Vector8& v) -> std::optional<double> {
           if (!(v(kBlur) > 0.05)) return std::nullopt;
           evaluate(v, rTry, jacTry);
+          clipped.censor(span(rTry));
           return cost(rTry);
         },
         [&] {
@@ -379,7 +387,9 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
           std::swap(jac, jacTry);
         },
         [](int it, const Vector8& step) { return it >= 1 && step.head<4>().norm() < 1e-4; }};
-    const LevenbergMarquardtSettings settings{.maxIterations = 15,
+    // A clipped rim's levels beyond the limit come from its step's slope, slowly
+    // (fitCircleProfile).
+    const LevenbergMarquardtSettings settings{.maxIterations = clipped.empty() ? 15 : 40,
                                               .maxTries = 6,
                                               .initialDamping = 1e-4,
                                               .dampingDecrease = 0.3,
@@ -441,7 +451,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   const double blur = pixelModel ? step_profile::equivalentBlur(q(kBlur)) : q(kBlur);
   if (!q.allFinite() || std::abs(q(kContrast)) < std::max(4.0 * sigma, 1.0) || blur < 0.2 ||
       blur > 5.0 || q(kRadius) <= 0.0 || std::hypot(q(kCx), q(kCy)) > maxShiftPx ||
-      std::abs(q(kRadius) - radiusPx) > maxShiftPx)
+      std::abs(q(kRadius) - radiusPx) > maxShiftPx || !clipped.middleSeen(q(kLevel), q(kContrast)))
     return std::nullopt;
   // The 50% level of a blurred convex rim lies s^2 / (2 rho) image pixels inside it, rho the
   // rim's radius of curvature in the image: about R / k with k the plane's scale across the rim.

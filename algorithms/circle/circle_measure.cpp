@@ -12,6 +12,7 @@
 #include "algorithms/circle/annulus_edges.hpp"
 #include "algorithms/circle/circle_fit.hpp"
 #include "algorithms/circle/circle_profile_fit.hpp"
+#include "algorithms/circle/rim_band.hpp"
 #include "algorithms/circle/rim_ellipse.hpp"
 #include "algorithms/geometry/ransac.hpp"
 
@@ -54,6 +55,13 @@ constexpr double kPartialEllipseChiSquare = 55.2;
 // An ellipse's shape whose last grey-value step is still this far from zero (chi-square, 2
 // degrees of freedom: four standard deviations) has not converged: the rim is refused.
 constexpr double kUnsettledShapeChiSquare = 16.0;
+// The band about the rim whose pixels at the sensor's limits tell a clipped rim, px: the blurred
+// step's reach at a blur of 1 px.
+constexpr double kClippedBand = 3.0;
+// The share of that band's pixels at a limit beyond which a rim the grey values could not fit is
+// refused: an overexposed backlight fills about a third (its light side at the clip); noise
+// alone puts a rim a few grey levels below the clip there in a pixel or two of a hundred.
+constexpr double kMaxUnfittedClippedShare = 0.05;
 
 using circle_fit::Circle;
 using circle_fit::circleThrough;
@@ -497,6 +505,16 @@ struct Candidate {
 
 }  // namespace
 
+std::string clippedRimRefusal(const CircleMeasurement& m, int depth) {
+  if (!(m.clippedShare > kMaxUnfittedClippedShare)) return {};
+  return cv::format(
+      "the rim is clipped: %.0f%% of the pixels within %.0f px of it are at the sensor's limit "
+      "(%s or 0), and its grey values could not be fitted as a clipped step (its middle beyond "
+      "the limit, or no fit); its edge points alone lie up to a pixel off: lower the exposure or "
+      "the light",
+      100.0 * m.clippedShare, kClippedBand, depth == CV_16U ? "65535" : "255");
+}
+
 std::string_view toString(CircleFailure failure) {
   switch (failure) {
     case CircleFailure::None:
@@ -712,6 +730,13 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
                    "circle, on too little of the rim to accept it, and no grey-value fit told "
                    "which it is",
                    2 * candidate->ellipse.major, 2 * candidate->ellipse.minor));
+  // A rim clipped by the sensor: its edge points alone are off (CircleMeasurement::clippedShare).
+  const double halfSpread = ellipse ? (ellipse->major - ellipse->minor) / 2.0 : 0.0;
+  m.clippedShare = rim_band::clippedShare(image, m.centre, m.radius - kClippedBand - halfSpread,
+                                          m.radius + kClippedBand + halfSpread);
+  if (params.refineWithGreyValues && !m.greyRefined)
+    if (std::string why = clippedRimRefusal(m, image.depth()); !why.empty())
+      return failed(m, CircleFailure::FitTooPoor, std::move(why));
   // The edge points' tests of an ellipse (rimShape), for one the grey values made.
   if (ellipse && (ellipse->minor < kMinAxesRatio * ellipse->major ||
                   ellipse->major > params.radius + params.width ||

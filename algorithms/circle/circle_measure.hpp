@@ -148,6 +148,11 @@ struct CircleMeasurement {
   double majorAxisDeg = 0.0;  // of the major axis, degrees counter-clockwise on screen, [0, 180)
   bool greyRefined = false;   // centre and radius come from the grey-value refinement
   double blur = 0.0;          // blur fitted by the grey-value refinement, pixels (0 without)
+  // Share of the pixels within 3 px of the rim at the sensor's limits (the image type's largest
+  // value, or 0): an overexposed backlight, say. The grey-value refinement fits such a rim with
+  // its step clipped as the sensor clips it; without that fit its edge points lie up to a pixel
+  // off towards the unclipped side, so a clipped rim the grey values could not fit is refused.
+  double clippedShare = 0.0;
   double lowThreshold = 0.0;  // Canny thresholds actually used
   double highThreshold = 0.0;
   std::vector<cv::Point2d> inlierPoints;  // subpixel edge points of the fit, for display
@@ -160,6 +165,11 @@ struct CircleMeasurement {
 
   Status<CircleFailure> status;  // NaN centre, radius and diameter when !ok()
 };
+
+// Why a measurement's circle cannot stand without a grey-value fit of its rim: the sensor
+// clipped the rim (clippedShare beyond a twentieth), so its edge points lie up to a pixel off
+// towards the unclipped side. Empty when it can. `depth`: the image's (CV_8U or CV_16U).
+[[nodiscard]] std::string clippedRimRefusal(const CircleMeasurement& m, int depth);
 
 // Measures one circle in an 8-bit or 16-bit single-channel image. Never throws for bad input:
 // the result's status carries BadInput and a message instead.

@@ -13,6 +13,7 @@
 
 #include <Eigen/Dense>
 
+#include "algorithms/circle/censored_pixels.hpp"
 #include "algorithms/circle/rim_band.hpp"
 #include "algorithms/circle/step_profile.hpp"
 #include "algorithms/circle/weighted_normal_equations.hpp"
@@ -387,6 +388,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   std::size_t m = samples.size();
   Eigen::VectorXd px, py, grey, r, rTry, weight;
   Columns jac, jacTry;
+  // Pixels the sensor clipped (censored_pixels.hpp).
+  CensoredPixels clipped;
   auto loadBand = [&] {
     const auto n = static_cast<Eigen::Index>(m);
     px.resize(n);
@@ -397,6 +400,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       py(i) = samples[i].y;
       grey(i) = samples[i].grey;
     }
+    clipped = CensoredPixels({grey.data(), m}, rim_band::clipLevel(image.depth()));
     r.resize(n);
     rTry.resize(n);
     weight.setOnes(n);
@@ -452,12 +456,13 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     }
   };
   auto tukeyWeights = [&] {
-    const double sigma = std::max(robustSigma({r.data(), m}), 0.25);
+    const double sigma = std::max(clipped.robustSigma({r.data(), m}), 0.25);
     const double c = tukeyC * sigma;
     for (std::size_t i = 0; i < m; ++i) {
       const double u = std::abs(r[i]) / c;
       weight[i] = u >= 1.0 ? 0.0 : (1 - u * u) * (1 - u * u);
     }
+    clipped.unweight({r.data(), m}, {weight.data(), m});
     return sigma;
   };
 
@@ -467,6 +472,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     LevenbergMarquardtCallbacks problem{
         [&](const Vector8& q) {
           evaluate(q, r, jac);
+          clipped.censor({r.data(), m});
           return cost(r);
         },
         [&](int, const Vector8&, Matrix8& h, Vector8& g, double& current) {
@@ -489,6 +495,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
         [&](const Vector8& q) -> std::optional<double> {
           if (!(q(3) > 0.05)) return std::nullopt;
           evaluate(q, rTry, jacTry);
+          clipped.censor({rTry.data(), m});
           return cost(rTry);
         },
         [&] {
@@ -516,7 +523,11 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // the ramp's two rows are computed here, at the solution: the full matrix again cost as much as
   // one and a half of the solve's own.
   bool withRamp = false;
-  if (!solve({true, true, true, true, true, false, false, true}, 10, true)) return std::nullopt;
+  // A clipped rim's levels beyond the limit come from the slope of its step, slowly: its steps
+  // along the valley of level, blur and radius took up to 30 iterations.
+  const int firstSolveIterations = clipped.empty() ? 10 : 40;
+  if (!solve({true, true, true, true, true, false, false, true}, firstSolveIterations, true))
+    return std::nullopt;
   {
     constexpr int kRamp[2] = {5, 6};
     constexpr int kRest[6] = {0, 1, 2, 3, 4, 7};
@@ -588,12 +599,14 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   if (!p.allFinite() || blur < 0.2 || blur > 5.0 || p(2) <= 0.0 ||
       std::hypot(c.x - centre.x, c.y - centre.y) > maxShift || std::abs(p(2) - radius) > maxShift)
     return std::nullopt;
+  if (!clipped.middleSeen(p(4), p(7))) return std::nullopt;
   CircleProfileFit fit;
   fit.centre = c;
   fit.blur = blur;
   fit.radius = p(2) + blur * blur / (2.0 * p(2));
   fit.noise = sigma;
   fit.pixels = static_cast<int>(samples.size());
+  fit.clipped = static_cast<int>(clipped.size());
   if (fitRimShape) {
     // |exp(S) u| = rho + (a (x^2 - y^2) + 2 c x y) / rho to first order: the columns of a and c
     // are d/drho's (minus d/dR's) times those factors. Their score and step against the free

@@ -45,6 +45,7 @@ struct CircleProfileFit {
   double blur = 0.0;    // fitted s (the equivalent Gaussian, PSF and pixel together), pixels
   double noise = 0.0;   // robust sigma of the grey residuals, grey levels (8-bit scale)
   int pixels = 0;       // pixels used
+  int clipped = 0;      // of them at the sensor's limits, fitted as censored (the model clipped)
   // Only when asked for (fitRimShape), else NaN and zero. The rim's distance from the centre
   // with a second harmonic, in the model's coordinates u (the mapped offsets): |exp(S) u| with
   // S = [[a, c], [c, -a]], an ellipse close to the fitted circle. `secondHarmonic`: the score
@@ -64,6 +65,11 @@ struct CircleProfileFit {
 // 0 = unknown) lets a clean, large rim use only the share of its pixels the precision needs.
 // Returns nothing when the fit does not converge to a plausible circle (moves farther than
 // `maxShift` pixels, blur outside (0.2, 5) px).
+//
+// Pixels at the sensor's limits (255 or 0 in an 8-bit image, 65535 or 0 in a 16-bit one) are
+// censored observations: the model is clipped there as the sensor clips (an overexposed
+// backlight's step is fitted with its levels beyond the clip). When the step's middle itself lies
+// beyond the limit, nothing is returned: the rim would be extrapolated, not measured.
 //
 // An elliptic rim (rim_ellipse.hpp): `toCircle` maps offsets from the centre so that the rim
 // becomes a circle of `radius` (Ellipse::toCircle, area-preserving), and the model applies to

@@ -1,6 +1,7 @@
 #include "algorithms/circle/rim_band.hpp"
 
 #include "algorithms/circle/step_profile.hpp"
+#include "algorithms/edges/row_runs.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -15,6 +16,29 @@ double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
   return v[v.size() / 2];
+}
+
+namespace {
+
+template <typename T>
+double clippedShareOf(const cv::Mat& image, const RowRuns& runs, T limit) {
+  std::size_t clipped = 0, all = 0;
+  for (const RowRun& run : runs) {
+    if (run.x1 <= run.x0) continue;
+    const T* row = image.ptr<T>(run.y);
+    for (int x = run.x0; x < run.x1; ++x) clipped += row[x] == limit || row[x] == 0;
+    all += static_cast<std::size_t>(run.x1 - run.x0);
+  }
+  return all == 0 ? 0.0 : static_cast<double>(clipped) / static_cast<double>(all);
+}
+
+}  // namespace
+
+double clippedShare(const cv::Mat& image, cv::Point2d centre, double rIn, double rOut) {
+  const RowRuns runs =
+      annulusRowRuns(centre, std::max(0.0, rIn), rOut, cv::Rect(0, 0, image.cols, image.rows));
+  return image.depth() == CV_16U ? clippedShareOf<std::uint16_t>(image, runs, 65535)
+                                 : clippedShareOf<std::uint8_t>(image, runs, 255);
 }
 
 double pixelsNeeded(double snr, double halfWidth) {

@@ -99,6 +99,9 @@ void run(const CircleOptions& o) {
                        // judging a result needs to know which.
                        {"grey_refined", m.greyRefined},
                        {"blur", m.blur},
+                       // The share of the pixels near the rim the sensor clipped (0 or its
+                       // largest value): fitted as clipped; a sign to lower the exposure.
+                       {"clipped_share", m.clippedShare},
                        {"elliptic", m.elliptic},
                        {"time_ms", ms}};
     // An elliptic rim (a tilted view): its axes, in pixels, and the major one's direction in
@@ -118,6 +121,12 @@ void run(const CircleOptions& o) {
                                 : "from the edge points only (grey-value fit did not converge)");
     if (m.greyRefined) std::cout << m.blur << " px";
     std::cout << "\n";
+    if (m.clippedShare > 0.0)
+      std::cout << 100.0 * m.clippedShare
+                << "% of the pixels near the rim are at the sensor's limit"
+                << (m.greyRefined
+                        ? ": fitted as clipped (lower the exposure for the best precision)\n"
+                        : ": its edge points lie off there (lower the exposure)\n");
     if (m.elliptic)
       std::cout << "the rim is an ellipse: axes " << m.majorDiameter << " x " << m.minorDiameter
                 << " px, the major one at " << m.majorAxisDeg

@@ -13,6 +13,7 @@ nlohmann::json worldCircle(const MeasuringPlane& plane, const cv::Mat& image,
     refusal = verdict.refusal;
     if (!verdict.circle) {
       if (!m.status.ok()) return nullptr;
+      if (!verdict.refusal.empty()) throw MeasurementFailure("fit_too_poor", verdict.refusal);
       throw MeasurementFailure("off_plane",
                                "the circle's rim does not map into the measuring plane");
     }

@@ -28,8 +28,8 @@ struct TiltedHoles {
   TiltedHoles(double tiltDeg, double lensBlur, std::uint64_t seed,
               const std::vector<std::pair<cv::Point2d, double>>& holes,
               const std::vector<std::vector<cv::Point2d>>& occluders = {},
-              scene::LensCamera camera = test::testCamera(), double noise = 2)
-      : scene(make(tiltDeg, lensBlur, seed, holes, occluders, camera, noise)),
+              scene::LensCamera camera = test::testCamera(), double noise = 2, double plate = 210)
+      : scene(make(tiltDeg, lensBlur, seed, holes, occluders, camera, noise, plate)),
         mapping(CameraModel{scene.camera.matrix(), scene.camera.distortion(), scene.camera.size},
                 PlanePose{scene.placement.rotation, scene.placement.translationMm, 0.0}),
         image(scene.render()) {}
@@ -37,12 +37,12 @@ struct TiltedHoles {
   static scene::PlaneScene make(double tiltDeg, double lensBlur, std::uint64_t seed,
                                 const std::vector<std::pair<cv::Point2d, double>>& holes,
                                 const std::vector<std::vector<cv::Point2d>>& occluders,
-                                const scene::LensCamera& camera, double noise) {
+                                const scene::LensCamera& camera, double noise, double plate) {
     scene::PlaneScene s;
     s.camera = camera;
     s.placement = scene::lookAtPlane({40, 30}, 250, tiltDeg, 20, 10, s.camera);
     s.background = 30;
-    s.addPolygon({{-20, -20}, {100, -20}, {100, 80}, {-20, 80}}, 210);
+    s.addPolygon({{-20, -20}, {100, -20}, {100, 80}, {-20, 80}}, plate);
     for (const auto& [centre, radius] : holes) s.addDisc(centre, radius, 40);
     for (const auto& polygon : occluders) s.addPolygon(polygon, 210);
     s.lensBlurSigma = lensBlur;
@@ -95,6 +95,30 @@ TEST(PlaneCircleProfile, AHoleSeenAt30DegreesIsMeasuredToTheGreyFitsPrecision) {
   }
   ASSERT_GE(n, 4);
   EXPECT_LT(3 * std::sqrt(grey2 / n), std::sqrt(edges2 / n));
+}
+
+// A plate lit 1.6 times beyond the sensor's clip (it reads 255 around the holes): fitted with the
+// clip in the model, as the image's fit (clipped_rim_test.cpp), the centre within 0.005 mm and
+// the diameter within 0.02 mm (measured -0.002 to -0.009 over 8 seeds; fitted as the pixels read,
+// -0.14 to -0.15 mm). Four times beyond it the step's middle is not seen: the plane refuses the
+// rim, with the cause, rather than give its edge points' circle.
+TEST(PlaneCircleProfile, AClippedRimIsFittedAsClippedOrRefused) {
+  for (std::uint64_t seed = 1; seed <= 2; ++seed) {
+    const TiltedHoles t(30, 0.7, seed, {{kBig, 5.0}}, {}, test::testCamera(), 2, 400);
+    const CircleMeasurement m = t.measured(kBig, 5.0);
+    EXPECT_GT(m.clippedShare, 0.2);
+    const PlaneCircleVerdict v = measureCircleInPlane(t.image, m, t.params(kBig, 5.0), t.mapping);
+    ASSERT_TRUE(v.circle.has_value()) << m.status.message << " " << v.refusal;
+    EXPECT_TRUE(v.circle->greyRefined);
+    EXPECT_LT(cv::norm(v.circle->centreMm - kBig), 0.005) << "seed " << seed;
+    EXPECT_NEAR(v.circle->diameterMm, 10.0, 0.02) << "seed " << seed;
+  }
+  const TiltedHoles over(30, 0.7, 1, {{kBig, 5.0}}, {}, test::testCamera(), 2, 1000);
+  const CircleMeasurement m = over.measured(kBig, 5.0);
+  const PlaneCircleVerdict v =
+      measureCircleInPlane(over.image, m, over.params(kBig, 5.0), over.mapping);
+  EXPECT_FALSE(v.circle.has_value());
+  EXPECT_NE(v.refusal.find("clipped"), std::string::npos) << v.refusal;
 }
 
 // Without lens blur (pixel integration alone, the sharpest image a sensor gives), where a

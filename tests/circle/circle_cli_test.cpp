@@ -68,6 +68,27 @@ TEST_F(CircleCli, PrintsOneJsonObjectWithTheCircle) {
   EXPECT_NEAR(j.at("blur").get<double>(), 1.0, 0.3);  // the scene's PSF sigma, plus pixel size
   EXPECT_FALSE(j.at("elliptic").get<bool>());
   EXPECT_FALSE(j.contains("ellipse"));
+  EXPECT_EQ(j.at("clipped_share").get<double>(), 0.0);  // nothing near the rim at 0 or 255
+}
+
+// A disc on an overexposed background (the sensor reads 255 where its light is 1.6 times that):
+// measured with the clip in the model, and the share of clipped pixels reported.
+TEST_F(CircleCli, AClippedRimIsMeasuredAndReportsTheClippedShare) {
+  facet::scene::SceneSpec spec = sceneSpec();
+  spec.background = 400;
+  facet::scene::Scene s(spec);
+  s.addDisc(centre_, 40.3, 30);
+  const std::string image = (dir_ / "backlit.png").string();
+  s.write(image);
+  const std::string args = "circle --image " + image + " --center 81,69 --radius 40";
+  const CliRun r = facet(args + " --json");
+  ASSERT_EQ(r.exitCode, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_NEAR(j.at("radius").get<double>(), 40.3, 0.06);
+  EXPECT_GT(j.at("clipped_share").get<double>(), 0.2);
+  const CliRun text = facet(args);
+  ASSERT_EQ(text.exitCode, 0) << text.err;
+  EXPECT_NE(text.out.find("fitted as clipped"), std::string::npos) << text.out;
 }
 
 TEST_F(CircleCli, AnEllipticRimReportsItsAxes) {

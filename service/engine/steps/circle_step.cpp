@@ -134,7 +134,9 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   r.note = note;
   if (plane) {
     if (!inPlane.circle)
-      return StepResult::failed("circle not measured: its rim does not map into the plane");
+      return StepResult::failed(inPlane.refusal.empty()
+                                    ? "circle not measured: its rim does not map into the plane"
+                                    : "circle not measured: " + inPlane.refusal);
     const PlaneCircle* w = &*inPlane.circle;
     // Offsets along the plane's axes (the calibration plate's x and y), mm.
     const cv::Point2d nominal = plane->toPlane(expected);

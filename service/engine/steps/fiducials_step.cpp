@@ -98,7 +98,9 @@ StepResult FiducialsStep::run(const config::Step& step, StepContext& part) const
       if (!inPlane.circle)
         return StepResult::failed(
             where + " not measured: " +
-            (m.status.ok() ? std::string("its rim does not map into the measuring plane")
+            (m.status.ok() ? (inPlane.refusal.empty()
+                                  ? std::string("its rim does not map into the measuring plane")
+                                  : inPlane.refusal)
                            : std::string(toString(m.status.cause)) +
                                  (inPlane.refusal.empty() ? "" : " (" + inPlane.refusal + ")")));
       // The image point of the mark's centre in the plane: the pose is fitted in the image.

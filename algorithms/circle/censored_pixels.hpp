@@ -1,0 +1,50 @@
+#pragma once
+
+// The pixels of a rim's band that the sensor clipped, fitted as censored observations.
+//
+// An overexposed backlight reads 255 (an 8-bit image; 65535 in a 16-bit one) wherever its light
+// exceeds that, and an underexposed part reads 0: the step across such a rim is cut on that side,
+// its 50% level moved towards the other. Fitted as it reads, a hole in a background a quarter over
+// the clip came out 0.33 px small, half over 0.57 px (r = 40 px, blur 1). A pixel at a limit only
+// says that the grey there is at or beyond it: where the model is too, the pixel has no residual
+// and no weight (the model is clipped as the sensor clips); where the model falls short, the
+// pixel pulls it as any other does. The levels beyond the clip are then fitted from the slope of
+// the step's visible part. A Tobit model's likelihood would also weigh the probability of the
+// clip; at a clip within the step (below) the difference is within the noise.
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace facet {
+
+class CensoredPixels {
+ public:
+  CensoredPixels() = default;
+  // `grey`: the band's grey values, on the scale where `clipLevel` is the sensor's largest value
+  // (rim_band::clipLevel); the pixels at it or at 0 are the censored ones.
+  CensoredPixels(std::span<const double> grey, double clipLevel);
+
+  [[nodiscard]] bool empty() const { return index_.empty(); }
+  [[nodiscard]] std::size_t size() const { return index_.size(); }
+
+  // Residuals (grey - model): a clipped pixel's is set to zero where the model lies at or beyond
+  // its limit.
+  void censor(std::span<double> residuals) const;
+  // Weights of the pixels censor() zeroed set to zero (an exact zero residual of a clipped pixel
+  // otherwise needs the model exactly at the limit).
+  void unweight(std::span<const double> residuals, std::span<double> weights) const;
+  // rim_band::robustSigma of the residuals without the censored pixels' zeros.
+  [[nodiscard]] double robustSigma(std::span<const double> residuals) const;
+  // Whether a step from `level` by `contrast` (either sign) has its middle within the sensor's
+  // range: beyond it, the rim is not seen but extrapolated from the foot of its step (holes in a
+  // background 2.4 times the clip came out 0.06-0.7 px small), and no fit of it is kept.
+  [[nodiscard]] bool middleSeen(double level, double contrast) const;
+
+ private:
+  std::vector<std::size_t> index_;  // ascending
+  std::vector<bool> high_;          // of each: at the upper limit (else at 0)
+  double clipLevel_ = 255.0;
+};
+
+}  // namespace facet
