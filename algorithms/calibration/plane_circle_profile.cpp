@@ -284,7 +284,13 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   }
 
   Vector8 q;
-  q << 0.0, 0.0, radiusPx, 1.2, rim_band::medianOf(outside), 0.0, 0.0, contrast;
+  {
+    const double clip = rim_band::clipLevel(image.depth());
+    const double out = rim_band::medianOf(outside), in = rim_band::medianOf(inside);
+    const double level = CensoredPixels::startingLevel(out, in, clip);
+    q << 0.0, 0.0, radiusPx, 1.2, level, 0.0, 0.0,
+        CensoredPixels::startingLevel(in, out, clip) - level;
+  }
   const double tukeyC = noiseSigma > 0.0 ? 8.0 : 4.685;  // fitCircleProfile's reasons
 
   // Residuals (grey - model) and the model's Jacobian at parameters v. The Jacobian's columns of

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "algorithms/edges/canny.hpp"
@@ -65,11 +66,19 @@ void annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const
       sectorPeak = std::max(sectorPeak, magnitude[x]);
     }
     // Immerkaer's noise mask (its taps' squares sum to 36), on every third pixel: plenty for a
-    // median.
+    // median. Not where the sensor clipped a pixel of the mask: there the noise is clipped away
+    // (an overexposed backlight filling half the annulus gave a median of 0, and Canny thresholds
+    // and the grey fit's screens at their floors).
     const T* above = image.ptr<T>(y - 1);
     const T* here = image.ptr<T>(y);
     const T* below = image.ptr<T>(y + 1);
+    constexpr T kClip = std::numeric_limits<T>::max();
+    auto clipped = [](const T* row, int x) {
+      return std::min({row[x - 1], row[x], row[x + 1]}) == 0 ||
+             std::max({row[x - 1], row[x], row[x + 1]}) == kClip;
+    };
     for (int x = run.x0 + ((3 - (run.x0 + y) % 3) % 3); x < run.x1; x += 3) {
+      if (clipped(above, x) || clipped(here, x) || clipped(below, x)) continue;
       const int n = above[x - 1] - 2 * above[x] + above[x + 1] - 2 * here[x - 1] + 4 * here[x] -
                     2 * here[x + 1] + below[x - 1] - 2 * below[x] + below[x + 1];
       noise.push_back(std::abs(n));

@@ -26,16 +26,22 @@ void CensoredPixels::unweight(std::span<const double> residuals, std::span<doubl
 }
 
 double CensoredPixels::robustSigma(std::span<const double> residuals) const {
-  if (index_.empty()) return rim_band::robustSigma(residuals);
+  if (index_.empty() || index_.size() == residuals.size()) return rim_band::robustSigma(residuals);
   std::vector<double> observed;
-  observed.reserve(residuals.size());
+  observed.reserve(residuals.size() - index_.size());
   std::size_t next = 0;
   for (std::size_t i = 0; i < residuals.size(); ++i) {
     const bool clipped = next < index_.size() && index_[next] == i;
     next += clipped ? 1 : 0;
-    if (!clipped || residuals[i] != 0.0) observed.push_back(residuals[i]);
+    if (!clipped) observed.push_back(residuals[i]);
   }
   return rim_band::robustSigma(observed);
+}
+
+double CensoredPixels::startingLevel(double level, double other, double clipLevel) {
+  if (level >= clipLevel) return clipLevel + 0.5 * (clipLevel - other);
+  if (level <= 0.0) return -0.5 * other;
+  return level;
 }
 
 bool CensoredPixels::middleSeen(double level, double contrast) const {

@@ -34,8 +34,15 @@ class CensoredPixels {
   // Weights of the pixels censor() zeroed set to zero (an exact zero residual of a clipped pixel
   // otherwise needs the model exactly at the limit).
   void unweight(std::span<const double> residuals, std::span<double> weights) const;
-  // rim_band::robustSigma of the residuals without the censored pixels' zeros.
+  // rim_band::robustSigma of the residuals of the pixels within the sensor's range. A clipped
+  // pixel's residual is no noise: censored it is zero, and where the model sits just inside the
+  // limit it is tiny; counted, they made the noise level collapse when a fit's level reached
+  // the clip (the robust weights then kept a few pixels, and the fit stuck there, 0.6 px off).
   [[nodiscard]] double robustSigma(std::span<const double> residuals) const;
+  // A starting level for a side of the step whose median `level` reads at a limit (`other`: the
+  // other side's): beyond the limit by half the step that is seen, so that the fit starts with
+  // that side censored rather than at the limit, next to the fit of the pixels as they read.
+  [[nodiscard]] static double startingLevel(double level, double other, double clipLevel);
   // Whether a step from `level` by `contrast` (either sign) has its middle within the sensor's
   // range: beyond it, the rim is not seen but extrapolated from the foot of its step (holes in a
   // background 2.4 times the clip came out 0.06-0.7 px small), and no fit of it is kept.

@@ -273,8 +273,12 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   }
   if (inside.empty() || outside.empty()) return std::nullopt;
   Vector8 p;
-  p << 0.0, 0.0, radius, 1.2, medianOf(outside), 0.0, 0.0, 0.0;
-  p(7) = medianOf(inside) - p(4);
+  {
+    const double clip = rim_band::clipLevel(image.depth());
+    const double out = medianOf(outside), in = medianOf(inside);
+    p << 0.0, 0.0, radius, 1.2, CensoredPixels::startingLevel(out, in, clip), 0.0, 0.0, 0.0;
+    p(7) = CensoredPixels::startingLevel(in, out, clip) - p(4);
+  }
 
   // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
   // bins, as many pixels as rim_band::pixelsNeeded. When pixels are to spare, the narrower band

@@ -105,8 +105,12 @@ TEST(CensoredPixels, ZeroOnlyTheResidualsOfPixelsWhoseModelIsBeyondTheirLimit) {
   std::vector<double> weights(6, 1.0);
   clipped.unweight(residuals, weights);
   EXPECT_EQ(weights, (std::vector<double>{0, 1, 0, 1, 1, 0}));
-  // The noise level of what is observed: the censored zeros do not lower it.
-  EXPECT_NEAR(clipped.robustSigma(residuals), 1.4826 * 5.0, 1e-9);
+  // The noise level of the pixels within the range: the clipped ones' residuals are no noise.
+  EXPECT_NEAR(clipped.robustSigma(residuals), 1.4826 * 7.0, 1e-9);
+  // A side that reads at a limit starts beyond it by half the step seen; others as they read.
+  EXPECT_EQ(CensoredPixels::startingLevel(255, 55, 255), 355);
+  EXPECT_EQ(CensoredPixels::startingLevel(0, 100, 255), -50);
+  EXPECT_EQ(CensoredPixels::startingLevel(200, 55, 255), 200);
   // A step from 30 up by 400: its middle (230) is seen; by 500 (280) it is not.
   EXPECT_TRUE(clipped.middleSeen(30, 400));
   EXPECT_FALSE(clipped.middleSeen(30, 500));
