@@ -47,7 +47,7 @@ CaliperResult measureCaliper(const cv::Mat& image, const MeasuringPath& path,
   const std::vector<ProfileEdge> found = findProfileEdges(profile, ep);
   std::vector<CaliperEdge> all;
   for (const ProfileEdge& e : found)
-    all.push_back({path.at(e.position, 0.0), e.position, e.amplitude});
+    all.push_back({path.at(e.position, 0.0), e.position, e.amplitude, e.clipped});
 
   CaliperResult result;
   result.partial = profile.partial;

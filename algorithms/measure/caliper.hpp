@@ -36,6 +36,9 @@ struct CaliperEdge {
   cv::Point2d point;     // image position on the axis
   double position = 0;   // signed distance from the centre along the axis, pixels
   double amplitude = 0;  // signed grey step: > 0 rising
+  // The sensor clipped the profile beside it (an overexposed backlight): the position lies
+  // towards the unclipped side by up to a pixel (ProfileEdge::clipped); lower the exposure.
+  bool clipped = false;
 };
 
 struct CaliperPair {

@@ -29,6 +29,9 @@ struct GreyProfile {
   double step = 0;
   // Part of the path lay outside the image: the profile covers only what was inside.
   bool partial = false;
+  // The sensor's largest value on the values' scale (255; 65535 / 256 for 16 bits): a value
+  // there, or at 0, averages pixels the sensor clipped.
+  double clipLevel = 255.0;
 
   [[nodiscard]] double positionAt(double index) const { return start + index * step; }
   [[nodiscard]] double end() const {

@@ -85,6 +85,9 @@ double integrate(const double* y, int n, double x0, double h, double lo, double 
 constexpr double kCoreWindow = 4.0;
 // The faintest step (grey levels, 8-bit scale) that stops a window, however clean the profile.
 constexpr double kFaintStep = 2.0;
+// A sample this close to a limit (0 or GreyProfile::clipLevel) averages clipped pixels only: the
+// bilinear weights' sum in floating point.
+constexpr double kClipRounding = 1e-6;
 
 // The step fit's unknowns: the level before the edge, the step, the edge, its width, and the
 // background's slope along the profile.
@@ -113,6 +116,7 @@ struct ProfileEdgeFinder::Step {
   bool alive = true;                  // fitted: a neighbour that the other steps' fits subtract
   bool reported = false;              // and strong enough to be an edge
   bool crowded = false;               // another step reached into its window in the first pass
+  bool clipped = false;               // its window holds samples the sensor clipped
 };
 
 ProfileEdgeFinder::ProfileEdgeFinder(const ProfileEdgeParams& params) : params_(params) {}
@@ -199,6 +203,10 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
     window_[j - j0] = near_.empty() ? p.values[j] : p.values[j] - neighbours(self, p.positionAt(j));
   const double* y = window_.data() + (i0 - j0);
   const int count = i1 - i0 + 1;
+  // Whether the sensor clipped the profile within the window (ProfileEdge::clipped).
+  st.clipped = false;
+  for (int j = i0; j <= i1 && !st.clipped; ++j)
+    st.clipped = p.values[j] >= p.clipLevel - kClipRounding || p.values[j] <= kClipRounding;
 
   // Gauss-Newton on (a, b, e, w, g): the model a + b Phi((s - e) / w) + g (s - s0), started with
   // the linear fit of the levels and slope at the current e, w. The slope is shading: where the
@@ -344,7 +352,7 @@ const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
   }
   found_.clear();
   for (const Step& st : steps_)
-    if (st.alive && st.reported) found_.push_back({st.e, st.b, st.w});
+    if (st.alive && st.reported) found_.push_back({st.e, st.b, st.w, st.clipped});
   std::sort(found_.begin(), found_.end(),
             [](const ProfileEdge& x, const ProfileEdge& y) { return x.position < y.position; });
   // Two candidates that converged onto one edge: keep the stronger.

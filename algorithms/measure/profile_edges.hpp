@@ -44,6 +44,11 @@ struct ProfileEdge {
   double position = 0;   // axis position, pixels (as GreyProfile::positionAt)
   double amplitude = 0;  // signed grey step along the axis: > 0 dark to light (rising)
   double blur = 0;       // fitted step width w, pixels (blur sigma with the pixel's footprint)
+  // Samples the sensor clipped (GreyProfile::clipLevel, or 0) lie in its window: the step is cut
+  // on that side and the position lies towards the other, by up to a pixel (a backlight 1.6 times
+  // the clip: 0.57 px). The profile's interpolation mixes clipped pixels with others, so no
+  // model of the profile alone undoes it; lower the exposure.
+  bool clipped = false;
 };
 
 // Every edge of either polarity with |amplitude| >= minAmplitude, sorted by position.

@@ -24,8 +24,11 @@ struct CaliperOptions {
 // `plane`: also the edge's place and position in the measuring plane, mm.
 nlohmann::json edgeJson(const CaliperEdge& e, const MeasuringPath& path,
                         const MeasuringPlane* plane) {
-  nlohmann::json j{
-      {"x", e.point.x}, {"y", e.point.y}, {"position", e.position}, {"amplitude", e.amplitude}};
+  nlohmann::json j{{"x", e.point.x},
+                   {"y", e.point.y},
+                   {"position", e.position},
+                   {"amplitude", e.amplitude},
+                   {"clipped", e.clipped}};
   if (plane) {
     const cv::Point2d q = plane->toPlane(e.point);
     j["x_mm"] = q.x;
@@ -90,6 +93,9 @@ void run(const CaliperOptions& o) {
     std::cout << "edge at (" << e.point.x << ", " << e.point.y << ") px, position " << e.position
               << " px, amplitude " << e.amplitude;
     if (plane) std::cout << "; position " << plane->span(path, 0.0, e.position) << " mm";
+    if (e.clipped)
+      std::cout << " (the sensor clipped the grey values beside it: up to a pixel towards the "
+                   "unclipped side; lower the exposure)";
     std::cout << "\n";
   }
   for (const CaliperPair& pr : r.pairs) {

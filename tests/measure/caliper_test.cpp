@@ -86,6 +86,27 @@ TEST(Caliper, PairsGiveTheWidthAndCentreOfABarFourPixelsWide) {
   EXPECT_EQ(none.status.cause, MeasureFailure::NoPair);
 }
 
+// A dark bar in a backlight 1.6 times the sensor's clip (it reads 255 on both sides): its edges
+// are flagged as clipped (their positions lie up to a pixel towards the bar); a bar within the
+// sensor's range is not flagged.
+TEST(Caliper, EdgesBesideClippedGreyValuesAreFlagged) {
+  CaliperParams p;
+  p.pairs = true;
+  p.polarity = EdgePolarity::Falling;
+  const MeasuringRect rect{40.4, 39.8, 40, 20, 23.0};
+  for (const double light : {400.0, 230.0}) {
+    const CaliperResult r =
+        measureCaliper(barImage(rect, -0.7, 8.3, light, 30, 2.0), MeasuringPath(rect), p);
+    ASSERT_TRUE(r.status.ok()) << r.status.message;
+    ASSERT_EQ(r.pairs.size(), 1u);
+    EXPECT_EQ(r.pairs[0].first.clipped, light > 255) << light;
+    EXPECT_EQ(r.pairs[0].second.clipped, light > 255) << light;
+    if (light < 255) {
+      EXPECT_NEAR(r.pairs[0].width, 8.3, 0.05);
+    }
+  }
+}
+
 TEST(Caliper, SelectsFirstLastStrongestOrAllOfAComb) {
   // Three teeth: the middle one has the most contrast.
   scene::SceneSpec spec;

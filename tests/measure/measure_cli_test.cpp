@@ -59,6 +59,7 @@ TEST_F(MeasureCli, CaliperPrintsEdgesAndPairs) {
   EXPECT_NEAR(j["edges"][0].at("y").get<double>(), 100, 1e-9);
   EXPECT_NEAR(j["edges"][0].at("position").get<double>(), 60.2 - 63, 0.05);
   EXPECT_LT(j["edges"][0].at("amplitude").get<double>(), -100);
+  EXPECT_FALSE(j["edges"][0].at("clipped").get<bool>());  // nothing near it at 0 or 255
   ASSERT_EQ(j.at("pairs").size(), 1u);
   EXPECT_NEAR(j["pairs"][0].at("width").get<double>(), 6.4, 0.05);
   EXPECT_NEAR(j["pairs"][0].at("x").get<double>(), 63.4, 0.05);
