@@ -97,6 +97,36 @@ TEST_F(MeasuringSteps, CaliperPartlyOutsideMeasuresInsideAndSaysSo) {
                 "edge: part of the caliper lies outside the image: measured inside only"});
 }
 
+// The plate photographed with twice the exposure: its light face reads 255. The caliper's edges
+// lie beside clipped grey values, and the part's record says so.
+TEST_F(MeasuringSteps, CaliperBesideClippedGreyValuesSaysSo) {
+  cv::Mat overexposed;
+  plate::render().convertTo(overexposed, CV_8U, 2.0);
+  const auto out = inspect(R"(  - id: across
+    kind: caliper
+    centre: [320, 240]
+    length: 300
+    width: 10
+    measure: pairs
+    polarity: rising
+)",
+                           overexposed);
+  ASSERT_EQ(out.notes.size(), 1u) << plate::failures(out);
+  EXPECT_NE(out.notes[0].find("the sensor clipped the grey values beside an edge"),
+            std::string::npos)
+      << out.notes[0];
+  // The same plate exposed as usual: nothing said.
+  EXPECT_TRUE(inspect(R"(  - id: across
+    kind: caliper
+    centre: [320, 240]
+    length: 300
+    width: 10
+    measure: pairs
+    polarity: rising
+)")
+                  .notes.empty());
+}
+
 TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {
   const std::string check =
       "    checks:\n      position: {nominal: 0, tol_minus: 1, tol_plus: 1}\n";

@@ -153,6 +153,14 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
     r.values["spacing"] = span(along.front(), along.back()) / static_cast<double>(along.size() - 1);
   r.point = points.front();
   if (m.partial) r.note = "part of the caliper lies outside the image: measured inside only";
+  // An edge beside grey values the sensor clipped lies up to a pixel off (CaliperEdge::clipped).
+  bool clipped = false;
+  for (const CaliperEdge& e : m.edges) clipped = clipped || e.clipped;
+  for (const CaliperPair& pr : m.pairs) clipped = clipped || pr.first.clipped || pr.second.clipped;
+  if (clipped)
+    r.note = (r.note.empty() ? "" : r.note + "; ") +
+             "the sensor clipped the grey values beside an edge: it lies up to a pixel towards "
+             "the unclipped side; lower the exposure";
 
   // Each edge as a short line across the axis; pair centres as crosses.
   const double half = path.width() / 2;
