@@ -58,10 +58,6 @@ constexpr double kUnsettledShapeChiSquare = 16.0;
 // The band about the rim whose pixels at the sensor's limits tell a clipped rim, px: the blurred
 // step's reach at a blur of 1 px.
 constexpr double kClippedBand = 3.0;
-// The share of that band's pixels at a limit beyond which a rim the grey values could not fit is
-// refused: an overexposed backlight fills about a third (its light side at the clip); noise
-// alone puts a rim a few grey levels below the clip there in a pixel or two of a hundred.
-constexpr double kMaxUnfittedClippedShare = 0.05;
 
 using circle_fit::Circle;
 using circle_fit::circleThrough;
@@ -506,7 +502,7 @@ struct Candidate {
 }  // namespace
 
 std::string clippedRimRefusal(const CircleMeasurement& m, int depth) {
-  if (!(m.clippedShare > kMaxUnfittedClippedShare)) return {};
+  if (!(m.clippedShare > kClippedRimShare)) return {};
   return cv::format(
       "the rim is clipped: %.0f%% of the pixels within %.0f px of it are at the sensor's limit "
       "(%s or 0), and its grey values could not be fitted as a clipped step (its middle beyond "

@@ -20,7 +20,9 @@
 //      Cramer-Rao bound where edge points stay about 2x above it (small circles) and corrects the
 //      curvature bias from the fitted blur instead of a constant. Angular sectors whose grey
 //      residuals are too large for the noise (faint clutter near the rim) are dropped and the
-//      fit repeated.
+//      fit repeated. Pixels the sensor clipped (an overexposed backlight) are fitted as
+//      censored (censored_pixels.hpp); a clipped rim the grey values cannot fit (its step's
+//      middle beyond the clip) is refused, its edge points alone being up to a pixel off.
 //   5b. (default) when an ellipse explains the rim's points significantly better than the circle
 //      and takes in at least its inliers (a tilted view: rim_ellipse.hpp), the rim is that
 //      ellipse; step 6 then fits the blurred disc in the coordinates that make it a circle and
@@ -166,9 +168,15 @@ struct CircleMeasurement {
   Status<CircleFailure> status;  // NaN centre, radius and diameter when !ok()
 };
 
+// The share of the pixels near a rim at the sensor's limits (CircleMeasurement::clippedShare)
+// beyond which the sensor clipped the rim: an overexposed backlight fills about a third (its
+// light side at the clip); noise alone puts a rim a few grey levels below the clip there in a
+// pixel or two of a hundred.
+inline constexpr double kClippedRimShare = 0.05;
+
 // Why a measurement's circle cannot stand without a grey-value fit of its rim: the sensor
-// clipped the rim (clippedShare beyond a twentieth), so its edge points lie up to a pixel off
-// towards the unclipped side. Empty when it can. `depth`: the image's (CV_8U or CV_16U).
+// clipped the rim (clippedShare beyond kClippedRimShare), so its edge points lie up to a pixel
+// off towards the unclipped side. Empty when it can. `depth`: the image's (CV_8U or CV_16U).
 [[nodiscard]] std::string clippedRimRefusal(const CircleMeasurement& m, int depth);
 
 // Measures one circle in an 8-bit or 16-bit single-channel image. Never throws for bad input:

@@ -127,6 +127,35 @@ TEST_F(MeasuringSteps, CaliperBesideClippedGreyValuesSaysSo) {
                   .notes.empty());
 }
 
+// The bore (0.8 mm) in the plate photographed with twice the exposure (the plate reads 255):
+// measured with the clip in the grey fit, within 0.005 mm, and the part's record says that the
+// sensor clipped its rim. With four times the exposure the step's middle lies beyond the clip:
+// the step either fails with the cause or, where its grey values also fit a sharper and smaller
+// step, is measured with the same note in the record (the image alone cannot tell them apart).
+TEST_F(MeasuringSteps, CircleOnAClippedRimIsFittedAsClippedAndSaysSo) {
+  const std::string bore = R"(  - id: bore
+    kind: circle
+    centre: [260, 200]
+    nominal_diameter: 0.8
+    search_width: 0.2
+    polarity: dark_inside
+    checks:
+      diameter: {nominal: 0.8, tol_minus: 0.005, tol_plus: 0.005}
+)";
+  cv::Mat twice, fourTimes;
+  plate::render().convertTo(twice, CV_8U, 2.0);
+  const auto out = inspect(bore, twice);
+  ASSERT_EQ(out.verdict, Verdict::Pass) << plate::failures(out);
+  ASSERT_EQ(out.notes.size(), 1u);
+  EXPECT_NE(out.notes[0].find("the sensor clipped"), std::string::npos) << out.notes[0];
+  plate::render().convertTo(fourTimes, CV_8U, 4.0, -100.0);
+  const auto heavy = inspect(bore, fourTimes);
+  const std::string said = plate::failures(heavy) + (heavy.notes.empty() ? "" : heavy.notes[0]);
+  EXPECT_TRUE(said.find("the rim is clipped") != std::string::npos ||
+              said.find("the sensor clipped") != std::string::npos)
+      << said;
+}
+
 TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {
   const std::string check =
       "    checks:\n      position: {nominal: 0, tol_minus: 1, tol_plus: 1}\n";

@@ -129,6 +129,7 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   }
   if (!inPlane.circle && !m.status.ok())
     return StepResult::failed("circle not measured: " + std::string(toString(m.status.cause)) +
+                              ": " + m.status.message +
                               (inPlane.refusal.empty() ? "" : " (" + inPlane.refusal + ")"));
   StepResult r;
   r.note = note;
@@ -169,6 +170,14 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
     else
       part.overlay.circle(m.centre, m.radius, true);
   }
+  // Measured although the sensor clipped the rim (its grey values fitted as clipped): the line
+  // should know that the exposure costs it precision.
+  if (m.clippedShare > kClippedRimShare)
+    r.note = (r.note.empty() ? "" : r.note + "; ") +
+             cv::format(
+                 "the sensor clipped %.0f%% of the pixels near the rim: fitted as clipped, a few "
+                 "hundredths of a pixel less precise; lower the exposure",
+                 100.0 * m.clippedShare);
   part.overlay.cross(*r.point, 4, true);
   return r;
 }
