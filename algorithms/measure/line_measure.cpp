@@ -30,6 +30,7 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
   ProfileEdgeFinder finder(ep);
 
   LineMeasurement m;
+  std::vector<bool> clipped;  // of each edge point
   const int count = std::max(1, static_cast<int>(std::floor(rect.length / params.spacing)));
   const double first = -(count - 1) * params.spacing / 2.0;
   int contrasted = 0;
@@ -52,7 +53,10 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
                           (params.polarity == EdgePolarity::Rising) == (e.amplitude > 0);
       if (wanted && (!best || std::abs(e.amplitude) > std::abs(best->amplitude))) best = &e;
     }
-    if (best) m.edgePoints.push_back(across.at(best->position, 0.0));
+    if (best) {
+      m.edgePoints.push_back(across.at(best->position, 0.0));
+      clipped.push_back(best->clipped);
+    }
   }
   if (m.stations == 0)
     return failed(MeasureFailure::OutsideImage, "the line rectangle lies outside the image", true);
@@ -76,6 +80,7 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
   m.straightness = fit->straightness;
   m.points = static_cast<int>(fit->inliers.size());
   m.inliers = fit->inliers;
+  for (const int i : m.inliers) m.clippedPoints += clipped[static_cast<std::size_t>(i)] ? 1 : 0;
   return m;
 }
 

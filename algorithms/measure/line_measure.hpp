@@ -45,6 +45,9 @@ struct LineMeasurement {
   std::vector<cv::Point2d> edgePoints;  // every edge point found (inliers and outliers)
   std::vector<int> inliers;             // indices into edgePoints of the fit's inliers
   bool partial = false;                 // part of the rectangle lay outside the image
+  // Inlier points beside grey values the sensor clipped (ProfileEdge::clipped): each lies up to a
+  // pixel towards the unclipped side, so the line is offset by as much; lower the exposure.
+  int clippedPoints = 0;
   Status<MeasureFailure> status;
 };
 

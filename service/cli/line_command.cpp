@@ -53,6 +53,7 @@ void run(const LineOptions& o) {
         {"rms", m.rms},
         {"straightness", m.straightness},
         {"points", m.points},
+        {"clipped_points", m.clippedPoints},
         {"partial", m.partial},
         {"time_ms", ms}};
     if (seen) {
@@ -69,6 +70,10 @@ void run(const LineOptions& o) {
     return;
   }
   if (m.partial) std::cout << "note: part of the rectangle lies outside the image\n";
+  if (m.clippedPoints > 0)
+    std::cout << "note: " << m.clippedPoints
+              << " points lie beside grey values the sensor clipped (up to a pixel towards the "
+                 "unclipped side); lower the exposure\n";
   std::cout << "line from (" << m.p1.x << ", " << m.p1.y << ") to (" << m.p2.x << ", " << m.p2.y
             << ") px, angle " << m.angle << " deg\nstraightness " << m.straightness << " px, rms "
             << m.rms << " px, " << m.points << " points, " << ms << " ms\n";

@@ -156,6 +156,25 @@ TEST_F(MeasuringSteps, CircleOnAClippedRimIsFittedAsClippedAndSaysSo) {
       << said;
 }
 
+// The plate's top edge with twice the exposure: the line's points lie beside clipped grey
+// values, and the part's record says how many.
+TEST_F(MeasuringSteps, LineBesideClippedGreyValuesSaysSo) {
+  const std::string top = R"(  - id: top
+    kind: line
+    centre: [320, 152]
+    length: 200
+    width: 16
+)";
+  cv::Mat overexposed;
+  plate::render().convertTo(overexposed, CV_8U, 2.0);
+  const auto out = inspect(top, overexposed);
+  ASSERT_EQ(out.notes.size(), 1u) << plate::failures(out);
+  EXPECT_NE(out.notes[0].find("of its points lie beside grey values the sensor clipped"),
+            std::string::npos)
+      << out.notes[0];
+  EXPECT_TRUE(inspect(top).notes.empty());
+}
+
 TEST_F(MeasuringSteps, CaliperOutsideTheImageOrWithoutAnEdgeFailsWithTheCause) {
   const std::string check =
       "    checks:\n      position: {nominal: 0, tol_minus: 1, tol_plus: 1}\n";
