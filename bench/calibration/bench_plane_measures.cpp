@@ -23,8 +23,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <random>
 #include <string>
@@ -38,6 +36,7 @@
 #include "algorithms/measure/blob_analysis.hpp"
 #include "algorithms/measure/caliper.hpp"
 #include "algorithms/measure/line_measure.hpp"
+#include "bench/scene_run_args.hpp"
 #include "tests/calibration/calibration_scenes.hpp"
 #include "tests/support/scene/plane_scene.hpp"
 
@@ -260,21 +259,11 @@ void printRow(const char* quantity, double tilt, const Errors& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool smoke = false;
-  int scenes = 8;
-  std::uint64_t seed = 1;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--smoke")) {
-      smoke = true;
-    } else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc) {
-      scenes = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) {
-      seed = std::strtoull(argv[++i], nullptr, 10);
-    } else {
-      std::fprintf(stderr, "usage: bench_plane_measures [--smoke] [--scenes N] [--seed N]\n");
-      return 1;
-    }
-  }
+  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_plane_measures", 8);
+  if (!args) return 1;
+  const bool smoke = args->smoke;
+  int scenes = args->scenes;
+  const std::uint64_t seed = args->seed;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const std::vector<double> tilts =
       smoke ? std::vector<double>{25} : std::vector<double>{0, 10, 20, 30};

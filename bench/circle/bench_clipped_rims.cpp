@@ -17,13 +17,13 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <random>
 #include <vector>
 
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/circle/circle_measure.hpp"
+#include "bench/scene_run_args.hpp"
 #include "tests/support/scene/scene.hpp"
 
 namespace {
@@ -113,21 +113,11 @@ void canonicalEllipse(const Scene& s, Errors& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool smoke = false;
-  int scenes = 40;
-  std::uint64_t seed = 1;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--smoke")) {
-      smoke = true;
-    } else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc) {
-      scenes = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) {
-      seed = std::strtoull(argv[++i], nullptr, 10);
-    } else {
-      std::fprintf(stderr, "usage: bench_clipped_rims [--smoke] [--scenes N] [--seed N]\n");
-      return 2;
-    }
-  }
+  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_clipped_rims", 40);
+  if (!args) return 2;
+  const bool smoke = args->smoke;
+  int scenes = args->scenes;
+  const std::uint64_t seed = args->seed;
   if (smoke) scenes = 2;
   cv::setNumThreads(1);
   std::printf(

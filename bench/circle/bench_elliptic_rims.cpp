@@ -15,7 +15,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -23,6 +22,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/circle/circle_measure.hpp"
+#include "bench/scene_run_args.hpp"
 #include "tests/support/scene/scene.hpp"
 
 namespace {
@@ -107,21 +107,11 @@ bool canonicalEllipse(const Scene& s, cv::Point2d* centre) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool smoke = false;
-  int scenes = 60;
-  std::uint64_t seed = 1;
-  for (int i = 1; i < argc; ++i) {
-    if (!std::strcmp(argv[i], "--smoke")) {
-      smoke = true;
-    } else if (!std::strcmp(argv[i], "--scenes") && i + 1 < argc) {
-      scenes = std::atoi(argv[++i]);
-    } else if (!std::strcmp(argv[i], "--seed") && i + 1 < argc) {
-      seed = std::strtoull(argv[++i], nullptr, 10);
-    } else {
-      std::fprintf(stderr, "usage: bench_elliptic_rims [--smoke] [--scenes N] [--seed N]\n");
-      return 2;
-    }
-  }
+  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_elliptic_rims", 60);
+  if (!args) return 2;
+  const bool smoke = args->smoke;
+  int scenes = args->scenes;
+  const std::uint64_t seed = args->seed;
   if (smoke) scenes = 2;
   cv::setNumThreads(1);
   std::printf(
