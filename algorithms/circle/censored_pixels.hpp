@@ -9,8 +9,9 @@
 // says that the grey there is at or beyond it: where the model is too, the pixel has no residual
 // and no weight (the model is clipped as the sensor clips); where the model falls short, the
 // pixel pulls it as any other does. The levels beyond the clip are then fitted from the slope of
-// the step's visible part. A Tobit model's likelihood would also weigh the probability of the
-// clip; at a clip within the step (below) the difference is within the noise.
+// the step's visible part. (A Tobit likelihood would weigh how probable each clipped reading is;
+// it differs from this hinge only for pixels whose model lies within a few noise levels of the
+// limit, a thin ring next to the clipped side.)
 
 #include <cstddef>
 #include <span>
