@@ -28,6 +28,9 @@ struct AnnulusEdges {
   double lowThreshold = 0.0;      // grey levels per pixel (8-bit scale)
   double highThreshold = 0.0;
   double noiseSigma = 0.0;  // estimated image noise, grey levels (8-bit scale)
+  // Whether the noise estimate met pixels the sensor clipped (0 or the type's largest value) in
+  // the annulus: its masks there are left out (they read the clip as a noise-free image).
+  bool clipped = false;
 };
 
 // Edge points of `image` (CV_8UC1 or CV_16UC1) whose pixels lie at distances [rIn, rOut] from

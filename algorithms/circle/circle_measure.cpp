@@ -547,6 +547,7 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
                       " lies outside the " + std::to_string(image.cols) + "x" +
                       std::to_string(image.rows) + " image");
 
+  const bool annulusClipped = edges.clipped;
   m.lowThreshold = edges.lowThreshold;
   m.highThreshold = edges.highThreshold;
   m.edgePoints = static_cast<int>(edges.points.size());
@@ -727,9 +728,11 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
                    "which it is",
                    2 * candidate->ellipse.major, 2 * candidate->ellipse.minor));
   // A rim clipped by the sensor: its edge points alone are off (CircleMeasurement::clippedShare).
+  // Looked for only when the annulus's noise estimate met a clipped pixel (most images: none).
   const double halfSpread = ellipse ? (ellipse->major - ellipse->minor) / 2.0 : 0.0;
-  m.clippedShare = rim_band::clippedShare(image, m.centre, m.radius - kClippedBand - halfSpread,
-                                          m.radius + kClippedBand + halfSpread);
+  if (annulusClipped)
+    m.clippedShare = rim_band::clippedShare(image, m.centre, m.radius - kClippedBand - halfSpread,
+                                            m.radius + kClippedBand + halfSpread);
   if (params.refineWithGreyValues && !m.greyRefined)
     if (std::string why = clippedRimRefusal(m, image.depth()); !why.empty())
       return failed(m, CircleFailure::FitTooPoor, std::move(why));
