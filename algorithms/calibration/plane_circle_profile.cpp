@@ -284,13 +284,9 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   }
 
   Vector8 q;
-  {
-    const double clip = rim_band::clipLevel(image.depth());
-    const double out = rim_band::medianOf(outside), in = rim_band::medianOf(inside);
-    const double level = CensoredPixels::startingLevel(out, in, clip);
-    q << 0.0, 0.0, radiusPx, 1.2, level, 0.0, 0.0,
-        CensoredPixels::startingLevel(in, out, clip) - level;
-  }
+  const CensoredPixels::Step start = CensoredPixels::startingStep(
+      rim_band::medianOf(outside), rim_band::medianOf(inside), rim_band::clipLevel(image.depth()));
+  q << 0.0, 0.0, radiusPx, 1.2, start.level, 0.0, 0.0, start.contrast;
   const double tukeyC = noiseSigma > 0.0 ? 8.0 : 4.685;  // fitCircleProfile's reasons
 
   // Residuals (grey - model) and the model's Jacobian at parameters v. The Jacobian's columns of
@@ -299,7 +295,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   Eigen::VectorXd r, rTry, weight;
   Columns jac, jacTry;
   CensoredPixels clipped;  // fitted as the sensor clipped them (censored_pixels.hpp)
-  auto span = [&](Eigen::VectorXd& v) { return std::span<double>(v.data(), v.size()); };
+  auto all = [&](Eigen::VectorXd& v) { return std::span<double>(v.data(), v.size()); };
   auto loadBand = [&] {
     n = band.size();
     clipped = CensoredPixels({band.grey.data(), static_cast<std::size_t>(n)},
@@ -327,13 +323,13 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
     return (weight.array() * res.array().square()).sum();
   };
   auto tukeyWeights = [&] {
-    const double sigma = std::max(clipped.robustSigma(span(r)), 0.25);
+    const double sigma = std::max(clipped.robustSigma(all(r)), 0.25);
     const double c = tukeyC * sigma;
     for (Eigen::Index i = 0; i < n; ++i) {
       const double u = std::abs(r(i)) / c;
       weight(i) = u >= 1.0 ? 0.0 : (1 - u * u) * (1 - u * u);
     }
-    clipped.unweight(span(r), span(weight));
+    clipped.unweight(all(r), all(weight));
     return sigma;
   };
   Matrix8 jtj;
@@ -367,7 +363,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
     LevenbergMarquardtCallbacks problem{
         [&](const Vector8& v) {
           evaluate(v, r, jac);
-          clipped.censor(span(r));
+          clipped.censor(all(r));
           return cost(r);
         },
         [&](int, const Vector8&, Matrix8& h, Vector8& g, double& current) {
@@ -385,7 +381,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
         [&](const Vector8& v) -> std::optional<double> {
           if (!(v(kBlur) > 0.05)) return std::nullopt;
           evaluate(v, rTry, jacTry);
-          clipped.censor(span(rTry));
+          clipped.censor(all(rTry));
           return cost(rTry);
         },
         [&] {

@@ -44,6 +44,11 @@ double CensoredPixels::startingLevel(double level, double other, double clipLeve
   return level;
 }
 
+CensoredPixels::Step CensoredPixels::startingStep(double outside, double inside, double clipLevel) {
+  const double level = startingLevel(outside, inside, clipLevel);
+  return {level, startingLevel(inside, outside, clipLevel) - level};
+}
+
 bool CensoredPixels::middleSeen(double level, double contrast) const {
   const double middle = level + contrast / 2.0;
   return index_.empty() || (middle < clipLevel_ && middle > 0.0);

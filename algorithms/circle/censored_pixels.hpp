@@ -44,6 +44,12 @@ class CensoredPixels {
   // other side's): beyond the limit by half the step that is seen, so that the fit starts with
   // that side censored rather than at the limit, next to the fit of the pixels as they read.
   [[nodiscard]] static double startingLevel(double level, double other, double clipLevel);
+  // The starting outside level and contrast (inside minus outside) of a step whose sides' medians
+  // read `outside` and `inside`: startingLevel for each side.
+  struct Step {
+    double level, contrast;
+  };
+  [[nodiscard]] static Step startingStep(double outside, double inside, double clipLevel);
   // Whether a step from `level` by `contrast` (either sign) has its middle within the sensor's
   // range: beyond it, the rim is not seen but extrapolated from the foot of its step (holes in a
   // background 2.4 times the clip came out 0.06-0.7 px small), and no fit of it is kept.

@@ -411,17 +411,16 @@ GreyRim fitRimGreyValues(const cv::Mat& image, const CircleMeasurement& m,
                       cosTol);
   };
   if (ellipse || !judgeShape) return fit(circle, ellipse, m.inlierPoints);
+  const std::vector<cv::Point2d> candidatePoints =
+      candidate ? imagePoints(candidate->inliers) : std::vector<cv::Point2d>{};
   auto fromCandidate = [&] {
     const rim_ellipse::Ellipse& e = candidate->ellipse;
-    return fit({e.centre, e.meanRadius()}, e, imagePoints(candidate->inliers));
+    return fit({e.centre, e.meanRadius()}, e, candidatePoints);
   };
   // The circle is judged on the candidate's sectors too: on its own it chose the sectors it
   // fits (a circle locked onto arcs of an elliptic rim sees no harmonic there).
   std::vector<cv::Point2d> sectors = m.inlierPoints;
-  if (candidate) {
-    const std::vector<cv::Point2d> more = imagePoints(candidate->inliers);
-    sectors.insert(sectors.end(), more.begin(), more.end());
-  }
+  sectors.insert(sectors.end(), candidatePoints.begin(), candidatePoints.end());
   GreyRim round = fit(circle, std::nullopt, std::move(sectors));
   if (!round.fit) {
     if (!candidate) return round;

@@ -273,12 +273,9 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   }
   if (inside.empty() || outside.empty()) return std::nullopt;
   Vector8 p;
-  {
-    const double clip = rim_band::clipLevel(image.depth());
-    const double out = medianOf(outside), in = medianOf(inside);
-    p << 0.0, 0.0, radius, 1.2, CensoredPixels::startingLevel(out, in, clip), 0.0, 0.0, 0.0;
-    p(7) = CensoredPixels::startingLevel(in, out, clip) - p(4);
-  }
+  const CensoredPixels::Step start = CensoredPixels::startingStep(
+      medianOf(outside), medianOf(inside), rim_band::clipLevel(image.depth()));
+  p << 0.0, 0.0, radius, 1.2, start.level, 0.0, 0.0, start.contrast;
 
   // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
   // bins, as many pixels as rim_band::pixelsNeeded. When pixels are to spare, the narrower band

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <numbers>
 #include <span>
 #include <utility>
@@ -21,7 +22,8 @@ double medianOf(std::vector<double> v) {
 namespace {
 
 template <typename T>
-double clippedShareOf(const cv::Mat& image, const RowRuns& runs, T limit) {
+double clippedShareOf(const cv::Mat& image, const RowRuns& runs) {
+  constexpr T limit = std::numeric_limits<T>::max();
   std::size_t clipped = 0, all = 0;
   for (const RowRun& run : runs) {
     if (run.x1 <= run.x0) continue;
@@ -37,8 +39,8 @@ double clippedShareOf(const cv::Mat& image, const RowRuns& runs, T limit) {
 double clippedShare(const cv::Mat& image, cv::Point2d centre, double rIn, double rOut) {
   const RowRuns runs =
       annulusRowRuns(centre, std::max(0.0, rIn), rOut, cv::Rect(0, 0, image.cols, image.rows));
-  return image.depth() == CV_16U ? clippedShareOf<std::uint16_t>(image, runs, 65535)
-                                 : clippedShareOf<std::uint8_t>(image, runs, 255);
+  return image.depth() == CV_16U ? clippedShareOf<std::uint16_t>(image, runs)
+                                 : clippedShareOf<std::uint8_t>(image, runs);
 }
 
 double pixelsNeeded(double snr, double halfWidth) {

@@ -23,6 +23,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/circle/circle_measure.hpp"
+#include "bench/circle/annulus_ellipse_baseline.hpp"
 #include "bench/scene_run_args.hpp"
 #include "tests/support/scene/scene.hpp"
 
@@ -85,29 +86,15 @@ void measure(const cv::Mat& image, const Scene& s, const facet::CircleMeasurePar
     ++e.refused;
 }
 
-// cv::fitEllipseAMS on the Canny pixels (thresholds as OpenCV's tutorials) in the annulus.
+// The OpenCV baseline (annulus_ellipse_baseline.hpp); its radius: the axes' geometric mean.
 void canonicalEllipse(const Scene& s, Errors& e) {
-  cv::Mat smooth, edges;
-  cv::GaussianBlur(s.image, smooth, {5, 5}, 1.5);
-  cv::Canny(smooth, edges, 50, 100);
-  const facet::CircleMeasureParams& p = s.params;
-  std::vector<cv::Point2f> pts;
-  for (int y = 0; y < edges.rows; ++y)
-    for (int x = 0; x < edges.cols; ++x)
-      if (edges.at<std::uint8_t>(y, x) &&
-          std::abs(std::hypot(x - p.centre.x, y - p.centre.y) - p.radius) <= p.width)
-        pts.emplace_back(static_cast<float>(x), static_cast<float>(y));
-  if (pts.size() < 6) {
+  const auto r = facet::bench::annulusEllipseAMS(s.image, s.params);
+  if (!r) {
     ++e.refused;
     return;
   }
-  const cv::RotatedRect r = cv::fitEllipseAMS(pts);
-  const double radius = std::sqrt(r.size.width * r.size.height) / 2.0;
-  if (!std::isfinite(radius)) {
-    ++e.refused;
-    return;
-  }
-  e.add(cv::Point2d(r.center) - s.centre, radius - s.radius);
+  e.add(cv::Point2d(r->center) - s.centre,
+        std::sqrt(r->size.width * r->size.height) / 2.0 - s.radius);
 }
 
 }  // namespace

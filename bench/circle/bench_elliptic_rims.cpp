@@ -22,6 +22,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/circle/circle_measure.hpp"
+#include "bench/circle/annulus_ellipse_baseline.hpp"
 #include "bench/scene_run_args.hpp"
 #include "tests/support/scene/scene.hpp"
 
@@ -85,25 +86,6 @@ Scene makeScene(double ratio, double radius, bool occluded, std::mt19937_64& rng
   return out;
 }
 
-// cv::fitEllipseAMS on the Canny pixels (thresholds as OpenCV's tutorials) in the annulus.
-bool canonicalEllipse(const Scene& s, cv::Point2d* centre) {
-  cv::Mat smooth, edges;
-  cv::GaussianBlur(s.image, smooth, {5, 5}, 1.5);
-  cv::Canny(smooth, edges, 50, 100);
-  const facet::CircleMeasureParams& p = s.params;
-  std::vector<cv::Point2f> pts;
-  for (int y = 0; y < edges.rows; ++y)
-    for (int x = 0; x < edges.cols; ++x) {
-      const double d = std::hypot(x - p.centre.x, y - p.centre.y);
-      if (edges.at<std::uint8_t>(y, x) && std::abs(d - p.radius) <= p.width)
-        pts.emplace_back(static_cast<float>(x), static_cast<float>(y));
-    }
-  if (pts.size() < 6) return false;
-  const cv::RotatedRect e = cv::fitEllipseAMS(pts);
-  *centre = e.center;
-  return std::isfinite(centre->x) && std::isfinite(centre->y);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -141,9 +123,8 @@ int main(int argc, char** argv) {
             circle.add(cv::norm(c.centre - s.centre));
           else
             ++circle.refused;
-          cv::Point2d e;
-          if (canonicalEllipse(s, &e))
-            ams.add(cv::norm(e - s.centre));
+          if (const auto e = facet::bench::annulusEllipseAMS(s.image, s.params))
+            ams.add(cv::norm(cv::Point2d(e->center) - s.centre));
           else
             ++ams.refused;
         }
