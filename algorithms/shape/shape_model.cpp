@@ -23,6 +23,8 @@ constexpr int kMinModelPoints = 8;
 // Automatic pyramid levels (ShapeModelParams::numLevels = 0).
 constexpr int kMinTopEdgePoints = 24;  // fewer cannot tell the part from clutter
 constexpr double kMinTopRadius = 5.0;  // pixels; the angle step atan(1 / R) stays below 12 deg
+// Automatic minimum edge component, level-0 pixels: the contour of a dot about 3 px across.
+constexpr int kAutoMinComponentSize = 10;
 
 // The q-quantile of the gradient magnitude over the masked pixels.
 double magnitudeQuantile(const cv::Mat& magnitude, const cv::Mat& mask, double q) {
@@ -98,9 +100,6 @@ std::vector<cv::Point> edgePixels(const cv::Mat& gx, const cv::Mat& gy, const cv
         }
       }
   }
-  // Raster order spreads thinning evenly over the whole model.
-  std::sort(accepted.begin(), accepted.end(),
-            [](cv::Point a, cv::Point b) { return a.y != b.y ? a.y < b.y : a.x < b.x; });
   return accepted;
 }
 
@@ -117,19 +116,53 @@ void thin(std::vector<T>& points, int maxPoints) {
 struct LevelResult {
   std::vector<ShapePoint> points;
   Thresholds thresholds;
-  cv::Mat edgeMask;  // CV_8U, 255 on every edge pixel before thinning
+  cv::Mat edgeMask;          // CV_8U, 255 on every edge pixel before thinning
+  int minComponentSize = 0;  // as applied (0 = every component kept)
 };
 
+// Clears the edge components of fewer than `minSize` pixels (8-connected). With `automatic`, keeps
+// them all instead when they hold half of the edge pixels or more, and returns 0 (nothing
+// dropped); otherwise returns minSize.
+int dropShortComponents(cv::Mat& edgeMask, int minSize, bool automatic) {
+  if (minSize <= 1) return 0;
+  cv::Mat labels, stats, centroids;
+  const int n = cv::connectedComponentsWithStats(edgeMask, labels, stats, centroids, 8, CV_32S);
+  std::vector<uchar> shortOne(static_cast<std::size_t>(n), 0);
+  int shortPixels = 0, allPixels = 0;
+  for (int i = 1; i < n; ++i) {
+    const int size = stats.at<int>(i, cv::CC_STAT_AREA);
+    shortOne[static_cast<std::size_t>(i)] = size < minSize;
+    shortPixels += size < minSize ? size : 0;
+    allPixels += size;
+  }
+  if (automatic && 2 * shortPixels >= allPixels) return 0;
+  for (int y = 0; y < edgeMask.rows; ++y)
+    for (int x = 0; x < edgeMask.cols; ++x)
+      if (shortOne[static_cast<std::size_t>(labels.at<int>(y, x))]) edgeMask.at<uchar>(y, x) = 0;
+  return minSize;
+}
+
+// The mask's edge pixels in raster order (thinning then spreads evenly over the whole model).
+std::vector<cv::Point> edgePixelsOf(const cv::Mat& edgeMask) {
+  std::vector<cv::Point> pixels;
+  cv::findNonZero(edgeMask, pixels);
+  return pixels;
+}
+
 LevelResult levelPoints(const cv::Mat& grey, const cv::Mat& mask, cv::Point2d reference,
-                        const ShapeModelParams& params, int maxPoints) {
+                        const ShapeModelParams& params, int maxPoints, int minComponentSize,
+                        bool automaticComponents) {
   cv::Mat gx, gy, magnitude;
   sobelGradients(grey, gx, gy);
   cv::magnitude(gx, gy, magnitude);
   LevelResult result;
   result.thresholds = chooseThresholds(magnitude, mask, params);
   result.edgeMask = cv::Mat(grey.size(), CV_8U, cv::Scalar(0));
-  for (const cv::Point p : edgePixels(gx, gy, magnitude, mask, result.thresholds)) {
+  for (const cv::Point p : edgePixels(gx, gy, magnitude, mask, result.thresholds))
     result.edgeMask.at<uchar>(p) = 255;
+  result.minComponentSize =
+      dropShortComponents(result.edgeMask, minComponentSize, automaticComponents);
+  for (const cv::Point p : edgePixelsOf(result.edgeMask)) {
     const float m = magnitude.at<float>(p);
     result.points.push_back(
         {cv::Point2f(static_cast<float>(p.x - reference.x), static_cast<float>(p.y - reference.y)),
@@ -203,6 +236,8 @@ void checkParams(const cv::Mat& image, const ShapeModelParams& p) {
   if (!(p.scaleMin > 0.0) || !(p.scaleMax >= p.scaleMin) || !(p.scaleStep >= 0.0))
     throw ShapeModelError("shape model: the scale range must satisfy 0 < min <= max");
   if (!(p.minContrast >= 0.0)) throw ShapeModelError("shape model: minContrast must be >= 0");
+  if (p.minComponentSize && *p.minComponentSize < 0)
+    throw ShapeModelError("shape model: the minimum edge component must be >= 0 pixels");
 }
 
 }  // namespace
@@ -255,11 +290,19 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
       if (!mask.empty()) cv::resize(mask, mask, grey.size(), 0, 0, cv::INTER_NEAREST);
     }
     const double f = std::ldexp(1.0, -level);
+    // Level 0 decides (automatic: whether the short components are the part); the levels above
+    // drop what that length shrinks to.
+    const bool automaticComponents = level == 0 && !params.minComponentSize;
+    const int minComponentSize = level == 0
+                                     ? params.minComponentSize.value_or(kAutoMinComponentSize)
+                                     : static_cast<int>(model.minComponentSize * f);
     LevelResult r = levelPoints(
         grey, mask, model.referencePoint * f, params,
         level == 0 ? params.maxPoints
                    : (params.maxPoints > 0 ? std::min(params.maxPoints, kMaxUpperLevelPoints)
-                                           : kMaxUpperLevelPoints));
+                                           : kMaxUpperLevelPoints),
+        minComponentSize, automaticComponents);
+    if (level == 0) model.minComponentSize = r.minComponentSize;
     if (level == 0) {
       if (static_cast<int>(r.points.size()) < kMinModelPoints)
         throw ShapeModelError("shape model: the template has too few edges (" +

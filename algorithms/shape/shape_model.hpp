@@ -78,6 +78,13 @@ struct ShapeModelParams {
   // Image gradients weaker than this (grey levels per pixel, 8-bit scale) are treated as noise
   // and contribute nothing to the score during the search. Default 5.
   double minContrast = 5.0;
+  // Edge components (8-connected edge pixels after hysteresis) with fewer pixels than this on
+  // level 0 are left out of the model (on level l, this divided by 2^l): the contours of specks,
+  // dust and the texture of one sample, which another sample of the part does not have, and which
+  // would lower its score. 0 or 1 = keep every component. Missing = automatic: 10 pixels (the
+  // contour of a dot about 3 px across), unless the short components hold half of the template's
+  // edge pixels or more (a pattern of small features: they are the part, and all are kept).
+  std::optional<int> minComponentSize;
   // Most points kept per pyramid level; larger models are thinned evenly along their edges.
   // Default 800 (level 0), 0 = no thinning. Upper levels keep at most 250 (top-level SIMD sums).
   int maxPoints = 800;
@@ -120,6 +127,9 @@ struct ShapeModel {
   double minContrast = 5.0;  // grey levels per pixel
   double contrastLow = 0.0;  // thresholds actually used for the template, grey levels per pixel
   double contrastHigh = 0.0;
+  // Shortest edge component kept on level 0, pixels (ShapeModelParams::minComponentSize as
+  // applied; 0 = all kept). Training only: 0 for a model loaded from a file.
+  int minComponentSize = 0;
   // Rotations that map the model almost onto itself, on level 0 or on the top level
   // (findSearchSymmetries, model_symmetry.hpp; derived from the points when the model is
   // created, and kept in its file).

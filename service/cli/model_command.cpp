@@ -1,6 +1,7 @@
 // facet model create: trains a shape model from a template image and writes it to a model file.
 #include <cmath>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -19,6 +20,7 @@ struct ModelOptions {
   std::string scaleRange;
   int levels = 0;
   double minContrast = ShapeModelParams{}.minContrast;
+  std::optional<int> minComponent;  // unset = automatic
   std::string edgeEstimator = "auto";
   std::string out;
   bool json = false;
@@ -66,6 +68,7 @@ void run(const ModelOptions& o) {
   }
   p.numLevels = o.levels;
   p.minContrast = o.minContrast;
+  p.minComponentSize = o.minComponent;
   if (o.edgeEstimator == "profile")
     p.edgeEstimator = EdgeEstimator::ProfileFit;
   else if (o.edgeEstimator == "zero-crossing")
@@ -107,6 +110,8 @@ void run(const ModelOptions& o) {
          {"contrast_low", model.contrastLow},
          {"contrast_high", model.contrastHigh},
          {"min_contrast", model.minContrast},
+         {"min_component", model.minComponentSize},
+         {"min_component_chosen", o.minComponent ? "--min-component" : "automatic"},
          {"near_symmetries", symmetries},
          {"edge_estimator", edgeEstimatorName(model.edgeEstimator)},
          {"edge_estimator_chosen", o.edgeEstimator == "auto" ? "automatic" : "--edge-estimator"},
@@ -136,6 +141,12 @@ void addModelCommand(CLI::App& app) {
   create->add_option("--levels", o->levels, "Pyramid levels (default 0 = automatic)");
   create->add_option("--min-contrast", o->minContrast,
                      "Weakest gradient used, grey levels per pixel (default 5)");
+  create
+      ->add_option("--min-component", o->minComponent,
+                   "Shortest edge contour kept, pixels; shorter ones (specks, dust, one sample's "
+                   "texture) are left out (default: automatic, 10 unless the short contours are "
+                   "most of the template's edges; 0 = keep all)")
+      ->check(CLI::Range(0, 1000000));
   create
       ->add_option("--edge-estimator", o->edgeEstimator,
                    "Subpixel edges of the refinement: profile (blurred-step fit), zero-crossing "

@@ -96,6 +96,21 @@ TEST(ShapeCli, CreateThenMatchPrintsThePoseAsJson) {
   EXPECT_EQ(created.at("edge_estimator_chosen"), "automatic");
   EXPECT_LT(created.at("edge_estimator_trials").at("profile").get<double>(),
             created.at("edge_estimator_trials").at("zero-crossing").get<double>());
+  // The automatic minimum contour length, and one given by hand.
+  EXPECT_EQ(created.at("min_component").get<int>(), 10);
+  EXPECT_EQ(created.at("min_component_chosen"), "automatic");
+  const CliRun keepAll = run(cli + " model create --image " + (dir / "template.png").string() +
+                                 " --roi 40,30,160,130 --min-component 0 --out " +
+                                 (dir / "all.model").string() + " --json",
+                             err);
+  ASSERT_EQ(keepAll.exitCode, 0) << readText(err);
+  EXPECT_EQ(nlohmann::json::parse(keepAll.out).at("min_component").get<int>(), 0);
+  EXPECT_EQ(nlohmann::json::parse(keepAll.out).at("min_component_chosen"), "--min-component");
+  const CliRun negative = run(cli + " model create --image " + (dir / "template.png").string() +
+                                  " --min-component -2 --out " + (dir / "x.model").string(),
+                              err);
+  EXPECT_EQ(negative.exitCode, 1);
+  EXPECT_NE(readText(err).find("--min-component"), std::string::npos) << readText(err);
 
   const CliRun match = run(cli + " match --model " + (dir / "part.model").string() + " --image " +
                                (dir / "scene.png").string() +

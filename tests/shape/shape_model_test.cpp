@@ -1,8 +1,10 @@
 // createShapeModel: what a trained model holds, and how each training parameter shapes it.
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
+#include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model.hpp"
 #include "tests/shape/bracket_scenes.hpp"
 
@@ -136,6 +138,79 @@ TEST(ShapeModel, TemplateWithoutEdgesIsRefusedClearly) {
   ShapeModelParams bad;
   bad.scaleMin = 0.0;
   EXPECT_THROW(createShapeModel(bracketTemplate(), bad), ShapeModelError);
+}
+
+// Places on the bracket's plate with no edge within 6 px: where a speck of dust would sit.
+std::vector<cv::Point2d> plainPlaces(const cv::Mat& templ, std::size_t count) {
+  std::vector<cv::Point2d> places;
+  for (int y = 8; y < templ.rows - 8 && places.size() < count; y += 9)
+    for (int x = 8; x < templ.cols - 8 && places.size() < count; x += 23) {
+      double lo = 0.0, hi = 0.0;
+      cv::minMaxLoc(templ(cv::Rect(x - 6, y - 6, 13, 13)), &lo, &hi);
+      if (lo > testing::kPartGrey - 12 && hi < testing::kPartGrey + 12) places.emplace_back(x, y);
+    }
+  return places;
+}
+
+// A speck on the template (dust, a scratch, one sample's texture) is not on the next part: its
+// contour would only lower that part's score in the search. The automatic minimum component
+// leaves out contours of fewer than 10 pixels; 0 keeps them.
+TEST(ShapeModel, SpecksOfOneSampleAreLeftOutOfTheModel) {
+  scene::Scene speckled =
+      scene::templateScene(scene::bracketPart(), testing::bracketSpec({}, 99), testing::kPartGrey);
+  const std::vector<cv::Point2d> specks = plainPlaces(bracketTemplate(), 6);
+  ASSERT_EQ(specks.size(), 6u);
+  for (const cv::Point2d& c : specks) speckled.addDisc(c, 1.0, 60.0);
+  const cv::Mat templ = speckled.render();
+
+  const ShapeModel automatic = createShapeModel(templ);
+  ShapeModelParams keepAll;
+  keepAll.minComponentSize = 0;
+  const ShapeModel everything = createShapeModel(templ, keepAll);
+  EXPECT_EQ(automatic.minComponentSize, 10);
+  EXPECT_EQ(everything.minComponentSize, 0);
+  const auto pointsNearSpecks = [&](const ShapeModel& m) {
+    int n = 0;
+    for (const ShapePoint& p : m.levels[0].points)
+      for (const cv::Point2d& c : specks)
+        n += std::hypot(p.position.x + m.referencePoint.x - c.x,
+                        p.position.y + m.referencePoint.y - c.y) < 3.0;
+    return n;
+  };
+  EXPECT_GE(pointsNearSpecks(everything), 12);  // the specks do make edges
+  EXPECT_EQ(pointsNearSpecks(automatic), 0);
+
+  // Another sample, without the specks: the model without them sees more of it (the search's
+  // score, on the level-0 points; the subpixel points have no edge on dots this small).
+  const Pose2D truth{200.3, 150.6, 0.4, 1.0};
+  const cv::Mat part = testing::bracketScene({400, 300}, {truth}, 17);
+  FindParams searchOnly;
+  searchOnly.subpixel = SubpixelMode::None;
+  const auto a = findShapeModel(part, automatic, searchOnly);
+  const auto e = findShapeModel(part, everything, searchOnly);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(e.size(), 1u);
+  EXPECT_GT(a[0].score, e[0].score + 0.03);
+  EXPECT_LT(std::hypot(a[0].x - truth.x, a[0].y - truth.y), 1.0);
+}
+
+// A template made of small features only (a dot pattern): they are the part, and the automatic
+// minimum keeps them; a minimum set by hand is applied as given.
+TEST(ShapeModel, APatternOfDotsKeepsItsDots) {
+  scene::SceneSpec spec = testing::bracketSpec({120, 100}, 5);
+  scene::Scene dots(spec);
+  for (int row = 0; row < 4; ++row)
+    for (int col = 0; col < 5; ++col)
+      dots.addDisc({20.3 + 20.0 * col, 20.6 + 20.0 * row}, 1.0, testing::kPartGrey);
+  const cv::Mat templ = dots.render();
+  const ShapeModel model = createShapeModel(templ);
+  EXPECT_EQ(model.minComponentSize, 0);
+  EXPECT_GE(model.levels[0].points.size(), 150u);
+  ShapeModelParams strict;
+  strict.minComponentSize = 12;
+  EXPECT_THROW(createShapeModel(templ, strict), ShapeModelError);
+  strict.minComponentSize = -1;
+  EXPECT_THROW(createShapeModel(bracketTemplate(), strict), ShapeModelError);
 }
 
 TEST(ShapeModel, SixteenBitTemplateGivesTheSameModel) {
