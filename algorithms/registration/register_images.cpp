@@ -10,6 +10,7 @@
 #include "algorithms/image/grey_image.hpp"
 #include "algorithms/registration/correlation_peak.hpp"
 #include "algorithms/registration/harris_affine.hpp"
+#include "algorithms/registration/patch_correlation.hpp"
 #include "algorithms/registration/rotation_scale_vote.hpp"
 
 namespace facet {
@@ -143,7 +144,7 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
     const cv::Rect search(cx - r - R, cy - r - R, 2 * (r + R) + 1, 2 * (r + R) + 1);
     if ((search & bounds) != search) continue;
     if (cv::countNonZero(valid(templ)) != templ.area()) continue;
-    cv::matchTemplate(img(search), warped(templ), result, cv::TM_CCOEFF_NORMED);
+    correlatePatch(img(search), warped(templ), result);
     double best = 0;
     cv::Point loc;
     cv::minMaxLoc(result, nullptr, &best, nullptr, &loc);
