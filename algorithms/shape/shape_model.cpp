@@ -302,13 +302,17 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
                    : (params.maxPoints > 0 ? std::min(params.maxPoints, kMaxUpperLevelPoints)
                                            : kMaxUpperLevelPoints),
         minComponentSize, automaticComponents);
-    if (level == 0) model.minComponentSize = r.minComponentSize;
     if (level == 0) {
+      model.minComponentSize = r.minComponentSize;
       if (static_cast<int>(r.points.size()) < kMinModelPoints)
-        throw ShapeModelError("shape model: the template has too few edges (" +
-                              std::to_string(r.points.size()) +
-                              " edge points above the contrast threshold " +
-                              std::to_string(r.thresholds.high) + " grey levels per pixel)");
+        throw ShapeModelError(
+            "shape model: the template has too few edges (" + std::to_string(r.points.size()) +
+            " edge points above the contrast threshold " + std::to_string(r.thresholds.high) +
+            " grey levels per pixel" +
+            (r.minComponentSize > 1
+                 ? " on contours of at least " + std::to_string(r.minComponentSize) + " pixels"
+                 : std::string()) +
+            ")");
       model.contrastLow = r.thresholds.low;
       model.contrastHigh = r.thresholds.high;
       cv::dilate(r.edgeMask, modelEdges, cv::Mat());
