@@ -17,10 +17,11 @@ struct SceneRunArgs {
   std::uint64_t seed = 1;
 };
 
-// The arguments with `scenes` per row by default and seed 1; nothing (after printing the usage
-// line with `name`) for any other argument or a count that is not a positive number.
+// The arguments with `scenes` per row by default (`smokeScenes` with --smoke) and seed 1; nothing
+// (after printing the usage line with `name`) for any other argument or a count that is not a
+// positive number.
 inline std::optional<SceneRunArgs> parseSceneRunArgs(int argc, char** argv, const char* name,
-                                                     int scenes) {
+                                                     int scenes, int smokeScenes) {
   SceneRunArgs args;
   args.scenes = scenes;
   for (int i = 1; i < argc; ++i) {
@@ -38,6 +39,7 @@ inline std::optional<SceneRunArgs> parseSceneRunArgs(int argc, char** argv, cons
       return std::nullopt;
     }
   }
+  if (args.smoke) args.scenes = smokeScenes;
   return args;
 }
 

@@ -19,6 +19,7 @@
 #include "algorithms/circle/weighted_normal_equations.hpp"
 #include "algorithms/edges/row_runs.hpp"
 #include "algorithms/geometry/levenberg_marquardt.hpp"
+#include "algorithms/image/sensor_limit.hpp"
 
 namespace facet {
 namespace {
@@ -285,7 +286,7 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
 
   Vector8 q;
   const CensoredPixels::Step start = CensoredPixels::startingStep(
-      rim_band::medianOf(outside), rim_band::medianOf(inside), rim_band::clipLevel(image.depth()));
+      rim_band::medianOf(outside), rim_band::medianOf(inside), sensorLimit(image.depth()));
   q << 0.0, 0.0, radiusPx, 1.2, start.level, 0.0, 0.0, start.contrast;
   const double tukeyC = noiseSigma > 0.0 ? 8.0 : 4.685;  // fitCircleProfile's reasons
 
@@ -298,8 +299,8 @@ std::optional<PlaneCircleProfileFit> fitPlaneCircleProfile(
   auto all = [&](Eigen::VectorXd& v) { return std::span<double>(v.data(), v.size()); };
   auto loadBand = [&] {
     n = band.size();
-    clipped = CensoredPixels({band.grey.data(), static_cast<std::size_t>(n)},
-                             rim_band::clipLevel(image.depth()));
+    clipped =
+        CensoredPixels({band.grey.data(), static_cast<std::size_t>(n)}, sensorLimit(image.depth()));
     r.resize(n), rTry.resize(n);
     weight.setOnes(n);
     for (Columns* j : {&jac, &jacTry}) {

@@ -23,7 +23,8 @@ class CensoredPixels {
  public:
   CensoredPixels() = default;
   // `grey`: the band's grey values, on the scale where `clipLevel` is the sensor's largest value
-  // (rim_band::clipLevel); the pixels at it or at 0 are the censored ones.
+  // (sensorLimit, algorithms/image/sensor_limit.hpp); the pixels at it or at 0 are the censored
+  // ones.
   CensoredPixels(std::span<const double> grey, double clipLevel);
 
   [[nodiscard]] bool empty() const { return index_.empty(); }

@@ -19,6 +19,7 @@
 #include "algorithms/circle/weighted_normal_equations.hpp"
 #include "algorithms/edges/row_runs.hpp"
 #include "algorithms/geometry/levenberg_marquardt.hpp"
+#include "algorithms/image/sensor_limit.hpp"
 
 namespace facet {
 namespace {
@@ -273,8 +274,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   }
   if (inside.empty() || outside.empty()) return std::nullopt;
   Vector8 p;
-  const CensoredPixels::Step start = CensoredPixels::startingStep(
-      medianOf(outside), medianOf(inside), rim_band::clipLevel(image.depth()));
+  const CensoredPixels::Step start =
+      CensoredPixels::startingStep(medianOf(outside), medianOf(inside), sensorLimit(image.depth()));
   p << 0.0, 0.0, radius, 1.2, start.level, 0.0, 0.0, start.contrast;
 
   // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
@@ -401,7 +402,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
       py(i) = samples[i].y;
       grey(i) = samples[i].grey;
     }
-    clipped = CensoredPixels({grey.data(), m}, rim_band::clipLevel(image.depth()));
+    clipped = CensoredPixels({grey.data(), m}, sensorLimit(image.depth()));
     r.resize(n);
     rTry.resize(n);
     weight.setOnes(n);

@@ -27,12 +27,6 @@ inline double greyAt(const cv::Mat& image, int x, int y) {
                                  : static_cast<double>(image.at<std::uint8_t>(y, x));
 }
 
-// The largest grey value of an image of `depth` (CV_8U or CV_16U) on greyAt's scale. A pixel
-// there or at 0 is at the sensor's limit: what it saw may have been brighter (or darker).
-inline double clipLevel(int depth) {
-  return depth == CV_16U ? 65535.0 / 256.0 : 255.0;
-}
-
 // The share of the pixels of the annulus rIn <= |p - centre| <= rOut (inside the image) at the
 // sensor's limits; 0 when the annulus holds no pixel.
 double clippedShare(const cv::Mat& image, cv::Point2d centre, double rIn, double rOut);

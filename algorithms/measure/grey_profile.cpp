@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "algorithms/image/sensor_limit.hpp"
+
 namespace facet {
 namespace {
 
@@ -141,7 +143,7 @@ const GreyProfile& GreyProfileSampler::sample(const cv::Mat& image, const Measur
   profile_.values.clear();
   profile_.start = profile_.step = 0;
   profile_.partial = false;
-  profile_.clipLevel = image.depth() == CV_8U ? 255.0 : 65535.0 / 256.0;
+  profile_.clipLevel = sensorLimit(image.depth());
   if (image.empty() || !(path.length() > 0) || !(path.width() > 0)) return profile_;
   if (image.depth() == CV_8U)
     sampleAs<std::uint8_t>(image, path, 1.0);

@@ -259,17 +259,14 @@ void printRow(const char* quantity, double tilt, const Errors& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_plane_measures", 8);
+  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_plane_measures", 8, 1);
   if (!args) return 1;
-  const bool smoke = args->smoke;
-  int scenes = args->scenes;
-  const std::uint64_t seed = args->seed;
+  const auto [smoke, scenes, seed] = *args;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   const std::vector<double> tilts =
       smoke ? std::vector<double>{25} : std::vector<double>{0, 10, 20, 30};
   // A lens's blur, and none (pixel integration alone: the sharpest image a sensor gives).
   const std::vector<double> blurs = smoke ? std::vector<double>{0.7} : std::vector<double>{0.7, 0};
-  if (smoke) scenes = 1;
   const struct {
     const char* name;
     Errors TiltRow::*errors;

@@ -100,12 +100,9 @@ void canonicalEllipse(const Scene& s, Errors& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_clipped_rims", 40);
+  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_clipped_rims", 40, 2);
   if (!args) return 2;
-  const bool smoke = args->smoke;
-  int scenes = args->scenes;
-  const std::uint64_t seed = args->seed;
-  if (smoke) scenes = 2;
+  const auto [smoke, scenes, seed] = *args;
   cv::setNumThreads(1);
   std::printf(
       "bench_clipped_rims: %d scenes per row, a hole (grey 30) in a backlight of `light` grey "

@@ -89,12 +89,9 @@ Scene makeScene(double ratio, double radius, bool occluded, std::mt19937_64& rng
 }  // namespace
 
 int main(int argc, char** argv) {
-  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_elliptic_rims", 60);
+  const auto args = facet::bench::parseSceneRunArgs(argc, argv, "bench_elliptic_rims", 60, 2);
   if (!args) return 2;
-  const bool smoke = args->smoke;
-  int scenes = args->scenes;
-  const std::uint64_t seed = args->seed;
-  if (smoke) scenes = 2;
+  const auto [smoke, scenes, seed] = *args;
   cv::setNumThreads(1);
   std::printf(
       "bench_elliptic_rims: %d scenes per row (half discs, half holes), blur 1, noise 2, clutter "

@@ -42,15 +42,18 @@ class MeasuringSteps : public ::testing::Test {
   fs::path dir_;
 };
 
-TEST_F(MeasuringSteps, CaliperPairGivesThePlatesWidth) {
-  const auto out = inspect(R"(  - id: across
+// A caliper across the plate, measuring its width as a pair of edges.
+const std::string kAcrossCaliper = R"(  - id: across
     kind: caliper
     centre: [320, 240]
     length: 300
     width: 10
     measure: pairs
     polarity: rising
-    checks:
+)";
+
+TEST_F(MeasuringSteps, CaliperPairGivesThePlatesWidth) {
+  const auto out = inspect(kAcrossCaliper + R"(    checks:
       width: {nominal: 12, tol_minus: 0.01, tol_plus: 0.01}
       position: {nominal: 0, tol_minus: 0.01, tol_plus: 0.01}
       count: {nominal: 1, tol_minus: 0, tol_plus: 0}
@@ -102,29 +105,13 @@ TEST_F(MeasuringSteps, CaliperPartlyOutsideMeasuresInsideAndSaysSo) {
 TEST_F(MeasuringSteps, CaliperBesideClippedGreyValuesSaysSo) {
   cv::Mat overexposed;
   plate::render().convertTo(overexposed, CV_8U, 2.0);
-  const auto out = inspect(R"(  - id: across
-    kind: caliper
-    centre: [320, 240]
-    length: 300
-    width: 10
-    measure: pairs
-    polarity: rising
-)",
-                           overexposed);
+  const auto out = inspect(kAcrossCaliper, overexposed);
   ASSERT_EQ(out.notes.size(), 1u) << plate::failures(out);
   EXPECT_NE(out.notes[0].find("the sensor clipped the grey values beside an edge"),
             std::string::npos)
       << out.notes[0];
   // The same plate exposed as usual: nothing said.
-  EXPECT_TRUE(inspect(R"(  - id: across
-    kind: caliper
-    centre: [320, 240]
-    length: 300
-    width: 10
-    measure: pairs
-    polarity: rising
-)")
-                  .notes.empty());
+  EXPECT_TRUE(inspect(kAcrossCaliper).notes.empty());
 }
 
 // The bore (0.8 mm) in the plate photographed with twice the exposure (the plate reads 255):
