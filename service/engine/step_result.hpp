@@ -20,6 +20,11 @@ struct StepResult {
   std::map<std::string, double> values;     // by check name; lengths in px (or mm, see below)
   bool lengthsInMm = false;                 // scan_align measures metric scans, not pixels
 
+  // Adds a reservation to the note ("; " between two).
+  void addNote(const std::string& reservation) {
+    note = note.empty() ? reservation : note + "; " + reservation;
+  }
+
   static StepResult failed(std::string cause) {
     StepResult r;
     r.ok = false;

@@ -158,9 +158,9 @@ StepResult CaliperStep::run(const config::Step& step, StepContext& part) const {
   for (const CaliperEdge& e : m.edges) clipped = clipped || e.clipped;
   for (const CaliperPair& pr : m.pairs) clipped = clipped || pr.first.clipped || pr.second.clipped;
   if (clipped)
-    r.note = (r.note.empty() ? "" : r.note + "; ") +
-             "the sensor clipped the grey values beside an edge: it lies up to a pixel towards "
-             "the unclipped side; lower the exposure";
+    r.addNote(
+        "the sensor clipped the grey values beside an edge: it lies up to a pixel towards the "
+        "unclipped side; lower the exposure");
 
   // Each edge as a short line across the axis; pair centres as crosses.
   const double half = path.width() / 2;

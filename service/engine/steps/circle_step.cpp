@@ -153,12 +153,10 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
     // A rim the image shows as an ellipse (a tilted view): its centre is right, its size is not
     // one diameter. The line must learn that its scale holds only on average here.
     if (m.elliptic)
-      r.note = (note.empty() ? "" : note + "; ") +
-               cv::format(
-                   "the rim is an ellipse (axes %.2f x %.2f px): the view is tilted; the "
-                   "diameter is that of a circle of its area (calibrate the measuring "
-                   "plane for the true one)",
-                   m.majorDiameter, m.minorDiameter);
+      r.addNote(cv::format(
+          "the rim is an ellipse (axes %.2f x %.2f px): the view is tilted; the diameter is that "
+          "of a circle of its area (calibrate the measuring plane for the true one)",
+          m.majorDiameter, m.minorDiameter));
     r.values["diameter"] = m.diameter;
     r.values["x"] = m.centre.x - expected.x;
     r.values["y"] = m.centre.y - expected.y;
@@ -173,11 +171,10 @@ StepResult CircleStep::run(const config::Step& step, StepContext& part) const {
   // Measured although the sensor clipped the rim (its grey values fitted as clipped): the line
   // should know that the exposure costs it precision.
   if (m.clippedShare > kClippedRimShare)
-    r.note = (r.note.empty() ? "" : r.note + "; ") +
-             cv::format(
-                 "the sensor clipped %.0f%% of the pixels near the rim: fitted as clipped, a few "
-                 "hundredths of a pixel less precise; lower the exposure",
-                 100.0 * m.clippedShare);
+    r.addNote(
+        cv::format("the sensor clipped %.0f%% of the pixels near the rim: fitted as clipped, a few "
+                   "hundredths of a pixel less precise; lower the exposure",
+                   100.0 * m.clippedShare));
   part.overlay.cross(*r.point, 4, true);
   return r;
 }

@@ -66,11 +66,10 @@ StepResult LineStep::run(const config::Step& step, StepContext& part) const {
   r.angleDeg = m.angle;
   if (m.partial) r.note = "part of the line rectangle lies outside the image: measured inside only";
   if (m.clippedPoints > 0)
-    r.note = (r.note.empty() ? "" : r.note + "; ") +
-             cv::format(
-                 "%d of its points lie beside grey values the sensor clipped: the line lies up "
-                 "to a pixel towards the unclipped side; lower the exposure",
-                 m.clippedPoints);
+    r.addNote(
+        cv::format("%d of its points lie beside grey values the sensor clipped: the line lies up "
+                   "to a pixel towards the unclipped side; lower the exposure",
+                   m.clippedPoints));
   part.overlay.polyline({m.p1, m.p2}, true);
   return r;
 }
