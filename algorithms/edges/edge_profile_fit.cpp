@@ -86,8 +86,12 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
   float* const t = out.t.data();
   float* const v = out.v.data();
   float* const weight = out.weight.data();
-  for (int dy = -reach; dy <= reach; ++dy) {
-    int first = -reach, last = reach;
+  // Near the image's border the window keeps the pixels inside it: a straight edge's fit needs
+  // no symmetric window, only pixels on both sides of the edge (checked by the caller).
+  const int rowFrom = std::max(-reach, -c.y), rowTo = std::min(reach, image.rows - 1 - c.y);
+  const int columnFrom = std::max(-reach, -c.x), columnTo = std::min(reach, image.cols - 1 - c.x);
+  for (int dy = rowFrom; dy <= rowTo; ++dy) {
+    int first = columnFrom, last = columnTo;
     across.restrict(dy, first, last);
     along.restrict(dy, first, last);
     last = std::min(last, first + (kCapacity - 4 - count) - 1);

@@ -51,7 +51,8 @@ struct EdgeProfileParams {
 
 // Refines the edge near pixel `pixel` of a CV_8UC1 / CV_16UC1 image, starting from the unit
 // normal `normal` and the offset `offset` (pixels along the normal from the pixel centre).
-// The pixel must lie at least edgeProfileReach(params) pixels inside the image. Returns the foot
+// Near the image's border the window keeps the pixels inside the image (the caller checks that
+// both sides of the edge are in it, as detectSubpixelEdges does). Returns the foot
 // of the pixel centre on the fitted edge line, the fitted normal and the slope at the edge
 // (b / (w sqrt(2 pi))), or nullopt when the fit degenerates. `fittedWidth`, when given, receives w.
 std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, cv::Point2d normal,

@@ -42,9 +42,13 @@ struct EdgeParams {
   bool correctCurvatureBias = false;
   // Refine each facet point by fitting a blurred-step model over a 7x7 px window along the edge
   // (edge_profile_fit.hpp): removes the cubic facet's shape bias and averages noise along the
-  // edge. Off gives the plain facet zero crossings. Points closer than 5 px to the image border
-  // keep their facet position.
+  // edge. Off gives the plain facet zero crossings. Near the image border the window is cut to
+  // the image; a point whose edge has less than two profile widths (2 px at least) of image on
+  // either side, across it, keeps its facet position.
   bool fitProfile = true;
+  // Near the image border (above): false keeps the facet position of every point whose full
+  // window would leave the image, as before the window was cut to the image.
+  bool fitAtImageBorder = true;
   // Optional 8-bit mask of the image's or of `roi`'s size (like `mask`): only points whose pixel
   // is non-zero there are refined by the profile fit; the others keep their facet position. The
   // blur is still estimated from all the edges, so the points fitted are the same as without it
