@@ -19,7 +19,13 @@ Rows, per blur model (lens, grid) and blur sigma:
     cv2.fitLine (L2) on the Canny pixels in the rectangle;
   - shape poses (`facet model create`, `facet match`): a bracket with a hole, any angle;
     baseline: cv2.matchTemplate (TM_CCOEFF_NORMED) of the template turned to the TRUE angle, the
-    peak refined by a parabola in x and y (a baseline told the angle).
+    peak refined by a parabola in x and y (a baseline told the angle);
+  - calibrated measurement (`facet calibrate --plane`, `facet circle --calibration`), full run
+    only: a camera drawn at random (focal length, centre, radial and tangential distortion), 14
+    views of a chessboard plate and one of it lying in the measuring plane (camera_render.py),
+    then holes on that plane measured in millimetres; baseline: OpenCV's textbook pipeline
+    (findChessboardCorners, cornerSubPix, calibrateCamera, solvePnP on the plane's view) mapping
+    facet's image centres into the plane.
 Targets printed are the issues' (edges #18, caliper and line #20) and bench_shape's.
 """
 import argparse
@@ -35,6 +41,7 @@ import cv2
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import camera_render  # noqa: E402
 import exact_render as render  # noqa: E402
 
 FACET = 'build/release/service/facet'
@@ -386,6 +393,99 @@ def shapes_table(pool, scenes):
               f"{'met' if met else 'MISSED'}")
 
 
+# ---- calibrated measurement ------------------------------------------------------------------
+
+BOARD = (11, 8, 2.0)  # inner corners, square mm
+
+
+def plate_point(K, dist, R, t, u, v):
+    """The plate point (mm) seen at image point (u, v) by OpenCV's calibration."""
+    x, y = cv2.undistortPoints(np.array([[[u, v]]], np.float64), K, dist).ravel()
+    ray = np.array([x, y, 1.0])
+    normal, origin = R[:, 2], t
+    p = ray * (normal @ origin) / (normal @ ray)
+    return (R.T @ (p - t))[:2]
+
+
+def opencv_calibration(views, plane):
+    cols, rows, square = BOARD
+    board = np.zeros((cols * rows, 3), np.float32)
+    board[:, :2] = np.mgrid[0:cols, 0:rows].T.reshape(-1, 2) * square
+    criteria = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_MAX_ITER, 50, 1e-4)
+
+    def corners(image):
+        ok, c = cv2.findChessboardCorners(image, (cols, rows))
+        return cv2.cornerSubPix(image, c, (11, 11), (-1, -1), criteria) if ok else None
+
+    found = [c for c in map(corners, views) if c is not None]
+    _, K, dist, _, _ = cv2.calibrateCamera([board] * len(found), found, views[0].shape[::-1],
+                                           None, None)
+    _, rvec, tvec = cv2.solvePnP(board, corners(plane), K, dist)
+    return K, dist, cv2.Rodrigues(rvec)[0], tvec.ravel()
+
+
+def calibrated_scene(seed):
+    rng = np.random.default_rng(seed)
+    cols, rows, square = BOARD
+    camera = camera_render.Camera((640, 480), fx=rng.uniform(1500, 2600), fy=0.0,
+                                  cx=319.5 + rng.uniform(-6, 6), cy=239.5 + rng.uniform(-6, 6),
+                                  k1=rng.uniform(-0.12, 0.05), k2=rng.uniform(-0.05, 0.05),
+                                  p1=rng.uniform(-5e-4, 5e-4), p2=rng.uniform(-5e-4, 5e-4))
+    camera.fy = camera.fx * (1 + rng.uniform(-1e-3, 1e-3))
+    pattern = camera_render.chessboard(cols, rows, square)
+    middle = np.array([(cols - 1) * square / 2, (rows - 1) * square / 2, 0.0])
+    folder = os.path.join(WORK, f'plates{seed}')
+    os.makedirs(folder)
+    views = []
+    for k in range(14):  # tilted up to 26 degrees, spread over the field
+        R = camera_render.rotation(*rng.uniform(-0.45, 0.45, 2), rng.uniform(-0.3, 0.3))
+        z = camera.fx * 28 / rng.uniform(380, 460)  # the board about 400 px across
+        t = np.array([rng.uniform(-0.07, 0.07) * z, rng.uniform(-0.05, 0.05) * z, z]) - R @ middle
+        views.append(camera.render(R, t, pattern, rng))
+        cv2.imwrite(os.path.join(folder, f'plate_{k:02d}.png'), views[-1])
+    R = camera_render.rotation(*rng.uniform(-0.08, 0.08, 2), rng.uniform(-0.5, 0.5))
+    z = camera.fx * 28 / 420
+    t = np.array([rng.uniform(-2, 2), rng.uniform(-2, 2), z]) - R @ middle
+    plane = camera.render(R, t, pattern, rng)
+    circles = [(rng.uniform(2, 18), rng.uniform(2, 12), rng.uniform(0.8, 2.0)) for _ in range(4)]
+    part = camera.render(R, t, camera_render.holes(circles), rng)
+    calibration = os.path.join(WORK, f'calibration{seed}.yaml')
+    facet('calibrate', '--images', folder, '--board', f'chessboard:{cols}x{rows}:{square:g}',
+          '--plane', save(plane, f'plane{seed}.png'), '--out', calibration)
+    K, dist, Rcv, tcv = opencv_calibration(views, plane)
+    part_file = save(part, f'part{seed}.png')
+    ours, baseline, diameters = [], [], []
+    mm_per_px = z / camera.fx
+    for cx, cy, r in circles:
+        u, v = camera.project(R, t, (cx, cy))
+        radius = abs(camera.project(R, t, (cx + r, cy))[0] - u)
+        j = facet('circle', '--image', part_file, '--centre', f'{u:.2f},{v:.2f}', '--radius',
+                  f'{radius:.2f}', '--calibration', calibration)
+        world = j.get('world', {})
+        if 'x_mm' not in world or 'x' not in j:
+            ours.append(None)
+            continue
+        ours.append((world['x_mm'] - cx, world['y_mm'] - cy))
+        diameters.append(world['diameter_mm'] - 2 * r)
+        baseline.append(plate_point(K, dist, Rcv, tcv, j['x'], j['y']) - (cx, cy))
+    return seed, ours, baseline, diameters, mm_per_px
+
+
+def calibrated_table(pool, seeds):
+    print(f"\n== calibrated measurement in the plane: {seeds} cameras drawn at random, 4 holes each "
+          "(facet calibrate, facet circle --calibration) ==")
+    print("camera | mm/px | facet centre error RMS um (px), diameter error RMS um, failed | "
+          "OpenCV textbook centre error RMS um | OpenCV / facet")
+    rows = pool.map(calibrated_scene, range(100, 100 + seeds))
+    for seed, ours, baseline, diameters, mm_per_px in rows:
+        o = np.array([v for v in ours if v is not None]).reshape(-1, 2)
+        centre = rms(np.hypot(o[:, 0], o[:, 1])) * 1000
+        base = rms(np.hypot(*np.array(baseline).reshape(-1, 2).T)) * 1000
+        print(f"{seed:6d} | {mm_per_px:.4f} | {centre:7.2f} ({centre / 1000 / mm_per_px:.3f}) "
+              f"{rms(diameters) * 1000:7.2f} {len(ours) - len(o):3d} | {base:7.2f} | "
+              f"{base / centre:6.1f}")
+
+
 def main():
     global FACET
     parser = argparse.ArgumentParser(description=__doc__.split('\n')[0])
@@ -406,6 +506,8 @@ def main():
             caliper_table(pool, 3 * scale)
             lines_table(pool, 2 * scale)
             shapes_table(pool, 1 * scale if args.smoke else 12)
+            if not args.smoke:
+                calibrated_table(pool, 4)
     finally:
         shutil.rmtree(WORK, ignore_errors=True)
 
