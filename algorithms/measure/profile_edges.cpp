@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 #include <utility>
 
 #include <Eigen/Dense>
@@ -332,35 +331,24 @@ const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
     st.a = p.values[std::max(0, i - static_cast<int>(2.0 / p.step))];
     steps_.push_back(st);
   }
-  // Passes until the steps settle: the first fits each step alone, the next ones each crowded step
-  // with its neighbours' fitted steps removed; steps whose fit degenerated no longer count as
-  // neighbours. Why more than two: where two steps' blurs overlap (a bar of 4 px under a blur of
-  // 1.5 px), the first fits are biased by the neighbour they leave in, and so is what the second
-  // pass subtracts; a bar of 4 px read 0.13 px wide after two passes and settles within 0.03 px
-  // (scenes rendered outside the project, lens and grid blur).
-  constexpr int kMaxPasses = 12;
-  constexpr double kSettled = 1e-4;  // pixels: no crowded step moved more in a pass
-  for (int pass = 0; pass < kMaxPasses; ++pass) {
-    double moved = 0;
+  // Two passes: the second fits each step with its neighbours' fitted steps removed; steps whose
+  // fit degenerated in the first pass no longer count as neighbours.
+  for (int pass = 0; pass < 2; ++pass) {
     for (std::size_t i = 0; i < steps_.size(); ++i) {
       if (!steps_[i].alive) continue;
       findNear(i);
       if (pass == 0) steps_[i].crowded = !near_.empty();
-      // Alone in every pass: another fit would repeat the first.
-      if (pass >= 1 && near_.empty() && !steps_[i].crowded) continue;
-      const double before = steps_[i].e;
+      // Alone in both passes: the second fit would repeat the first.
+      if (pass == 1 && near_.empty() && !steps_[i].crowded) continue;
       // A step whose fit fails is no neighbour, but still stops the others' windows; one too
       // weak to be an edge is still subtracted from theirs.
       if (!fitStep(p, i)) {
         steps_[i].alive = false;
         faint_.push_back(steps_[i].e);
-        moved = std::numeric_limits<double>::infinity();
         continue;
       }
-      if (pass >= 1) moved = std::max(moved, std::abs(steps_[i].e - before));
       steps_[i].reported = std::abs(steps_[i].b) >= prm.minAmplitude;
     }
-    if (pass >= 1 && moved < kSettled) break;
   }
   found_.clear();
   for (const Step& st : steps_)
