@@ -76,6 +76,22 @@ def half_plane(through, normal, reach=600.0):
             tuple(p - reach * t + reach * normal), tuple(p - reach * t)]
 
 
+def scene_jobs(rows, scenes):
+    """`scenes` jobs per row: the row's values and a seed of its own, 1000 * row + scene."""
+    return [(*row, 1000 * k + i) for k, row in enumerate(rows) for i in range(scenes)]
+
+
+def by_row(results, key_length):
+    """(job, ours, baseline) results gathered per row (the job's first `key_length` values):
+    {row: (ours, baselines)}, in the jobs' order."""
+    rows = {}
+    for job, ours, baseline in results:
+        mine, theirs = rows.setdefault(job[:key_length], ([], []))
+        mine.append(ours)
+        theirs.append(baseline)
+    return rows
+
+
 # ---- straight edges ---------------------------------------------------------------------------
 
 def classic_edge_points(image):
@@ -125,9 +141,8 @@ def edges_table(pool, scenes):
     print(f"\n== straight edges, 64x64, any angle (facet edges); {scenes} scenes per row ==")
     print("model blur noise | facet RMS px: >= 12 px from the border | 2-12 px | classic RMS | "
           "classic / facet | target")
-    jobs = [(m, b, n, 1000 * k + i) for k, (m, b, n) in enumerate(
-        (m, b, n) for m in ('lens', 'grid') for b in (0.5, 0.9, 1.5) for n in (0.0, NOISE))
-        for i in range(scenes)]
+    jobs = scene_jobs([(m, b, n) for m in ('lens', 'grid') for b in (0.5, 0.9, 1.5)
+                       for n in (0.0, NOISE)], scenes)
     rows = {}
     for job, inner, near, classic in pool.map(edge_scene, jobs):
         row = rows.setdefault(job[:3], ([], [], []))
@@ -167,14 +182,9 @@ def circles_table(pool, scenes):
     print(f"\n== circles (facet circle), discs and holes; {scenes} scenes per row ==")
     print("model blur radius | facet centre RMS, radius RMS, failed | HoughCircles ALT centre, "
           "radius, failed | Hough / facet centre | target")
-    jobs = [(m, b, r, 1000 * k + i) for k, (m, b, r) in enumerate(
-        (m, b, r) for m in ('lens', 'grid') for b in (0.7, 1.2) for r in (10, 30, 100))
-        for i in range(scenes)]
-    rows = {}
-    for job, ours, hough in pool.map(circle_scene, jobs):
-        rows.setdefault(job[:3], ([], []))
-        rows[job[:3]][0].append(ours), rows[job[:3]][1].append(hough)
-    for (model, blur, radius), (ours, hough) in rows.items():
+    jobs = scene_jobs([(m, b, r) for m in ('lens', 'grid') for b in (0.7, 1.2)
+                       for r in (10, 30, 100)], scenes)
+    for (model, blur, radius), (ours, hough) in by_row(pool.map(circle_scene, jobs), 3).items():
         o = np.array([v for v in ours if v is not None]).reshape(-1, 2)
         h = np.array([v for v in hough if v is not None]).reshape(-1, 2)
         met = len(o) == len(ours) and rms(o[:, 0]) <= 0.01 and rms(o[:, 1]) <= 0.01
@@ -226,9 +236,7 @@ def caliper_scene(job):
     ours = None
     if len(edges) == 2 and len(j.get('pairs', [])) == 1:
         ours = (edges[0] + width / 2, edges[1] - width / 2, j['pairs'][0]['width'] - width)
-    # the classic caliper measures along the design's axis (cos a, -sin a) too
-    c0, c1 = classic_caliper(image, centre, np.array([np.cos(np.radians(degrees)),
-                                                      -np.sin(np.radians(degrees))]))
+    c0, c1 = classic_caliper(image, centre, axis)  # the same axis, (cos a, -sin a)
     return job, ours, (c0 + width / 2, c1 - width / 2, c1 - c0 - width)
 
 
@@ -237,14 +245,9 @@ def caliper_table(pool, scenes):
           "scenes per row ==")
     print("model blur bar px | facet edge RMS, width RMS, failed | classic edge RMS, width RMS | "
           "classic / facet edge | target (#20, blur 0.9)")
-    jobs = [(m, b, w, 1000 * k + i) for k, (m, b, w) in enumerate(
-        (m, b, w) for m in ('lens', 'grid') for b in (0.9, 1.5) for w in (4, 8))
-        for i in range(scenes)]
-    rows = {}
-    for job, ours, classic in pool.map(caliper_scene, jobs):
-        rows.setdefault(job[:3], ([], []))
-        rows[job[:3]][0].append(ours), rows[job[:3]][1].append(classic)
-    for (model, blur, width), (ours, classic) in rows.items():
+    jobs = scene_jobs([(m, b, w) for m in ('lens', 'grid') for b in (0.9, 1.5) for w in (4, 8)],
+                      scenes)
+    for (model, blur, width), (ours, classic) in by_row(pool.map(caliper_scene, jobs), 3).items():
         o = np.array([v for v in ours if v is not None]).reshape(-1, 3)
         c = np.array(classic).reshape(-1, 3)
         edge, pair = rms(o[:, :2]), rms(o[:, 2])
@@ -298,13 +301,8 @@ def lines_table(pool, scenes):
     print(f"\n== lines (facet line, 200x16 px along an edge), any angle; {scenes} scenes per row ==")
     print("model blur | facet angle RMS deg, ends RMS px, failed | fitLine angle RMS, ends RMS | "
           "fitLine / facet angle | target (#20, blur 0.9)")
-    jobs = [(m, b, 1000 * k + i) for k, (m, b) in enumerate(
-        (m, b) for m in ('lens', 'grid') for b in (0.5, 0.9, 1.5)) for i in range(scenes)]
-    rows = {}
-    for job, ours, classic in pool.map(line_scene, jobs):
-        rows.setdefault(job[:2], ([], []))
-        rows[job[:2]][0].append(ours), rows[job[:2]][1].append(classic)
-    for (model, blur), (ours, classic) in rows.items():
+    jobs = scene_jobs([(m, b) for m in ('lens', 'grid') for b in (0.5, 0.9, 1.5)], scenes)
+    for (model, blur), (ours, classic) in by_row(pool.map(line_scene, jobs), 2).items():
         o = [v for v in ours if v is not None]
         angle, ends = rms([v[0] for v in o]), rms([e for v in o for e in v[1]])
         c_angle, c_ends = rms([v[0] for v in classic]), rms([e for v in classic for e in v[1]])
@@ -379,11 +377,7 @@ def shapes_table(pool, scenes):
         model_file = os.path.join(WORK, f't{k}.fsm')
         facet('model', 'create', '--image', template_file, '--out', model_file)
         jobs += [(model, blur, 1000 * k + i, model_file, template_file) for i in range(scenes)]
-    rows = {}
-    for job, ours, ncc in pool.map(shape_scene, jobs):
-        rows.setdefault(job[:2], ([], []))
-        rows[job[:2]][0].append(ours), rows[job[:2]][1].append(ncc)
-    for (model, blur), (ours, ncc) in rows.items():
+    for (model, blur), (ours, ncc) in by_row(pool.map(shape_scene, jobs), 2).items():
         o = np.array([v for v in ours if v is not None]).reshape(-1, 2)
         n = [v for v in ncc if v is not None]
         met = len(o) == len(ours) and rms(o[:, 0]) <= 0.02 and rms(o[:, 1]) <= 0.01
@@ -427,11 +421,11 @@ def opencv_calibration(views, plane):
 def calibrated_scene(seed):
     rng = np.random.default_rng(seed)
     cols, rows, square = BOARD
-    camera = camera_render.Camera((640, 480), fx=rng.uniform(1500, 2600), fy=0.0,
-                                  cx=319.5 + rng.uniform(-6, 6), cy=239.5 + rng.uniform(-6, 6),
-                                  k1=rng.uniform(-0.12, 0.05), k2=rng.uniform(-0.05, 0.05),
-                                  p1=rng.uniform(-5e-4, 5e-4), p2=rng.uniform(-5e-4, 5e-4))
-    camera.fy = camera.fx * (1 + rng.uniform(-1e-3, 1e-3))
+    fx, cx, cy = rng.uniform(1500, 2600), 319.5 + rng.uniform(-6, 6), 239.5 + rng.uniform(-6, 6)
+    k1, k2 = rng.uniform(-0.12, 0.05), rng.uniform(-0.05, 0.05)
+    p1, p2 = rng.uniform(-5e-4, 5e-4), rng.uniform(-5e-4, 5e-4)
+    camera = camera_render.Camera((640, 480), fx, fx * (1 + rng.uniform(-1e-3, 1e-3)), cx, cy, k1,
+                                  k2, p1, p2)
     pattern = camera_render.chessboard(cols, rows, square)
     middle = np.array([(cols - 1) * square / 2, (rows - 1) * square / 2, 0.0])
     folder = os.path.join(WORK, f'plates{seed}')
