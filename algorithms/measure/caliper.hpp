@@ -3,9 +3,11 @@
 // measure_pairs, Cognex Caliper).
 //
 // The grey profile along the axis, averaged across the width (grey_profile.hpp), is searched for
-// step edges with a symmetric-area subpixel estimator (profile_edges.hpp). Edges are filtered by
-// polarity and minimum amplitude and selected (first, last, strongest, all); pairs are
-// neighbouring edges of opposite polarity whose first edge has the requested polarity.
+// step edges with a symmetric-area subpixel estimator (profile_edges.hpp); two neighbouring edges
+// of opposite polarity whose blurs overlap (a narrow bar or slot) are fitted together as one bar
+// (bar_profile_fit.hpp). Edges are filtered by polarity and minimum amplitude and selected (first,
+// last, strongest, all); pairs are neighbouring edges of opposite polarity whose first edge has
+// the requested polarity.
 // Positions are signed distances from the path's centre along its axis, in pixels.
 
 #include <string>
