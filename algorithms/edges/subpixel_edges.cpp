@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <optional>
 #include <stdexcept>
@@ -54,6 +56,18 @@ void dropPointsOutsideTheirPixel(EdgeContours& result, const std::vector<cv::Poi
     contour.resize(n);
   }
   std::erase_if(result.contours, [](const std::vector<int>& c) { return c.empty(); });
+}
+
+// The first x in [x, end) whose edge map byte is set, or end. Edge pixels are sparse: eight
+// empty pixels are passed over with one comparison.
+int nextEdgePixel(const uchar* edges, int x, int end) {
+  for (; x + 8 <= end; x += 8) {
+    std::uint64_t eight;
+    std::memcpy(&eight, edges + x, sizeof eight);
+    if (eight != 0) break;
+  }
+  while (x < end && !edges[x]) ++x;
+  return x;
 }
 
 // Whether a mask is given for the ROI rather than for the whole image; refuses any other size
@@ -129,8 +143,8 @@ EdgeContours detectSubpixelEdges(const cv::Mat& image, const EdgeParams& params)
   std::vector<double> magnitudes, curvatures;
   for (int y = candidates.y; y < candidates.y + candidates.height; ++y) {
     const auto* e = edges.ptr<uchar>(y);
-    for (int x = candidates.x; x < candidates.x + candidates.width; ++x) {
-      if (!e[x]) continue;
+    const int end = candidates.x + candidates.width;
+    for (int x = nextEdgePixel(e, candidates.x, end); x < end; x = nextEdgePixel(e, x + 1, end)) {
       const cv::Point p = cv::Point(x, y) + area.tl();
       const auto z = facetZeroCrossing(fitCubicFacet(image, p));
       if (!z || std::abs(z->rho) > 1.0) continue;
