@@ -13,6 +13,8 @@
 #include <type_traits>
 #include <vector>
 
+#include <opencv2/core/hal/intrin.hpp>
+
 #include "algorithms/geometry/spd_solve.hpp"
 
 namespace facet {
@@ -32,11 +34,11 @@ using Lanes = float __attribute__((vector_size(16)));
 using IntLanes = int __attribute__((vector_size(16)));
 
 struct Samples {
-  int count = 0;   // padded to a multiple of 4 with zero-weight samples
-  int filled = 0;  // the samples before the padding
+  int count = 0;   // padded to a multiple of 4 with zero samples (weight 0 in the fit)
+  int filled = 0;  // the samples before the padding (weight 1)
   float mean = 0;
-  // across, along, grey value minus mean, weight (1, or 0 for padding)
-  alignas(16) std::array<float, kCapacity> s, t, v, weight;
+  // across, along, grey value minus mean
+  alignas(16) std::array<float, kCapacity> s, t, v;
 };
 
 float horizontalSum(Lanes x) {
@@ -45,17 +47,19 @@ float horizontalSum(Lanes x) {
 
 // The integer range of dx for which lo <= dx * k + c <= hi on each row dy of a window, with
 // c = dy * slope and invK = 1 / k (all dx when k ~ 0 and c fits). What does not depend on the row
-// is settled once per window: the order of the two ends follows the sign of invK alone (lo < hi).
+// is settled once per window: the order of the two ends follows the sign of invK alone (lo < hi),
+// so the end that bounds the first dx (lo, or hi when invK < 0) is chosen once.
 struct RowRange {
-  double slope, lo, hi, invK;
-  bool flat, reversed;
+  double slope, lo, hi, invK, firstEnd, lastEnd;
+  bool flat;
   RowRange(double k, double inverse, double rowSlope, double low, double high)
       : slope(rowSlope),
         lo(low),
         hi(high),
         invK(inverse),
-        flat(std::abs(k) < 1e-12),
-        reversed(inverse < 0) {}
+        firstEnd(inverse < 0 ? high : low),
+        lastEnd(inverse < 0 ? low : high),
+        flat(std::abs(k) < 1e-12) {}
 
   void restrict(int dy, int& first, int& last) const {
     const double c = dy * slope;
@@ -63,19 +67,52 @@ struct RowRange {
       if (c < lo || c > hi) last = first - 1;
       return;
     }
-    const double a = (lo - c) * invK, b = (hi - c) * invK;
-    const double x0 = reversed ? b : a, x1 = reversed ? a : b;
-    first = std::max(first, static_cast<int>(std::ceil(x0 - 1e-9)));
-    last = std::min(last, static_cast<int>(std::floor(x1 + 1e-9)));
+    first = std::max(first, static_cast<int>(std::ceil((firstEnd - c) * invK - 1e-9)));
+    last = std::min(last, static_cast<int>(std::floor((lastEnd - c) * invK + 1e-9)));
   }
 };
+
+// Four consecutive pixels of a row as floats (OpenCV's widening loads; a conversion of a 4-byte
+// vector extension type is done lane by lane).
+Lanes fourPixels(const uchar* p) {
+  Lanes out;
+  cv::v_store(reinterpret_cast<float*>(&out),
+              cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(p))));
+  return out;
+}
+Lanes fourPixels(const ushort* p) {
+  Lanes out;
+  cv::v_store(reinterpret_cast<float*>(&out),
+              cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand(p))));
+  return out;
+}
+
+// The sum of the grey values, as the samples were gathered one by one. 8-bit values are
+// integers and every partial sum stays below 2^24, so it is exact in any order and four lanes
+// give the same sum; 16-bit values (multiples of 1/256) round, so they keep the order.
+template <typename T>
+float sumOfValues(const float* v, int n) {
+  float sum = 0;
+  int i = 0;
+  if constexpr (std::is_same_v<T, uchar>) {
+    static_assert(kCapacity * 255 < (1 << 24));
+    Lanes lanes{};
+    for (; i + 4 <= n; i += 4) {
+      Lanes four;
+      std::memcpy(&four, v + i, sizeof four);
+      lanes += four;
+    }
+    sum = horizontalSum(lanes);
+  }
+  for (; i < n; ++i) sum += v[i];
+  return sum;
+}
 
 template <typename T>
 void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
             const EdgeProfileParams& params, float scale, Samples& out) {
   const int reach = edgeProfileReach(params);
   int count = 0;
-  float sum = 0;
   const auto nx = static_cast<float>(n.x), ny = static_cast<float>(n.y);
   const double invX = std::abs(n.x) < 1e-12 ? 0.0 : 1.0 / n.x;
   const double invY = std::abs(n.y) < 1e-12 ? 0.0 : -1.0 / n.y;
@@ -85,7 +122,8 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
   float* const s = out.s.data();
   float* const t = out.t.data();
   float* const v = out.v.data();
-  float* const weight = out.weight.data();
+  // dx + 0..3 for four samples of a row (small integers: exact in float).
+  const Lanes ramp{0, 1, 2, 3};
   // Near the image's border the window keeps the pixels inside it: a straight edge's fit needs
   // no symmetric window, only pixels on both sides of the edge (checked by the caller).
   const int rowFrom = std::max(-reach, -c.y), rowTo = std::min(reach, image.rows - 1 - c.y);
@@ -97,22 +135,33 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
     last = std::min(last, first + (kCapacity - 4 - count) - 1);
     const T* row = image.ptr<T>(c.y + dy) + c.x;
     const float sRow = static_cast<float>(dy) * ny, tRow = static_cast<float>(dy) * nx;
-    for (int dx = first; dx <= last; ++dx, ++count) {
+    // Four samples at a time, the same operations on each as one at a time below. A row's last
+    // four may reach past `last` while their pixels are still in the image: the samples beyond
+    // it are written past `count`, where the next row or the padding overwrites them.
+    int dx = first;
+    for (; dx <= last && dx + 3 <= columnTo; dx += 4) {
+      const Lanes fx = static_cast<float>(dx) + ramp;
+      const Lanes across4 = fx * nx + sRow, along4 = tRow - fx * ny;
+      const Lanes value4 = fourPixels(row + dx) * scale;
+      std::memcpy(s + count, &across4, sizeof across4);
+      std::memcpy(t + count, &along4, sizeof along4);
+      std::memcpy(v + count, &value4, sizeof value4);
+      count += std::min(4, last - dx + 1);
+    }
+    for (; dx <= last; ++dx, ++count) {
       const auto fx = static_cast<float>(dx);
       s[count] = fx * nx + sRow;
       t[count] = tRow - fx * ny;
-      const float value = static_cast<float>(row[dx]) * scale;
-      v[count] = value;
-      weight[count] = 1.0f;
-      sum += value;
+      v[count] = static_cast<float>(row[dx]) * scale;
     }
   }
   const int real = out.filled = count;
-  out.mean = real ? sum / static_cast<float>(real) : 0.0f;
-  for (int i = 0; i < real; ++i) v[i] -= out.mean;
+  const float mean = real ? sumOfValues<T>(v, real) / static_cast<float>(real) : 0.0f;
+  out.mean = mean;
+  for (int i = 0; i < real; ++i) v[i] -= mean;
   while (count % 4) {
     const int i = count++;
-    s[i] = t[i] = v[i] = weight[i] = 0.0f;
+    s[i] = t[i] = v[i] = 0.0f;
   }
   out.count = count;
 }
@@ -125,8 +174,13 @@ struct Table {
 
 Table tableLanes(const ProfileInterval* packed, IntLanes idx) {
   static_assert(sizeof(ProfileInterval) == sizeof(Lanes));
+  // Byte offsets, scaled in one vector shift; as unsigned (idx >= 0) they need no sign extension
+  // when moved out of the vector.
+  const IntLanes offset = idx * static_cast<int>(sizeof(ProfileInterval));
+  const auto* base = reinterpret_cast<const char*>(packed);
   Lanes q[4];
-  for (int k = 0; k < 4; ++k) std::memcpy(&q[k], &packed[idx[k]], sizeof(Lanes));
+  for (int k = 0; k < 4; ++k)
+    std::memcpy(&q[k], base + static_cast<unsigned>(offset[k]), sizeof(Lanes));
   const Lanes low01 = __builtin_shufflevector(q[0], q[1], 0, 4, 1, 5);
   const Lanes low23 = __builtin_shufflevector(q[2], q[3], 0, 4, 1, 5);
   const Lanes high01 = __builtin_shufflevector(q[0], q[1], 2, 6, 3, 7);
@@ -158,7 +212,10 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
     std::memcpy(&ss, &smp.s[i], sizeof ss);
     std::memcpy(&tt, &smp.t[i], sizeof tt);
     std::memcpy(&vv, &smp.v[i], sizeof vv);
-    if constexpr (decltype(padded)::value) std::memcpy(&ww, &smp.weight[i], sizeof ww);
+    if constexpr (decltype(padded)::value) {
+      const IntLanes index = IntLanes{0, 1, 2, 3} + i;
+      ww = index < smp.filled ? ww : Lanes{};
+    }
     const Lanes z = (ss + vPhi * tt - vE) * vScale;
     Lanes f = (z + profile.range) * profile.perUnit;
     f = f < vLow ? vLow : f;
@@ -205,8 +262,7 @@ double fitResidual(const Samples& smp, const ProfileView& view, double offset) {
       !step<Extra::None>(smp, view, a, b, e, w, phi))
     return std::numeric_limits<double>::infinity();
   double rss = 0;
-  for (int i = 0; i < smp.count; ++i) {
-    if (smp.weight[i] == 0) continue;
+  for (int i = 0; i < smp.filled; ++i) {
     const double f = std::clamp((static_cast<double>(smp.s[i]) - e) * view.coordScale + view.range,
                                 0.0, static_cast<double>(view.size - 1) / view.perUnit) *
                      view.perUnit;
