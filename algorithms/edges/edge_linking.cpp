@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace facet {
@@ -32,13 +33,14 @@ struct PixelIndex {
     for (int i : order) ++rowStart[px[i].y - firstRow + 1];
     for (int r = 0; r < rows; ++r) rowStart[r + 1] += rowStart[r];
   }
-  int find(cv::Point p) const {
-    const int r = p.y - firstRow;
-    if (r < 0 || r + 1 >= static_cast<int>(rowStart.size())) return -1;
-    const auto first = order.begin() + rowStart[r], last = order.begin() + rowStart[r + 1];
-    const auto it =
-        std::lower_bound(first, last, p.x, [&](int i, int x) { return (*pixels)[i].x < x; });
-    return it != last && (*pixels)[*it].x == p.x ? *it : -1;
+  // The points of row y from column x0 on, in order of x: [begin, end) of `order`.
+  std::pair<const int*, const int*> rowFrom(int y, int x0) const {
+    const int r = y - firstRow;
+    if (r < 0 || r + 1 >= static_cast<int>(rowStart.size())) return {nullptr, nullptr};
+    const int* first = order.data() + rowStart[r];
+    const int* last = order.data() + rowStart[r + 1];
+    return {std::lower_bound(first, last, x0, [&](int i, int x) { return (*pixels)[i].x < x; }),
+            last};
   }
 };
 
@@ -50,11 +52,16 @@ int nextPoint(int i, double sign, const std::vector<EdgePoint>& points,
   const cv::Point2d t = sign * cv::Point2d(-p.normal.y, p.normal.x);
   int best = -1;
   double bestAhead = 0.2;  // must move forward noticeably
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      if (dx == 0 && dy == 0) continue;
-      const int j = index.find(pixels[i] + cv::Point(dx, dy));
-      if (j < 0 || visited[j]) continue;
+  const cv::Point centre = pixels[i];
+  // The neighbouring pixels row by row, left to right: one search per row finds all three
+  // columns. Of points sharing a pixel the first is that pixel's point.
+  for (int dy = -1; dy <= 1; ++dy) {
+    int previousX = centre.x - 2;
+    for (auto [it, end] = index.rowFrom(centre.y + dy, centre.x - 1);
+         it != end && pixels[*it].x <= centre.x + 1; ++it) {
+      const int j = *it;
+      const int x = std::exchange(previousX, pixels[j].x);
+      if (x == pixels[j].x || (dy == 0 && pixels[j].x == centre.x) || visited[j]) continue;
       if (points[j].normal.dot(p.normal) < params.minNormalAgreement) continue;
       const cv::Point2d d = points[j].position - p.position;
       const double ahead = d.dot(t) / std::max(1e-9, std::sqrt(d.x * d.x + d.y * d.y));
@@ -63,6 +70,7 @@ int nextPoint(int i, double sign, const std::vector<EdgePoint>& points,
         best = j;
       }
     }
+  }
   return best;
 }
 
