@@ -421,9 +421,12 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   // A known width w is the erf width of the blur and the pixel aperture together; the aperture's
   // variance along any normal is (cos^2 + sin^2) / 12 = 1/12, the rest is the PSF.
   std::shared_ptr<ApertureProfiles> aperture;
-  if (!fitWidth)
+  ProfileView view;  // the known width's profile at the normal's angle (fixed during the fit)
+  if (!fitWidth) {
     aperture = apertureProfiles(std::sqrt(std::max(params.width * params.width - 1.0 / 12, 0.04)),
                                 params.blurOnPixelGrid);
+    view = apertureView(*aperture, normal);
+  }
   double a = 0, b = 0, e = offset, w = fitWidth ? params.initialWidth : params.width, phi = 0;
   const int iterations = std::max(1, params.iterations);
   for (int it = 0; it < iterations; ++it) {
@@ -433,7 +436,6 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
       ok = step<Extra::Width>(smp, erfView(w), a, b, e, w, phi) &&
            (!last || step<Extra::Turn>(smp, erfView(w), a, b, e, w, phi));
     } else {
-      const ProfileView view = apertureView(*aperture, normal);
       ok = last ? step<Extra::Turn>(smp, view, a, b, e, w, phi)
                 : step<Extra::None>(smp, view, a, b, e, w, phi);
     }
@@ -443,7 +445,6 @@ std::optional<EdgePoint> fitEdgeProfile(const cv::Mat& image, cv::Point pixel, c
   // steps: the linearisation in phi is only good for small turns. Give up when they do not
   // settle.
   if (!fitWidth && std::abs(phi) > 0.03) {
-    const ProfileView view = apertureView(*aperture, normal);
     double previous = phi;
     for (int extra = 0; extra < 3; ++extra) {
       if (!step<Extra::Turn>(smp, view, a, b, e, w, phi)) return std::nullopt;
