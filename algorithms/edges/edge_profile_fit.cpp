@@ -126,7 +126,21 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
   const Lanes ramp{0, 1, 2, 3};
   // Near the image's border the window keeps the pixels inside it: a straight edge's fit needs
   // no symmetric window, only pixels on both sides of the edge (checked by the caller).
-  const int rowFrom = std::max(-reach, -c.y), rowTo = std::min(reach, image.rows - 1 - c.y);
+  int rowFrom = std::max(-reach, -c.y), rowTo = std::min(reach, image.rows - 1 - c.y);
+  // Only the rows the window crosses hold samples: with (dx, dy) = (s n + t (-ny, nx)) / |n|^2,
+  // s in [lo, hi] and |t| <= halfAlong span dy in [min(lo ny, hi ny), max(lo ny, hi ny)]
+  // -+ |nx| halfAlong, over |n|^2. The others would find their column ranges empty (the margin
+  // is far above the ranges' tolerance of 1e-9 px and the rounding).
+  {
+    const double lowY = (offset - params.halfAcross) * n.y,
+                 highY = (offset + params.halfAcross) * n.y;
+    const double alongY = std::abs(n.x) * params.halfAlong, norm2 = n.x * n.x + n.y * n.y;
+    const double spanFrom = (std::min(lowY, highY) - alongY) / norm2;
+    const double spanTo = (std::max(lowY, highY) + alongY) / norm2;
+    // Compared as doubles: a degenerate normal's NaN or infinite span keeps the reach.
+    rowFrom = static_cast<int>(std::max<double>(rowFrom, std::ceil(spanFrom - 1e-6)));
+    rowTo = static_cast<int>(std::min<double>(rowTo, std::floor(spanTo + 1e-6)));
+  }
   const int columnFrom = std::max(-reach, -c.x), columnTo = std::min(reach, image.cols - 1 - c.x);
   for (int dy = rowFrom; dy <= rowTo; ++dy) {
     int first = columnFrom, last = columnTo;
