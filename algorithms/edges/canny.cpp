@@ -168,6 +168,45 @@ cv::Rect candidateArea(cv::Size size, cv::Rect candidates) {
                             : candidates & inside;
 }
 
+// The gradient of a strip of image rows that moves down the image: the rows a strip shares with
+// the previous one (suppression reads one row above and below each strip, so two) are moved up
+// in the maps instead of being computed again. Maps of `capacity` rows, allocated once.
+class StripGradient {
+ public:
+  StripGradient(const cv::Mat& image, int x, int width, int capacity) : image_(image) {
+    const bool eightBit = image.depth() == CV_8U;
+    g_.scale = (eightBit ? 1.0 : 1.0 / 256.0) / kSobelGain;
+    const int type = eightBit ? CV_16S : CV_32F;
+    g_.gx.create(capacity, width, type);
+    g_.gy.create(capacity, width, type);
+    g_.magnitude.create(capacity, width, CV_32F);
+    g_.area = cv::Rect(x, 0, width, 0);
+  }
+
+  // The gradient of image rows y .. y + count - 1 (at most the capacity; y not above the
+  // previous strip's first row), in the maps' first `count` rows.
+  const EdgeGradient& rows(int y, int count) {
+    cv::Rect& area = g_.area;
+    const int shared = std::clamp(area.y + area.height - y, 0, area.height);
+    for (cv::Mat* map : {&g_.gx, &g_.gy, &g_.magnitude})
+      for (int i = 0; i < shared; ++i) map->row(area.height - shared + i).copyTo(map->row(i));
+    area.y = y;
+    area.height = count;
+    runs_.clear();
+    for (int i = shared; i < count; ++i) runs_.push_back({y + i, area.x, area.br().x});
+    if (image_.depth() == CV_8U)
+      gradientOnRuns<uchar, short>(image_, runs_, g_);
+    else
+      gradientOnRuns<ushort, float>(image_, runs_, g_);
+    return g_;
+  }
+
+ private:
+  const cv::Mat& image_;
+  EdgeGradient g_;
+  RowRuns runs_;
+};
+
 }  // namespace
 
 EdgeGradient computeEdgeGradient(const cv::Mat& image, cv::Rect area) {
@@ -271,11 +310,11 @@ cv::Mat cannyInStrips(const cv::Mat& image, cv::Rect area, double low, double hi
   // Strips of 16 rows keep the gradient maps small (below malloc's mmap threshold, so they are
   // reused instead of being mapped and faulted in afresh for every image).
   constexpr int kStrip = 16;
+  StripGradient strips(image, area.x, area.width, kStrip + 2);
   for (int r0 = candidates.y; r0 < candidates.y + candidates.height; r0 += kStrip) {
     const int r1 = std::min(r0 + kStrip, candidates.y + candidates.height);
     // Gradient rows r0 - 1 .. r1 (suppression looks one row up and down).
-    const cv::Rect strip(area.x, area.y + r0 - 1, area.width, r1 - r0 + 2);
-    const EdgeGradient g = computeEdgeGradient(image, strip);
+    const EdgeGradient& g = strips.rows(area.y + r0 - 1, r1 - r0 + 2);
     const cv::Rect rows(candidates.x, r0, candidates.width, r1 - r0);
     if (g.gx.depth() == CV_16S)
       suppress<short>(g, lowF, highF, mask, rows, r0 - 1, state, stack);
