@@ -39,6 +39,9 @@ struct Samples {
   float mean = 0;
   // across, along, grey value minus mean
   alignas(16) std::array<float, kCapacity> s, t, v;
+  // Per lane, the sum of v over the blocks of four in order: the first right-hand side of every
+  // step's normal equations, the same for all of them.
+  Lanes valueSums{};
 };
 
 float horizontalSum(Lanes x) {
@@ -178,6 +181,13 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
     s[i] = t[i] = v[i] = 0.0f;
   }
   out.count = count;
+  Lanes valueSums{};
+  for (int i = 0; i < count; i += 4) {
+    Lanes four;
+    std::memcpy(&four, v + i, sizeof four);
+    valueSums += four;
+  }
+  out.valueSums = valueSums;
 }
 
 // The table intervals of four lanes, one field per vector: each interval is one 16-byte load,
@@ -207,7 +217,9 @@ Table tableLanes(const ProfileInterval* packed, IntLanes idx) {
 
 // One Gauss-Newton step of the model v = a + b Phi(z), z = (s + phi t - e) / w, for (a, b, e)
 // and, as the extra fourth unknown, either the width w (Extra::Width) or the turn phi of the
-// normal (Extra::Turn). Returns false when the system is singular or the contrast not positive.
+// normal (Extra::Turn); Extra::None fits (a, b, e) along the given normal (phi = 0, as it is
+// before the turn is fitted). Returns false when the system is singular or the contrast not
+// positive.
 enum class Extra { None, Width, Turn };
 
 template <Extra X>
@@ -230,7 +242,9 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
       const IntLanes index = IntLanes{0, 1, 2, 3} + i;
       ww = index < smp.filled ? ww : Lanes{};
     }
-    const Lanes z = (ss + vPhi * tt - vE) * vScale;
+    // None steps run before any turn is fitted (phi = 0, and s + 0 t = s, the same z): they
+    // spare the turn's product.
+    const Lanes z = X == Extra::None ? (ss - vE) * vScale : (ss + vPhi * tt - vE) * vScale;
     Lanes f = (z + profile.range) * profile.perUnit;
     f = f < vLow ? vLow : f;
     f = f > vHigh ? vHigh : f;
@@ -242,7 +256,9 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
     Lanes basis[4] = {ww, cdf * ww, pdf, Lanes{}};
     if constexpr (X == Extra::Width) basis[3] = z * pdf;
     if constexpr (X == Extra::Turn) basis[3] = tt * pdf;
-    for (int row = 0; row < N; ++row) {
+    // Row 0 (weight times weight, and times v) is the same in every step: the count of the
+    // samples and smp.valueSums, which gather summed in the same order.
+    for (int row = 1; row < N; ++row) {
       acc[row][N] += basis[row] * vv;
       for (int k = 0; k <= row; ++k) acc[row][k] += basis[row] * basis[k];
     }
@@ -252,7 +268,9 @@ bool step(const Samples& smp, const ProfileView& profile, double& a, double& b, 
   for (; i < smp.count; i += 4) accumulate(i, std::true_type{});
   std::array<std::array<double, N>, N> m{};
   std::array<double, N> y{};
-  for (int r = 0; r < N; ++r) {
+  m[0][0] = smp.filled;  // each lane's count is exact, and so is their sum
+  y[0] = horizontalSum(smp.valueSums);
+  for (int r = 1; r < N; ++r) {
     y[r] = horizontalSum(acc[r][N]);
     for (int k = 0; k <= r; ++k) m[r][k] = horizontalSum(acc[r][k]);
   }
