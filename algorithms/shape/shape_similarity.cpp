@@ -69,8 +69,10 @@ double scoreSpreadPose(const cv::Mat& field, const PosedPoints& posed, cv::Point
   for (int j = 0; j < n; ++j) {
     const int x = at.x + posed.offsets[j].x, y = at.y + posed.offsets[j].y;
     if (x < 0 || y < 0 || x >= w || y >= h) continue;
-    const int mx = static_cast<int>(std::lround(posed.directions[j].x * 128.0f));
-    const int my = static_cast<int>(std::lround(posed.directions[j].y * 128.0f));
+    // cvRound: one conversion instruction (std::lround is a library call, 8% of a deformable
+    // search); the two differ only on exact halves, by one unit of 128 in one component.
+    const int mx = cvRound(posed.directions[j].x * 128.0f);
+    const int my = cvRound(posed.directions[j].y * 128.0f);
     const int u0 = std::max(x - spread, 0), u1 = std::min(x + spread, w - 1);
     const int v0 = std::max(y - spread, 0), v1 = std::min(y + spread, h - 1);
     int best = 0;  // a pixel without a direction
