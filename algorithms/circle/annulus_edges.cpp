@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 
+#include "algorithms/circle/pixel_pass.hpp"
 #include "algorithms/edges/canny.hpp"
 #include "algorithms/edges/facet_model.hpp"
 
@@ -38,7 +39,8 @@ int medianByCounting(const std::vector<int>& v, int bound) {
 // The sectors of the n pixels from column x0 on of the row dy below the centre, from the "diamond
 // angle" in [0, 4), a monotonic stand-in for atan2. A function of its own with a distinct output
 // array (__restrict), so that the loop vectorises.
-void rowSectors(int x0, int n, double centreX, double dy, int sectors, int* __restrict sector) {
+FACET_PIXEL_PASS void rowSectors(int x0, int n, double centreX, double dy, int sectors,
+                                 int* __restrict sector) {
   for (int i = 0; i < n; ++i) {
     const double dx = static_cast<double>(x0 + i) - centreX;
     const double q = dy / (std::abs(dx) + std::abs(dy) + 1e-12);

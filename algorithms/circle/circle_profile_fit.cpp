@@ -60,7 +60,8 @@ int angularBin(double dx, double dy, int bins) {
 // The angular bins of the n pixels from column x0 on of the row dy below the centre. No branch:
 // the loop vectorises. The column from the integer counter: a floating-point counter (x += 1)
 // keeps the loop from vectorising.
-void rowBins(int x0, int n, double centreX, double dy, int bins, int* __restrict bin) {
+FACET_PIXEL_PASS void rowBins(int x0, int n, double centreX, double dy, int bins,
+                              int* __restrict bin) {
   for (int i = 0; i < n; ++i) bin[i] = angularBin(static_cast<double>(x0 + i) - centreX, dy, bins);
 }
 
