@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <numbers>
 
@@ -164,9 +166,15 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
   const cv::Mat edges = cannyOnRuns(gradient, out.lowThreshold, out.highThreshold, runs);
   for (const RowRun& run : runs) {
     const auto* e = edges.ptr<std::uint8_t>(run.y - crop.y) - crop.x;
-    for (int x = run.x0; x < run.x1; ++x)
+    for (int x = run.x0; x < run.x1; ++x) {
+      // About one pixel in ten is an edge: eight at a time are passed over while none is.
+      if (std::uint64_t eight = 0; x + 8 <= run.x1 && (std::memcpy(&eight, e + x, 8), eight == 0)) {
+        x += 7;
+        continue;
+      }
       if (e[x])
         if (auto point = facetEdgePoint(image, cv::Point(x, run.y))) out.points.push_back(*point);
+    }
   }
   return out;
 }

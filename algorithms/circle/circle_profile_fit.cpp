@@ -158,6 +158,31 @@ void evaluatePixelProfile(const Vector8& q, std::ptrdiff_t n, const double* x, c
   }
 }
 
+// Tukey's biweight of the n residuals r with tuning constant c. A pass of its own, so that it
+// vectorises.
+FACET_PIXEL_PASS void tukeyWeight(std::ptrdiff_t n, const double* __restrict r, double c,
+                                  double* __restrict weight) {
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const double u = std::abs(r[i]) / c;
+    weight[i] = u >= 1.0 ? 0.0 : (1 - u * u) * (1 - u * u);
+  }
+}
+
+// The Jacobian's columns of the second harmonic's (a, c) at parameters q (fitRimShape, below),
+// from the column of the radius `cr`.
+FACET_PIXEL_PASS void secondHarmonicColumns(const Vector8& q, std::ptrdiff_t n,
+                                            const double* __restrict x, const double* __restrict y,
+                                            const double* __restrict cr, double* __restrict ha,
+                                            double* __restrict hc) {
+  const double cx0 = q(0), cy0 = q(1);
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const double ex = x[i] - cx0, ey = y[i] - cy0;
+    const double perRho = -cr[i] / std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
+    ha[i] = perRho * (ex * ex - ey * ey);
+    hc[i] = perRho * 2.0 * ex * ey;
+  }
+}
+
 }  // namespace
 
 std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point2d centre,
@@ -460,11 +485,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   };
   auto tukeyWeights = [&] {
     const double sigma = std::max(clipped.robustSigma({r.data(), m}), 0.25);
-    const double c = tukeyC * sigma;
-    for (std::size_t i = 0; i < m; ++i) {
-      const double u = std::abs(r[i]) / c;
-      weight[i] = u >= 1.0 ? 0.0 : (1 - u * u) * (1 - u * u);
-    }
+    tukeyWeight(static_cast<std::ptrdiff_t>(m), r.data(), tukeyC * sigma, weight.data());
     clipped.unweight({r.data(), m}, {weight.data(), m});
     return sigma;
   };
@@ -617,12 +638,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     // the block is the last step's and the free parameters' own score is taken as zero (the
     // solve has converged), so that one pass over the band computes the rest.
     Eigen::VectorXd harmonicA(static_cast<Eigen::Index>(m)), harmonicC(harmonicA.size());
-    for (Eigen::Index i = 0; i < harmonicA.size(); ++i) {
-      const double ex = px(i) - p(0), ey = py(i) - p(1);
-      const double perRho = -jac(i, 2) / std::max(std::sqrt(ex * ex + ey * ey), 1e-9);
-      harmonicA(i) = perRho * (ex * ex - ey * ey);
-      harmonicC(i) = perRho * 2.0 * ex * ey;
-    }
+    secondHarmonicColumns(p, harmonicA.size(), px.data(), py.data(), jac.col(2).data(),
+                          harmonicA.data(), harmonicC.data());
     const std::array<int, 8> free{0, 1, 2, 3, 4, 7, 5, 6};
     const int k = withRamp ? 8 : 6;
     Eigen::MatrixXd hho(2, k), hoo(k, k);

@@ -52,17 +52,24 @@ double pixelsNeeded(double snr, double halfWidth) {
 
 std::vector<std::uint8_t> closedCoverage(const std::vector<std::uint8_t>& covered, int margin) {
   const int bins = static_cast<int>(covered.size());
-  auto at = [&](const std::vector<std::uint8_t>& v, int i) {
-    return v[static_cast<std::size_t>((i % bins + bins) % bins)] != 0;
-  };
-  std::vector<std::uint8_t> closed = covered, kept(covered.size(), 0);
-  for (int i = 0; i < bins; ++i)
-    if (!at(covered, i) && (at(covered, i - 1) || at(covered, i - 2)) &&
-        (at(covered, i + 1) || at(covered, i + 2)))
-      closed[static_cast<std::size_t>(i)] = 1;
+  // The coverage around the circle as a row that repeats it `pad` bins beyond either end, so that
+  // the tests below read neighbours without wrapping each index.
+  const int pad = margin + 2;
+  std::vector<std::uint8_t> around(static_cast<std::size_t>(bins + 2 * pad));
+  for (int k = 0; k < bins + 2 * pad; ++k)
+    around[static_cast<std::size_t>(k)] =
+        covered[static_cast<std::size_t>(((k - pad) % bins + bins) % bins)] != 0;
+  const std::uint8_t* at = around.data() + pad;  // at[i]: bin i, i in [-pad, bins + pad)
+  // Gaps of up to 2 bins closed, for bins [-margin, bins + margin).
+  std::vector<std::uint8_t> closedAround(static_cast<std::size_t>(bins + 2 * margin));
+  for (int i = -margin; i < bins + margin; ++i)
+    closedAround[static_cast<std::size_t>(i + margin)] =
+        at[i] || ((at[i - 1] || at[i - 2]) && (at[i + 1] || at[i + 2]));
+  const std::uint8_t* closed = closedAround.data() + margin;
+  std::vector<std::uint8_t> kept(covered.size(), 0);
   for (int i = 0; i < bins; ++i) {
     bool inside = true;
-    for (int k = -margin; k <= margin && inside; ++k) inside = at(closed, i + k);
+    for (int k = -margin; k <= margin && inside; ++k) inside = closed[i + k] != 0;
     kept[static_cast<std::size_t>(i)] = inside ? 1 : 0;
   }
   return kept;
@@ -159,7 +166,8 @@ cv::Point2d sobel3(const cv::Mat& image, int x, int y, double scale) {
   return {gx * scale / 8.0, gy * scale / 8.0};
 }
 
-template <typename T>
+// `border`: the box reaches the image's outermost pixels, which have no 3x3 neighbourhood.
+template <typename T, bool border>
 void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radius,
                  double noiseSigma, cv::Rect box, double scale) {
   constexpr double kGradientZ = 4.0;
@@ -177,7 +185,7 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radi
   std::vector<std::uint8_t> flaggedRow;  // 1: the row of `flagged` is zeroed and marked
   for (const Sample& e : samples) {
     const int x = e.column, y = e.row;
-    if (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1) continue;
+    if (border && (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1)) continue;
     const cv::Point2d g = sobel3<T>(image, x, y, scale);
     const double dx = e.x, dy = e.y;
     const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
@@ -224,10 +232,18 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radi
 // tail is still a few grey levels high where its gradient has sunk into the noise.
 void dropForeignGradients(std::vector<Sample>& samples, const cv::Mat& image, double radius,
                           double noiseSigma, cv::Rect box) {
-  if (image.depth() == CV_16U)
-    dropForeign<std::uint16_t>(samples, image, radius, noiseSigma, box, 1.0 / 256.0);
+  const bool border =
+      box.x < 1 || box.y < 1 || box.br().x > image.cols - 1 || box.br().y > image.rows - 1;
+  const bool wide = image.depth() == CV_16U;
+  const double scale = wide ? 1.0 / 256.0 : 1.0;
+  if (wide && border)
+    dropForeign<std::uint16_t, true>(samples, image, radius, noiseSigma, box, scale);
+  else if (wide)
+    dropForeign<std::uint16_t, false>(samples, image, radius, noiseSigma, box, scale);
+  else if (border)
+    dropForeign<std::uint8_t, true>(samples, image, radius, noiseSigma, box, scale);
   else
-    dropForeign<std::uint8_t>(samples, image, radius, noiseSigma, box, 1.0);
+    dropForeign<std::uint8_t, false>(samples, image, radius, noiseSigma, box, scale);
 }
 
 }  // namespace facet::rim_band
