@@ -1,5 +1,6 @@
 #include "algorithms/circle/rim_band.hpp"
 
+#include "algorithms/circle/pixel_pass.hpp"
 #include "algorithms/circle/step_profile.hpp"
 #include "algorithms/edges/row_runs.hpp"
 
@@ -7,8 +8,10 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <span>
+#include <tuple>
 #include <utility>
 
 namespace facet::rim_band {
@@ -153,23 +156,25 @@ std::vector<std::uint8_t> contaminatedBins(const std::vector<Sample>& samples,
 
 namespace {
 
-// The 3x3 Sobel gradient (divided by 8: unit gain) at pixel (x, y), on the 8-bit scale. The taps
-// are summed in integers and scaled once: the same value as scaling each (the scale is a power of
-// two and every sum is exact).
+// The 3x3 Sobel gradient's taps at pixel (x, y), summed in integers: (x, y) components, 8 times
+// the unit-gain derivative in the image's grey levels.
 template <typename T>
-cv::Point2d sobel3(const cv::Mat& image, int x, int y, double scale) {
-  const T* a = image.ptr<T>(y - 1) + x;
-  const T* b = image.ptr<T>(y) + x;
-  const T* c = image.ptr<T>(y + 1) + x;
-  const int gx = a[1] + 2 * b[1] + c[1] - a[-1] - 2 * b[-1] - c[-1];
-  const int gy = c[-1] + 2 * c[0] + c[1] - a[-1] - 2 * a[0] - a[1];
-  return {gx * scale / 8.0, gy * scale / 8.0};
+std::pair<int, int> sobel3(const T* image, std::ptrdiff_t step, int x, int y) {
+  const T* b = image + y * step + x;
+  const T* a = b - step;
+  const T* c = b + step;
+  return {a[1] + 2 * b[1] + c[1] - a[-1] - 2 * b[-1] - c[-1],
+          c[-1] + 2 * c[0] + c[1] - a[-1] - 2 * a[0] - a[1]};
 }
 
-// `border`: the box reaches the image's outermost pixels, which have no 3x3 neighbourhood.
-template <typename T, bool border>
-void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radius,
-                 double noiseSigma, cv::Rect box, double scale) {
+// Whether the gradient of each of n samples is foreign to the rim (see dropForeignGradients): its
+// Sobel taps (tapsX, tapsY), its offset (x, y) from the centre. `scale` takes the taps to the
+// 8-bit scale; they are scaled once: the same value as scaling each (the scale is a power of two
+// and every sum is exact). Elementwise, a pass of its own so that it vectorises.
+FACET_PIXEL_PASS void foreignGradients(std::ptrdiff_t n, const int* __restrict tapsX,
+                                       const int* __restrict tapsY, const double* __restrict x,
+                                       const double* __restrict y, double scale, double radius,
+                                       double noiseSigma, std::uint8_t* __restrict foreign) {
   constexpr double kGradientZ = 4.0;
   constexpr double kFlatZone = 3.0;  // pixels from the rim: the blurred edge's slope is < 1% there
   // The 3x3 Sobel divided by 8 is a unit-gain derivative; its noise is sqrt(12) / 8 of the pixels'.
@@ -178,26 +183,57 @@ void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radi
   // turns by up to several degrees from the normal with the step's place in the pixel: a
   // tangential share of the rim's own magnitude, not a foreign gradient. sin(10 degrees).
   constexpr double kSobelTurn = 0.17;
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const double gx = tapsX[i] * scale / 8.0, gy = tapsY[i] * scale / 8.0;
+    const double dx = x[i], dy = y[i];
+    const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
+    const double tangential = (gy * dx - gx * dy) / rho;
+    // Both tests, then a choice without a branch: which one applies (the narrow band reaches
+    // 4 px from the rim) follows no pattern the branch predictor learns.
+    const bool far = std::abs(rho - radius) > kFlatZone;
+    const bool steep = gx * gx + gy * gy > limit * limit;
+    const bool across = std::abs(tangential) > limit + kSobelTurn * std::sqrt(gx * gx + gy * gy);
+    foreign[i] = (far & steep) | (!far & across);
+  }
+}
+
+// `border`: the box reaches the image's outermost pixels, which have no 3x3 neighbourhood.
+template <typename T, bool border>
+void dropForeign(std::vector<Sample>& samples, const cv::Mat& image, double radius,
+                 double noiseSigma, cv::Rect box, double scale) {
+  // The samples' Sobel taps and offsets in columns, for the vectorised test. Left uninitialised:
+  // every entry is written before it is read (zeroing them cost a fifth of this screen).
+  const auto n = static_cast<std::ptrdiff_t>(samples.size());
+  const auto tapsX = std::make_unique_for_overwrite<int[]>(samples.size());
+  const auto tapsY = std::make_unique_for_overwrite<int[]>(samples.size());
+  const auto x = std::make_unique_for_overwrite<double[]>(samples.size());
+  const auto y = std::make_unique_for_overwrite<double[]>(samples.size());
+  const auto foreign = std::make_unique_for_overwrite<std::uint8_t[]>(samples.size());
+  const T* pixels = image.ptr<T>(0);
+  const auto step = static_cast<std::ptrdiff_t>(image.step1());
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const Sample& e = samples[static_cast<std::size_t>(i)];
+    // A pixel without a 3x3 neighbourhood has taps 0 (and is never marked, below).
+    if (!border ||
+        (e.column >= 1 && e.row >= 1 && e.column < image.cols - 1 && e.row < image.rows - 1))
+      std::tie(tapsX[i], tapsY[i]) = sobel3(pixels, step, e.column, e.row);
+    else
+      tapsX[i] = tapsY[i] = 0;
+    x[i] = e.x;
+    y[i] = e.y;
+  }
+  foreignGradients(n, tapsX.get(), tapsY.get(), x.get(), y.get(), scale, radius, noiseSigma,
+                   foreign.get());
   // The flag map only when some pixel is foreign: a clean rim needs none. A row of it is zeroed
   // when first marked (zeroing the whole map cost a quarter of this screen); a row not zeroed
   // holds no flag.
   cv::Mat flagged;
   std::vector<std::uint8_t> flaggedRow;  // 1: the row of `flagged` is zeroed and marked
-  for (const Sample& e : samples) {
-    const int x = e.column, y = e.row;
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    if (!foreign[i]) continue;
+    const int x = samples[static_cast<std::size_t>(i)].column;
+    const int y = samples[static_cast<std::size_t>(i)].row;
     if (border && (x < 1 || y < 1 || x >= image.cols - 1 || y >= image.rows - 1)) continue;
-    const cv::Point2d g = sobel3<T>(image, x, y, scale);
-    const double dx = e.x, dy = e.y;
-    const double rho = std::max(std::sqrt(dx * dx + dy * dy), 1e-9);
-    const double tangential = (g.y * dx - g.x * dy) / rho;
-    // Both tests, then a choice without a branch: which one applies (the narrow band reaches
-    // 4 px from the rim) follows no pattern the branch predictor learns.
-    const bool far = std::abs(rho - radius) > kFlatZone;
-    const bool steep = g.x * g.x + g.y * g.y > limit * limit;
-    const bool across =
-        std::abs(tangential) > limit + kSobelTurn * std::sqrt(g.x * g.x + g.y * g.y);
-    const bool foreign = (far & steep) | (!far & across);
-    if (!foreign) continue;
     if (flagged.empty()) {
       flagged.create(box.height + 2, box.width + 2, CV_8U);  // 1 px margin
       flaggedRow.assign(box.height + 2, 0);
