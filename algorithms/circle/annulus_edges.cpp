@@ -1,6 +1,7 @@
 #include "algorithms/circle/annulus_edges.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -173,15 +174,25 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
   const cv::Mat edges = cannyOnRuns(gradient, out.lowThreshold, out.highThreshold, runs);
   for (const RowRun& run : runs) {
     const auto* e = edges.ptr<std::uint8_t>(run.y - crop.y) - crop.x;
-    for (int x = run.x0; x < run.x1; ++x) {
-      // About one pixel in ten is an edge: eight at a time are passed over while none is.
-      if (std::uint64_t eight = 0; x + 8 <= run.x1 && (std::memcpy(&eight, e + x, 8), eight == 0)) {
-        x += 7;
+    auto edgePoint = [&](int x) {
+      if (auto point = facetEdgePoint(image, cv::Point(x, run.y))) out.points.push_back(*point);
+    };
+    // About one pixel in ten is an edge: eight map bytes at a time, from one edge to the next.
+    int x = run.x0;
+    for (std::uint64_t eight = 0; x + 8 <= run.x1;) {
+      std::memcpy(&eight, e + x, 8);
+      if (eight == 0) {
+        x += 8;
         continue;
       }
-      if (e[x])
-        if (auto point = facetEdgePoint(image, cv::Point(x, run.y))) out.points.push_back(*point);
+      // The first edge among them: the lowest non-zero byte in memory order.
+      x += (std::endian::native == std::endian::little ? std::countr_zero(eight)
+                                                       : std::countl_zero(eight)) /
+           8;
+      edgePoint(x++);
     }
+    for (; x < run.x1; ++x)
+      if (e[x]) edgePoint(x);
   }
   return out;
 }

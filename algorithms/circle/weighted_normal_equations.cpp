@@ -81,11 +81,12 @@ __attribute__((target("avx2"))) void rowBlockAvx2(const double* const* cols,
                                                   double& firstR, double& secondR) {
   constexpr int P = (B + 1) / 2;  // pairs of columns; an odd B's last pair repeats its column
   Quad a[P] = {}, b[P] = {};
-  Lanes ra = {}, rb = {};
+  Quad rab = {};  // J^T W r's two rows: row a's lanes, then row a + 1's
   std::ptrdiff_t i = 0;
   for (; i + 2 <= n; i += 2) {
     const Lanes w = load(weight + i), r = load(residual + i);
     const Quad w2 = __builtin_shufflevector(w, w, 0, 1, 0, 1);
+    const Quad r2 = __builtin_shufflevector(r, r, 0, 1, 0, 1);
     Quad c[P];
     for (int p = 0; p < P; ++p)
       c[p] = __builtin_shufflevector(load(cols[2 * p] + i),
@@ -94,18 +95,17 @@ __attribute__((target("avx2"))) void rowBlockAvx2(const double* const* cols,
     const Quad wab = w2 * c[0];
     const Quad wa = __builtin_shufflevector(wab, wab, 0, 1, 0, 1);
     for (int p = 0; p < P; ++p) a[p] += wa * c[p];
-    ra += __builtin_shufflevector(wab, wab, 0, 1) * r;
+    rab += wab * r2;
     if constexpr (pair) {
       const Quad wb = __builtin_shufflevector(wab, wab, 2, 3, 2, 3);
       for (int p = 0; p < P; ++p) b[p] += wb * c[p];
-      rb += __builtin_shufflevector(wab, wab, 2, 3) * r;
     }
   }
   for (int j = 0; j < B; ++j) first[j] = a[j / 2][2 * (j % 2)] + a[j / 2][2 * (j % 2) + 1];
-  firstR = ra[0] + ra[1];
+  firstR = rab[0] + rab[1];
   if constexpr (pair) {
     for (int j = 1; j < B; ++j) second[j] = b[j / 2][2 * (j % 2)] + b[j / 2][2 * (j % 2) + 1];
-    secondR = rb[0] + rb[1];
+    secondR = rab[2] + rab[3];
   }
   finishRowBlock<B, pair>(cols, weight, residual, i, n, first, second, firstR, secondR);
 }
