@@ -172,6 +172,7 @@ AnnulusEdges detectAnnulusEdges(const cv::Mat& image, cv::Point2d centre, double
   // Edge pixels can only lie on the runs: visiting them row by row keeps the points in the
   // image's row-major order.
   const cv::Mat edges = cannyOnRuns(gradient, out.lowThreshold, out.highThreshold, runs);
+  out.points.reserve(static_cast<std::size_t>(out.annulusPixels) / 8);  // a rim: about 1 in 11
   for (const RowRun& run : runs) {
     const auto* e = edges.ptr<std::uint8_t>(run.y - crop.y) - crop.x;
     auto edgePoint = [&](int x) {

@@ -116,6 +116,7 @@ std::optional<Circle> fitRim(const std::vector<Eigen::Vector2d>& pts, Circle cir
                              const CircleMeasureParams& params, std::vector<Eigen::Vector2d>& in) {
   std::vector<double> w;
   std::vector<std::uint8_t> taken, takenBefore;
+  in.reserve(pts.size());
   for (int round = 0; round < 2; ++round) {
     in.clear();
     taken.assign(pts.size(), 0);
@@ -161,6 +162,7 @@ std::vector<std::vector<std::size_t>> inlierArcs(const std::vector<Eigen::Vector
     return l.first < r.first || (l.first == r.first && l.second < r.second);
   });
   angles.clear();
+  angles.reserve(a.size());
   for (const auto& [angle, i] : a) angles.push_back(angle);
   std::vector<std::vector<std::size_t>> arcs;
   for (std::size_t k = 0; k < a.size(); ++k) {
@@ -194,6 +196,8 @@ std::vector<Eigen::Vector2d> strayArc(const std::vector<Eigen::Vector2d>& in, co
   for (const auto& arc : arcs) {
     if (3 * arc.size() >= in.size()) continue;
     std::vector<Eigen::Vector2d> rest, own;
+    rest.reserve(in.size());
+    own.reserve(arc.size());
     std::vector<std::uint8_t> mine(in.size(), 0);
     for (std::size_t i : arc) mine[i] = 1;
     for (std::size_t i = 0; i < in.size(); ++i) (mine[i] ? own : rest).push_back(in[i]);
@@ -372,6 +376,7 @@ GreyRim fitGreyRim(const cv::Mat& image, const CircleMeasurement& m,
       shape->minor *= scale;
     }
     std::vector<Eigen::Vector2d> on;
+    on.reserve(rimCandidates.size());
     for (const auto& p : rimCandidates)
       if (std::abs(shape ? rim_ellipse::residual(*shape, p) : residual(around, p)) <=
           params.ransacThreshold)
@@ -589,6 +594,8 @@ CircleMeasurement measureCircle(const cv::Mat& image, const CircleMeasureParams&
   int rimSign = +1;  // +1: gradient points outwards (dark inside), -1: inwards
   for (int sign : {+1, -1}) {
     std::vector<Eigen::Vector2d> pts, normals;
+    pts.reserve(candidates.size());
+    normals.reserve(candidates.size());
     for (const Candidate& c : candidates)
       if (c.radialCos * sign > 0) {
         pts.push_back(c.p);

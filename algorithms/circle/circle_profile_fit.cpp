@@ -293,6 +293,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // Every few pixels suffice for a starting level (a big rim's band has thousands).
   std::vector<double> inside, outside;
   const std::size_t levelStride = std::max<std::size_t>(1, inBand / 1024);
+  inside.reserve(inBand / levelStride + 1);
+  outside.reserve(inBand / levelStride + 1);
   {
     std::size_t next = 0, start = 0;  // band indices: the next pixel read, the stretch's first
     for (const Stretch& s : band) {
