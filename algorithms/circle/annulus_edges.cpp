@@ -90,28 +90,35 @@ bool annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const
     return std::min({row[x - 1], row[x], row[x + 1]}) == 0 ||
            std::max({row[x - 1], row[x], row[x + 1]}) == kClip;
   };
+  // Every mask first, noting whether a centre was clipped; only then are the masks tested pixel
+  // by pixel and taken again.
+  auto response = [](const T* above, const T* here, const T* below, int x) {
+    return std::abs(above[x - 1] - 2 * above[x] + above[x + 1] - 2 * here[x - 1] + 4 * here[x] -
+                    2 * here[x + 1] + below[x - 1] - 2 * below[x] + below[x + 1]);
+  };
   bool anyClipped = false;
-  for (const bool testMasks : {false, true}) {
-    for (const RowRun& run : runs) {
-      const int y = run.y;
-      const T* above = image.ptr<T>(y - 1);
-      const T* here = image.ptr<T>(y);
-      const T* below = image.ptr<T>(y + 1);
-      for (int x = run.x0 + ((3 - (run.x0 + y) % 3) % 3); x < run.x1; x += 3) {
-        if (testMasks ? clipped(above, x) || clipped(here, x) || clipped(below, x)
-                      : here[x] == 0 || here[x] == kClip) {
-          anyClipped = true;
-          if (testMasks) continue;
-        }
-        const int n = above[x - 1] - 2 * above[x] + above[x + 1] - 2 * here[x - 1] + 4 * here[x] -
-                      2 * here[x + 1] + below[x - 1] - 2 * below[x] + below[x + 1];
-        noise.push_back(std::abs(n));
-      }
+  for (const RowRun& run : runs) {
+    const int y = run.y;
+    const T* above = image.ptr<T>(y - 1);
+    const T* here = image.ptr<T>(y);
+    const T* below = image.ptr<T>(y + 1);
+    for (int x = run.x0 + ((3 - (run.x0 + y) % 3) % 3); x < run.x1; x += 3) {
+      anyClipped |= here[x] == 0 || here[x] == kClip;
+      noise.push_back(response(above, here, below, x));
     }
-    if (!anyClipped || testMasks) break;
-    noise.clear();
   }
-  return anyClipped;
+  if (!anyClipped) return false;
+  noise.clear();
+  for (const RowRun& run : runs) {
+    const int y = run.y;
+    const T* above = image.ptr<T>(y - 1);
+    const T* here = image.ptr<T>(y);
+    const T* below = image.ptr<T>(y + 1);
+    for (int x = run.x0 + ((3 - (run.x0 + y) % 3) % 3); x < run.x1; x += 3)
+      if (!clipped(above, x) && !clipped(here, x) && !clipped(below, x))
+        noise.push_back(response(above, here, below, x));
+  }
+  return true;
 }
 
 }  // namespace
