@@ -134,8 +134,7 @@ std::optional<Circle> fitRim(const std::vector<Eigen::Vector2d>& pts, Circle cir
         std::vector<double> a;
         a.reserve(in.size());
         for (const auto& p : in) a.push_back(std::abs(residual(circle, p)));
-        std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
-        const double sigma = std::max(1.4826 * a[a.size() / 2], 0.01);
+        const double sigma = std::max(1.4826 * rim_band::medianOf(std::move(a)), 0.01);
         for (std::size_t i = 0; i < in.size(); ++i)
           w[i] = robustWeight(params.robustWeight, residual(circle, in[i]), sigma);
       }
@@ -206,8 +205,7 @@ std::vector<Eigen::Vector2d> strayArc(const std::vector<Eigen::Vector2d>& in, co
     if (!others || coverageDeg(rest, *others) < params.minCoverageDeg) continue;
     std::vector<double> r;
     for (const auto& p : own) r.push_back(residual(*others, p));
-    std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
-    const double off = std::abs(r[r.size() / 2]);
+    const double off = std::abs(rim_band::medianOf(std::move(r)));
     if (off > params.ransacThreshold && off > worst) {
       worst = off;
       stray = std::move(own);

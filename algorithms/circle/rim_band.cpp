@@ -16,10 +16,49 @@
 
 namespace facet::rim_band {
 
+namespace {
+
+// The value of rank k among v[0, n), as std::nth_element would place it at k, for values without
+// a NaN. Three-way partitions around a median of three, each element going to the lower part, the
+// upper part (in `scratch`) or neither (equal to the pivot) without a branch: std::nth_element's
+// comparisons mispredicted about once in three elements (random residuals, levels), which cost
+// more time than its instructions. `scratch` holds room for n values; both buffers are clobbered.
+double valueOfRank(double* v, double* scratch, std::size_t n, std::size_t k) {
+  while (n > 1) {
+    const double a = v[0], b = v[n / 2], c = v[n - 1];
+    const double pivot = std::max(std::min(a, b), std::min(std::max(a, b), c));
+    std::size_t below = 0, above = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      const double x = v[i];
+      v[below] = x;  // i >= below: x has been read
+      scratch[above] = x;
+      below += x < pivot;
+      above += pivot < x;
+    }
+    if (k < below) {
+      n = below;
+    } else if (k < n - above) {
+      return pivot;  // one of the values equal to it
+    } else {
+      k -= n - above;
+      n = above;
+      std::swap(v, scratch);
+    }
+  }
+  return v[0];
+}
+
+}  // namespace
+
 double medianOf(std::vector<double> v) {
   if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
+  const std::size_t k = v.size() / 2;
+  if (std::any_of(v.begin(), v.end(), [](double x) { return std::isnan(x); })) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(k), v.end());
+    return v[k];
+  }
+  const auto scratch = std::make_unique_for_overwrite<double[]>(v.size());
+  return valueOfRank(v.data(), scratch.get(), v.size(), k);
 }
 
 namespace {

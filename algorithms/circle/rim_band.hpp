@@ -31,6 +31,8 @@ inline double greyAt(const cv::Mat& image, int x, int y) {
 // sensor's limits; 0 when the annulus holds no pixel.
 double clippedShare(const cv::Mat& image, cv::Point2d centre, double rIn, double rOut);
 
+// The median of v (the value of rank size / 2, as std::nth_element places it; 0 when empty). Of
+// two zeros of either sign, either may come back.
 double medianOf(std::vector<double> v);
 
 // How many band pixels a clean rim's grey-value fit needs for a centre precision of about
