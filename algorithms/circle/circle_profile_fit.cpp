@@ -291,10 +291,13 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
 
   // Start: outside and inside levels from the band's two halves, blur 1.2 px, no ramp.
   // Every few pixels suffice for a starting level (a big rim's band has thousands).
-  std::vector<double> inside, outside;
+  // Every pixel read is written to both lists and counted in the one its side picks: which side
+  // a pixel lies on follows no pattern the branch predictor learns.
   const std::size_t levelStride = std::max<std::size_t>(1, inBand / 1024);
-  inside.reserve(inBand / levelStride + 1);
-  outside.reserve(inBand / levelStride + 1);
+  const std::size_t levelRoom = inBand / levelStride + 1;
+  const auto inside = std::make_unique_for_overwrite<double[]>(levelRoom);
+  const auto outside = std::make_unique_for_overwrite<double[]>(levelRoom);
+  std::size_t insideCount = 0, outsideCount = 0;
   {
     std::size_t next = 0, start = 0;  // band indices: the next pixel read, the stretch's first
     for (const Stretch& s : band) {
@@ -303,16 +306,20 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
         const int column = s.x0 + static_cast<int>(next - start);
         const double dx = column - centre.x, dy = s.row - centre.y;
         const double d = elliptic ? mappedDistance(dx, dy) : std::sqrt(dx * dx + dy * dy) - radius;
-        if (d < -2.0) inside.push_back(greyAt(image, column, s.row));
-        if (d > 2.0) outside.push_back(greyAt(image, column, s.row));
+        const double grey = greyAt(image, column, s.row);
+        inside[insideCount] = grey;
+        outside[outsideCount] = grey;
+        insideCount += d < -2.0;
+        outsideCount += d > 2.0;
       }
       start = end;
     }
   }
-  if (inside.empty() || outside.empty()) return std::nullopt;
+  if (insideCount == 0 || outsideCount == 0) return std::nullopt;
   Vector8 p;
-  const CensoredPixels::Step start =
-      CensoredPixels::startingStep(medianOf(outside), medianOf(inside), sensorLimit(image.depth()));
+  const CensoredPixels::Step start = CensoredPixels::startingStep(
+      medianOf({outside.get(), outside.get() + outsideCount}),
+      medianOf({inside.get(), inside.get() + insideCount}), sensorLimit(image.depth()));
   p << 0.0, 0.0, radius, 1.2, start.level, 0.0, 0.0, start.contrast;
 
   // A clean rim needs far fewer pixels than a big circle has: keep an evenly spread share of the
