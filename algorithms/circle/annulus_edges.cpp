@@ -8,7 +8,7 @@
 #include <limits>
 #include <numbers>
 
-#include "algorithms/circle/pixel_pass.hpp"
+#include "algorithms/circle/diamond_angle.hpp"
 #include "algorithms/edges/canny.hpp"
 #include "algorithms/edges/facet_model.hpp"
 
@@ -40,25 +40,6 @@ int medianByCounting(const std::vector<int>& v, int bound) {
   return value;
 }
 
-// The sectors of the n pixels from column x0 on of the row dy below the centre, from the "diamond
-// angle" in [0, 4), a monotonic stand-in for atan2. Four pixels at a time, written out as vectors:
-// a run of the annulus is a dozen pixels, for which a loop the compiler vectorises spent more
-// instructions in its set-up and remainder than in its vector body. `sector` has room for n
-// rounded up to a multiple of 4 (the last group's extra lanes are written too).
-FACET_PIXEL_PASS void rowSectors(int x0, int n, double centreX, double dy, int sectors,
-                                 int* __restrict sector) {
-  using namespace pixel_pass;
-  const Ints4 last = Ints4{} + (sectors - 1);
-  for (int i = 0; i < n; i += 4) {
-    const Doubles4 dx = (static_cast<double>(x0 + i) + kLane) - centreX;
-    const Doubles4 q = dy / ((dx < 0.0 ? -dx : dx) + std::abs(dy) + 1e-12);
-    const Doubles4 turn = (dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q)) / 4.0;
-    const Ints4 s = __builtin_convertvector(turn * static_cast<double>(sectors), Ints4);
-    const Ints4 clamped = s < last ? s : last;
-    std::memcpy(sector + i, &clamped, sizeof clamped);
-  }
-}
-
 // The largest gradient magnitude in each angular sector and Immerkaer's noise response on every
 // third pixel of the annulus (its absolute value, in the image's own grey levels); whether a mask
 // met a clipped pixel.
@@ -72,8 +53,8 @@ bool annulusStatistics(const cv::Mat& image, const EdgeGradient& gradient, const
     const int y = run.y;
     const double dy = y - centre.y;
     const float* magnitude = gradient.magnitude.ptr<float>(y - crop.y) - crop.x;
-    sector.resize(static_cast<std::size_t>((run.x1 - run.x0 + 3) & ~3));  // rowSectors' groups
-    rowSectors(run.x0, run.x1 - run.x0, centre.x, dy, sectors, sector.data());
+    sector.resize(static_cast<std::size_t>((run.x1 - run.x0 + 3) & ~3));  // rowBins' groups
+    diamond_angle::rowBins(run.x0, run.x1 - run.x0, centre.x, dy, sectors, sector.data());
     for (int x = run.x0; x < run.x1; ++x) {
       float& sectorPeak = peak[sector[x - run.x0]];
       sectorPeak = std::max(sectorPeak, magnitude[x]);

@@ -14,6 +14,7 @@
 #include <Eigen/Dense>
 
 #include "algorithms/circle/censored_pixels.hpp"
+#include "algorithms/circle/diamond_angle.hpp"
 #include "algorithms/circle/rim_band.hpp"
 #include "algorithms/circle/step_profile.hpp"
 #include "algorithms/circle/weighted_normal_equations.hpp"
@@ -42,37 +43,8 @@ using Vector8 = Eigen::Matrix<double, 8, 1>;
 using Matrix8 = Eigen::Matrix<double, 8, 8>;
 using Columns = Eigen::Matrix<double, Eigen::Dynamic, 8>;
 
-// A monotonic stand-in for the polar angle, in [0, 4) (no atan2 in the pixel loops); bins of
-// equal width in it are within a factor 1.5 of equal angles. 0 at the centre itself. Without a
-// branch, so that the loops over the band's rows vectorise.
-double diamondAngle(double dx, double dy) {
-  const double sum = std::abs(dx) + std::abs(dy);
-  const double q = dy / (sum > 0.0 ? sum : 1.0);
-  return dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
-}
-
-// The angular bin, of `bins` equal widths in diamondAngle, of the offset (dx, dy) from the centre.
-int angularBin(double dx, double dy, int bins) {
-  const int b = static_cast<int>(diamondAngle(dx, dy) / 4.0 * bins);
-  return b < bins - 1 ? b : bins - 1;
-}
-
-// The angular bins of the n pixels from column x0 on of the row dy below the centre: angularBin,
-// four pixels at a time (pixel_pass.hpp). `bin` has room for n rounded up to a multiple of 4.
-FACET_PIXEL_PASS void rowBins(int x0, int n, double centreX, double dy, int bins,
-                              int* __restrict bin) {
-  using namespace pixel_pass;
-  const Ints4 last = Ints4{} + (bins - 1);
-  for (int i = 0; i < n; i += 4) {
-    const Doubles4 dx = (static_cast<double>(x0 + i) + kLane) - centreX;
-    const Doubles4 sum = (dx < 0.0 ? -dx : dx) + std::abs(dy);
-    const Doubles4 q = dy / (sum > 0.0 ? sum : Doubles4{} + 1.0);
-    const Doubles4 turn = dx < 0.0 ? 2.0 - q : (dy < 0.0 ? 4.0 + q : q);
-    const Ints4 b = __builtin_convertvector(turn / 4.0 * static_cast<double>(bins), Ints4);
-    const Ints4 clamped = b < last ? b : last;
-    std::memcpy(bin + i, &clamped, sizeof clamped);
-  }
-}
+using diamond_angle::binOf;
+using diamond_angle::rowBins;
 
 // A stretch of a row of the band: columns [x0, x1).
 struct Stretch {
@@ -205,7 +177,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   // Angular bins of about 2 px of arc: a bin takes part when an inlier edge point lies in it.
   const int bins = std::max(16, static_cast<int>(2.0 * kPi * radius / 2.0));
   std::vector<std::uint8_t> covered(bins, 0);
-  for (const auto& q : rimPoints) covered[angularBin(q.x - centre.x, q.y - centre.y, bins)] = 1;
+  for (const auto& q : rimPoints) covered[binOf(q.x - centre.x, q.y - centre.y, bins)] = 1;
   // A small rim (under kSmallRim px) has few bins to spare: it keeps a wider band and the ends of
   // its covered runs (below); a long rim trades a little information for less contamination.
   constexpr double kSmallRim = 25.0;
@@ -251,7 +223,7 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
   const rim_band::ForeignReach tainted(foreignPoints, noiseSigma,
                                        cv::Rect(x0, y0, x1 - x0 + 1, y1 - y0 + 1));
   // The band's pixels that take part (in a covered bin, clear of foreign edges), in the runs'
-  // order. Along a row the angular bin is monotonic (diamondAngle), so a run whose end pixels'
+  // order. Along a row the angular bin is monotonic (diamond_angle.hpp), so a run whose end pixels'
   // bins enclose covered bins only is covered throughout and needs no bin per pixel here; the
   // others are tested pixel by pixel.
   std::vector<int> uncoveredBelow(bins + 1, 0);  // bins below b that are not covered
@@ -267,8 +239,8 @@ std::optional<CircleProfileFit> fitCircleProfile(const cv::Mat& image, cv::Point
     if (n <= 0) continue;
     const double dy = run.y - centre.y;
     const std::uint8_t* taint = tainted.row(run.y);
-    const int first = angularBin(static_cast<double>(run.x0) - centre.x, dy, bins);
-    const int last = angularBin(static_cast<double>(run.x1 - 1) - centre.x, dy, bins);
+    const int first = binOf(static_cast<double>(run.x0) - centre.x, dy, bins);
+    const int last = binOf(static_cast<double>(run.x1 - 1) - centre.x, dy, bins);
     if (taint == nullptr &&
         uncoveredBelow[std::max(first, last) + 1] == uncoveredBelow[std::min(first, last)]) {
       band.push_back({run.y, run.x0, run.x1});
