@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <numbers>
 
 namespace facet {
@@ -17,6 +18,11 @@ struct Placement {
   int first = 0;
   std::int64_t sum = 0, squares = 0;
   double variance = 0;  // N * squares - sum^2 (N times the sum of squared deviations)
+  double mean = 0;      // sum / N
+  // For the Jensen bound, over the compared rows from r on (rings + 1 entries): their sum, and
+  // their squared deviations from `mean`. They depend on the window alone, not on the pair.
+  std::vector<double> restSum;
+  std::vector<double> restDeviation;
   // Energy of the window minus its mean, ring effects and column effects (the two profiles are
   // orthogonal after centring): what neither projection explains.
   double interaction = 0;
@@ -36,6 +42,16 @@ Placement place(const LogPolarWindow& w, int first, int rings) {
   p.squares = w.ringSquares[first + rings] - w.ringSquares[first];
   const auto n = static_cast<std::int64_t>(rings) * A;
   p.variance = static_cast<double>(n * p.squares - p.sum * p.sum);
+  p.mean = static_cast<double>(p.sum) / static_cast<double>(n);
+  p.restSum.resize(rings + 1);
+  p.restDeviation.resize(rings + 1);
+  for (int r = 0; r <= rings; ++r) {
+    const double m = static_cast<double>(rings - r) * A;
+    const double sum = static_cast<double>(w.ringSum[first + rings] - w.ringSum[first + r]);
+    const double sq = static_cast<double>(w.ringSquares[first + rings] - w.ringSquares[first + r]);
+    p.restSum[r] = sum;
+    p.restDeviation[r] = std::max(0.0, sq - 2 * p.mean * sum + m * p.mean * p.mean);
+  }
   p.ringSums.resize(rings);
   double ringEnergy = 0;
   for (int r = 0; r < rings; ++r) {
@@ -92,6 +108,38 @@ inline float dotFloat(const float* a, const float* b, int n) {
   return sum;
 }
 
+using FloatLanes = float __attribute__((vector_size(16)));
+constexpr int kLaneWidth = 4;
+// Shifts correlated in one pass over the profile: eight lanes, whose sums stay in registers.
+constexpr int kProfileLanes = 8;
+
+// Cyclic correlation of two angle profiles for the shifts t0 .. t0 + 4 * lanes - 1 at once:
+// out[t] = sum_i a[i] b[i + t], with `b` stored twice so that b[i + t] needs no wrap. Each shift
+// is summed in order of i; its rounding error stays below n * 2^-24 * |a| |b| as for dotFloat.
+template <int lanes>
+inline void correlateProfileShifts(const float* a, const float* b, int n, int t0, float* out) {
+  FloatLanes acc[lanes] = {};
+  for (int i = 0; i < n; ++i) {
+    const FloatLanes ai = {a[i], a[i], a[i], a[i]};
+    for (int k = 0; k < lanes; ++k) {
+      FloatLanes bk;
+      std::memcpy(&bk, b + i + t0 + kLaneWidth * k, sizeof bk);
+      acc[k] += ai * bk;
+    }
+  }
+  std::memcpy(out + t0, acc, sizeof acc);
+}
+
+// out[t] = sum_i a[i] b[i + t] for every cyclic shift t in [0, n): the angle profiles'
+// correlation, all shifts in a few passes instead of one dot product per shift.
+inline void correlateProfiles(const float* a, const float* bTwice, int n, float* out) {
+  int t = 0;
+  for (; t + kLaneWidth * kProfileLanes <= n; t += kLaneWidth * kProfileLanes)
+    correlateProfileShifts<kProfileLanes>(a, bTwice, n, t, out);
+  for (; t + kLaneWidth <= n; t += kLaneWidth) correlateProfileShifts<1>(a, bTwice, n, t, out);
+  for (; t < n; ++t) out[t] = dotFloat(a, bTwice + t, n);
+}
+
 inline std::int32_t rowDot(const std::int16_t* a, const std::int16_t* b, int n) {
   std::int32_t acc = 0;
   for (int i = 0; i < n; ++i) acc += static_cast<std::int32_t>(a[i]) * b[i];
@@ -129,24 +177,19 @@ bool fullScore(const Pair& q, int si, int t, double thr, const NccAccelerations&
   const std::int64_t varB = q.N * sbb - sb * sb;
   if (varB <= 0) return false;
   const double den = std::sqrt(q.pa.variance * static_cast<double>(varB));
-  const double meanA = static_cast<double>(q.pa.sum) / q.N;
-  const double meanB = static_cast<double>(sb) / q.N;
+  const double meanA = q.pa.mean;
+  const double meanB = pb.mean;  // sb equals pb.sum with or without the sum tables
   std::int64_t sab = 0;
   for (int r = 0; r < q.R; ++r) {
     sab += rowDot(q.a.row(q.pa.first + r), q.b.row(pb.first + r) + t, A);
     if (acc.jensen && (r & 1) && r + 1 < q.R) {
       // The rest of the covariance is at most the product of the rest's deviations.
-      const int ra = q.pa.first + r + 1, rb = pb.first + r + 1;
-      const int ea = q.pa.first + q.R, eb = pb.first + q.R;
-      const double n = static_cast<double>(q.R - r - 1) * A;
-      const double sumA = static_cast<double>(q.a.ringSum[ea] - q.a.ringSum[ra]);
-      const double sqA = static_cast<double>(q.a.ringSquares[ea] - q.a.ringSquares[ra]);
-      const double sumB = static_cast<double>(q.b.ringSum[eb] - q.b.ringSum[rb]);
-      const double sqB = static_cast<double>(q.b.ringSquares[eb] - q.b.ringSquares[rb]);
-      const double devA = std::max(0.0, sqA - 2 * meanA * sumA + n * meanA * meanA);
-      const double devB = std::max(0.0, sqB - 2 * meanB * sumB + n * meanB * meanB);
-      const double restBound =
-          std::sqrt(devA * devB) + meanA * sumB + meanB * sumA - n * meanA * meanB;
+      const int rest = r + 1;
+      const double n = static_cast<double>(q.R - rest) * A;
+      const double sumA = q.pa.restSum[rest];
+      const double sumB = pb.restSum[rest];
+      const double restBound = std::sqrt(q.pa.restDeviation[rest] * pb.restDeviation[rest]) +
+                               meanA * sumB + meanB * sumA - n * meanA * meanB;
       const double bound = (static_cast<double>(q.N) * (static_cast<double>(sab) + restBound) -
                             static_cast<double>(q.pa.sum) * static_cast<double>(sb)) /
                            den;
@@ -163,8 +206,15 @@ struct Candidate {
   int si, t;
 };
 
+// Buffers reused from one window pair to the next.
+struct CompareScratch {
+  std::vector<Candidate> candidates;
+  std::vector<float> profileCross;  // angle profiles' correlation for every angle shift
+};
+
 WindowScore comparePlaced(const Pair& q, double threshold, const NccAccelerations& acc,
-                          std::vector<Candidate>& candidates) {
+                          CompareScratch& scratch) {
+  std::vector<Candidate>& candidates = scratch.candidates;
   WindowScore best;
   int bestIndex = -1;
   if (q.pa.variance <= 0) return best;
@@ -192,6 +242,8 @@ WindowScore comparePlaced(const Pair& q, double threshold, const NccAcceleration
   const double N = static_cast<double>(q.N);
   const double sa = static_cast<double>(q.pa.sum);
   candidates.clear();
+  std::vector<float>& profileCross = scratch.profileCross;
+  profileCross.resize(q.A);
   for (int si = 0; si < shifts; ++si) {
     const Placement& pb = q.pb[si];
     if (pb.variance <= 0) continue;
@@ -219,12 +271,11 @@ WindowScore comparePlaced(const Pair& q, double threshold, const NccAcceleration
       const double ringSpectral = static_cast<double>(dot) * (1 + 1e-4) + 1.0;
       if (N * (ringCross + ringSpectral / q.A) / den < threshold - kBoundSlack) continue;
     }
-    // Float dot products (vectorised); their rounding error is below A * 2^-24 * |X| |Y|.
+    // Float correlations, all shifts in lanes; each rounds by less than A * 2^-24 * |X| |Y|.
     const double crossPad = 4.0 * q.A * 6e-8 * q.pa.columnNorm * pb.columnNorm + 1.0;
+    correlateProfiles(q.pa.columnSums.data(), pb.columnSums.data(), q.A, profileCross.data());
     for (int t = 0; t < q.A; ++t) {
-      const double cross =
-          static_cast<double>(dotFloat(q.pa.columnSums.data(), pb.columnSums.data() + t, q.A)) +
-          crossPad;
+      const double cross = static_cast<double>(profileCross[t]) + crossPad;
       const double bound = N * (ringCross + cross / q.R - meanTerm + interaction) / den;
       if (bound >= threshold - kBoundSlack) candidates.push_back({bound, si, t});
     }
@@ -251,8 +302,8 @@ WindowScore compareWindows(const LogPolarWindow& ref, const LogPolarWindow& imag
   const std::vector<Placement> pb = placements(image, R, ringShifts);
   const Pair q{ref,        image, pa,         pb,
                ringShifts, R,     ref.angles, static_cast<std::int64_t>(R) * ref.angles};
-  std::vector<Candidate> candidates;
-  return comparePlaced(q, threshold, acc, candidates);
+  CompareScratch scratch;
+  return comparePlaced(q, threshold, acc, scratch);
 }
 
 std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
@@ -267,7 +318,7 @@ std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
   std::vector<std::vector<Placement>> imagePlacements(image.size());
   for (std::size_t j = 0; j < image.size(); ++j)
     if (image[j].valid) imagePlacements[j] = placements(image[j], R, ringShifts);
-  std::vector<Candidate> candidates;
+  CompareScratch scratch;
   const NccAccelerations& acc = params.accelerations;
   const bool pruneAcrossWindows = acc.projections || acc.jensen;
   for (std::size_t i = 0; i < ref.size(); ++i) {
@@ -282,7 +333,7 @@ std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
       // the earlier image window, as the plain loop does).
       const double thr =
           (pruneAcrossWindows && best.image >= 0) ? best.best.score : params.minScore;
-      const WindowScore s = comparePlaced(q, thr, acc, candidates);
+      const WindowScore s = comparePlaced(q, thr, acc, scratch);
       if (s.score < params.minScore) continue;
       if (best.image < 0 || s.score > best.best.score) {
         best.ref = static_cast<int>(i);
