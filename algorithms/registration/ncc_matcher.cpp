@@ -108,6 +108,23 @@ inline float dotFloat(const float* a, const float* b, int n) {
   return sum;
 }
 
+using DoubleLanes = double __attribute__((vector_size(16)));
+
+// Double dot product with two partial sums (even and odd terms), held in one lane vector.
+inline double dotDouble(const double* a, const double* b, int n) {
+  DoubleLanes acc = {0, 0};
+  int i = 0;
+  for (; i + 2 <= n; i += 2) {
+    DoubleLanes x, y;
+    std::memcpy(&x, a + i, sizeof x);
+    std::memcpy(&y, b + i, sizeof y);
+    acc += x * y;
+  }
+  double sum = acc[0] + acc[1];
+  for (; i < n; ++i) sum += a[i] * b[i];
+  return sum;
+}
+
 using FloatLanes = float __attribute__((vector_size(16)));
 constexpr int kLaneWidth = 4;
 // Shifts correlated in one pass over the profile: eight lanes, whose sums stay in registers.
@@ -140,7 +157,18 @@ inline void correlateProfiles(const float* a, const float* bTwice, int n, float*
   for (; t < n; ++t) out[t] = dotFloat(a, bTwice + t, n);
 }
 
+constexpr int kDefaultAngles = LogPolarParams{}.angles;
+
+template <int n>
+inline std::int32_t rowDotOfLength(const std::int16_t* a, const std::int16_t* b) {
+  std::int32_t acc = 0;
+  for (int i = 0; i < n; ++i) acc += static_cast<std::int32_t>(a[i]) * b[i];
+  return acc;
+}
+
 inline std::int32_t rowDot(const std::int16_t* a, const std::int16_t* b, int n) {
+  // The default angle count gets a loop of known length, which the compiler unrolls whole.
+  if (n == kDefaultAngles) return rowDotOfLength<kDefaultAngles>(a, b);
   std::int32_t acc = 0;
   for (int i = 0; i < n; ++i) acc += static_cast<std::int32_t>(a[i]) * b[i];
   return acc;
@@ -249,15 +277,14 @@ WindowScore comparePlaced(const Pair& q, double threshold, const NccAcceleration
     if (pb.variance <= 0) continue;
     const double den = std::sqrt(q.pa.variance * pb.variance);
     const double meanTerm = sa * static_cast<double>(pb.sum) / N;
-    double ringCross = 0;
-    for (int r = 0; r < q.R; ++r) ringCross += q.pa.ringSums[r] * pb.ringSums[r];
+    // Exact in any order: integer terms whose sum stays far below 2^53.
+    double ringCross = dotDouble(q.pa.ringSums.data(), pb.ringSums.data(), q.R);
     ringCross = ringCross / q.A - meanTerm;
     const double interaction = std::sqrt(q.pa.interaction * pb.interaction);
     // Bound over every angle shift at once from the angle profiles' amplitude spectra: their
     // cyclic correlation minus its mean term is at most (1/A) sum_k |X_k| |Y_k|.
-    double spectral = 0;
-    for (std::size_t k = 0; k < pb.spectrum.size(); ++k)
-      spectral += q.pa.spectrum[k] * pb.spectrum[k];
+    const double spectral =
+        dotDouble(q.pa.spectrum.data(), pb.spectrum.data(), static_cast<int>(pb.spectrum.size()));
     const double spectralBound = N * (ringCross + spectral / (q.A * q.R) + interaction) / den;
     if (spectralBound < threshold - kBoundSlack) continue;
     // Tighter, per ring: each ring's cyclic correlation minus its mean term is at most
@@ -274,7 +301,12 @@ WindowScore comparePlaced(const Pair& q, double threshold, const NccAcceleration
     // Float correlations, all shifts in lanes; each rounds by less than A * 2^-24 * |X| |Y|.
     const double crossPad = 4.0 * q.A * 6e-8 * q.pa.columnNorm * pb.columnNorm + 1.0;
     correlateProfiles(q.pa.columnSums.data(), pb.columnSums.data(), q.A, profileCross.data());
+    // The bound below reaches the threshold only from this correlation on; the few shifts that
+    // get there have their bound computed in full.
+    const double crossCutoff =
+        ((threshold - kBoundSlack) * den / N - ringCross + meanTerm - interaction) * q.R - crossPad;
     for (int t = 0; t < q.A; ++t) {
+      if (static_cast<double>(profileCross[t]) < crossCutoff) continue;
       const double cross = static_cast<double>(profileCross[t]) + crossPad;
       const double bound = N * (ringCross + cross / q.R - meanTerm + interaction) / den;
       if (bound >= threshold - kBoundSlack) candidates.push_back({bound, si, t});
