@@ -110,16 +110,20 @@ inline float dotFloat(const float* a, const float* b, int n) {
 
 using DoubleLanes = double __attribute__((vector_size(16)));
 
-// Double dot product with two partial sums (even and odd terms), held in one lane vector.
+// Double dot product with four partial sums (terms i mod 4), held in two lane vectors.
 inline double dotDouble(const double* a, const double* b, int n) {
-  DoubleLanes acc = {0, 0};
+  DoubleLanes acc0 = {0, 0}, acc1 = {0, 0};
   int i = 0;
-  for (; i + 2 <= n; i += 2) {
-    DoubleLanes x, y;
-    std::memcpy(&x, a + i, sizeof x);
-    std::memcpy(&y, b + i, sizeof y);
-    acc += x * y;
+  for (; i + 4 <= n; i += 4) {
+    DoubleLanes x0, y0, x1, y1;
+    std::memcpy(&x0, a + i, sizeof x0);
+    std::memcpy(&y0, b + i, sizeof y0);
+    std::memcpy(&x1, a + i + 2, sizeof x1);
+    std::memcpy(&y1, b + i + 2, sizeof y1);
+    acc0 += x0 * y0;
+    acc1 += x1 * y1;
   }
+  const DoubleLanes acc = acc0 + acc1;
   double sum = acc[0] + acc[1];
   for (; i < n; ++i) sum += a[i] * b[i];
   return sum;
