@@ -87,15 +87,26 @@ LogPolarWindow sampleLogPolar(const std::vector<cv::Mat>& pyramid, cv::Point2d c
     w.ringSquares[r + 1] = w.ringSquares[r] + s2;
   }
   const int K = A / 2;
+  // The DFT's cosines and sines in the order each frequency k meets them (k * t mod A), laid out
+  // once per window rather than indexed by a division for every ring.
+  std::vector<double> cosinesByFrequency(static_cast<std::size_t>(K) * A);
+  std::vector<double> sinesByFrequency(static_cast<std::size_t>(K) * A);
+  for (int k = 1; k <= K; ++k)
+    for (int t = 0; t < A; ++t) {
+      const int phase = (k * t) % A;  // cos/sin tables are indexed by angle sample
+      cosinesByFrequency[static_cast<std::size_t>(k - 1) * A + t] = cosines[phase];
+      sinesByFrequency[static_cast<std::size_t>(k - 1) * A + t] = sines[phase];
+    }
   w.ringSpectrum.assign(static_cast<std::size_t>(w.rows) * K, 0.f);
   for (int r = 0; r < w.rows; ++r) {
     const std::int16_t* row = w.row(r);
     for (int k = 1; k <= K; ++k) {
+      const double* cosK = cosinesByFrequency.data() + static_cast<std::size_t>(k - 1) * A;
+      const double* sinK = sinesByFrequency.data() + static_cast<std::size_t>(k - 1) * A;
       double re = 0, im = 0;
       for (int t = 0; t < A; ++t) {
-        const int phase = (k * t) % A;  // cos/sin tables are indexed by angle sample
-        re += row[t] * cosines[phase];
-        im -= row[t] * sines[phase];
+        re += row[t] * cosK[t];
+        im -= row[t] * sinK[t];
       }
       const double weight = (2 * k == A) ? 1.0 : std::sqrt(2.0);
       w.ringSpectrum[r * K + k - 1] = static_cast<float>(weight * std::hypot(re, im));
