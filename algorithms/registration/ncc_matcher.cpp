@@ -163,16 +163,11 @@ inline void correlateProfiles(const float* a, const float* bTwice, int n, float*
 
 constexpr int kDefaultAngles = LogPolarParams{}.angles;
 
-template <int n>
-inline std::int32_t rowDotOfLength(const std::int16_t* a, const std::int16_t* b) {
-  std::int32_t acc = 0;
-  for (int i = 0; i < n; ++i) acc += static_cast<std::int32_t>(a[i]) * b[i];
-  return acc;
-}
-
+// Rows of `fixedAngles` samples (0: the length n is known at run time only). A length known at
+// compile time lets the compiler unroll the whole row.
+template <int fixedAngles>
 inline std::int32_t rowDot(const std::int16_t* a, const std::int16_t* b, int n) {
-  // The default angle count gets a loop of known length, which the compiler unrolls whole.
-  if (n == kDefaultAngles) return rowDotOfLength<kDefaultAngles>(a, b);
+  if constexpr (fixedAngles > 0) n = fixedAngles;
   std::int32_t acc = 0;
   for (int i = 0; i < n; ++i) acc += static_cast<std::int32_t>(a[i]) * b[i];
   return acc;
@@ -189,10 +184,11 @@ struct Pair {
 
 // Full NCC at ring shift index si (s = si - S) and angle shift t. Returns false when the shift
 // has no defined NCC (flat window) or was abandoned by the Jensen bound below `thr`.
+template <int fixedAngles>  // q.A when not 0; see rowDot
 bool fullScore(const Pair& q, int si, int t, double thr, const NccAccelerations& acc,
                double& score) {
   const Placement& pb = q.pb[si];
-  const int A = q.A;
+  const int A = fixedAngles > 0 ? fixedAngles : q.A;
   std::int64_t sb = 0, sbb = 0;
   if (acc.sumTables) {
     sb = pb.sum;
@@ -213,7 +209,7 @@ bool fullScore(const Pair& q, int si, int t, double thr, const NccAccelerations&
   const double meanB = pb.mean;  // sb equals pb.sum with or without the sum tables
   std::int64_t sab = 0;
   for (int r = 0; r < q.R; ++r) {
-    sab += rowDot(q.a.row(q.pa.first + r), q.b.row(pb.first + r) + t, A);
+    sab += rowDot<fixedAngles>(q.a.row(q.pa.first + r), q.b.row(pb.first + r) + t, A);
     if (acc.jensen && (r & 1) && r + 1 < q.R) {
       // The rest of the covariance is at most the product of the rest's deviations.
       const int rest = r + 1;
@@ -254,7 +250,9 @@ WindowScore comparePlaced(const Pair& q, double threshold, const NccAcceleration
   auto consider = [&](int si, int t) {
     const double thr = bestIndex < 0 ? threshold : std::max(threshold, best.score);
     double score = 0;
-    if (!fullScore(q, si, t, thr, acc, score)) return;
+    const bool scored = q.A == kDefaultAngles ? fullScore<kDefaultAngles>(q, si, t, thr, acc, score)
+                                              : fullScore<0>(q, si, t, thr, acc, score);
+    if (!scored) return;
     if (score < threshold) return;
     const int index = si * q.A + t;
     if (bestIndex < 0 || score > best.score || (score == best.score && index < bestIndex)) {
