@@ -76,17 +76,23 @@ struct RowRange {
 };
 
 // Four consecutive pixels of a row as floats (OpenCV's widening loads; a conversion of a 4-byte
-// vector extension type is done lane by lane).
+// vector extension type is done lane by lane). The pixels are copied to an aligned block first:
+// the widening load reads them as one int (or int64), which a row's arbitrary address may not be
+// aligned for; the copy is a single move.
 Lanes fourPixels(const uchar* p) {
+  alignas(16) uchar block[16] = {};
+  std::memcpy(block, p, 4);
   Lanes out;
   cv::v_store(reinterpret_cast<float*>(&out),
-              cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(p))));
+              cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand_q(block))));
   return out;
 }
 Lanes fourPixels(const ushort* p) {
+  alignas(16) ushort block[8] = {};
+  std::memcpy(block, p, 4 * sizeof(ushort));
   Lanes out;
   cv::v_store(reinterpret_cast<float*>(&out),
-              cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand(p))));
+              cv::v_cvt_f32(cv::v_reinterpret_as_s32(cv::v_load_expand(block))));
   return out;
 }
 
