@@ -36,8 +36,7 @@ using IntLanes = int __attribute__((vector_size(16)));
 struct Samples {
   int count = 0;   // padded to a multiple of 4 with zero samples (weight 0 in the fit)
   int filled = 0;  // the samples before the padding (weight 1)
-  float mean = 0;
-  // across, along, grey value minus mean
+  // across, along, grey value minus the samples' mean (the fit's level is relative to it)
   alignas(16) std::array<float, kCapacity> s, t, v;
   // Per lane, the sum of v over the blocks of four in order: the first right-hand side of every
   // step's normal equations, the same for all of them.
@@ -180,7 +179,6 @@ void gather(const cv::Mat& image, cv::Point c, cv::Point2d n, double offset,
   }
   const int real = out.filled = count;
   const float mean = real ? sumOfValues<T>(v, real) / static_cast<float>(real) : 0.0f;
-  out.mean = mean;
   for (int i = 0; i < real; ++i) v[i] -= mean;
   while (count % 4) {
     const int i = count++;
