@@ -1,11 +1,12 @@
 #include "algorithms/measure/bar_profile_fit.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <vector>
 
-#include "algorithms/geometry/spd_solve.hpp"
+#include <Eigen/Dense>
+
+#include "algorithms/geometry/levenberg_marquardt.hpp"
 
 namespace facet {
 namespace {
@@ -58,7 +59,9 @@ std::optional<BarEdges> fitBarProfile(const GreyProfile& p, const ProfileEdge& f
 
   // Levenberg-Marquardt from the single-edge fits; the level before the bar from the window's
   // first samples.
-  std::array<double, kUnknowns> x{};
+  using Vector7 = Eigen::Matrix<double, kUnknowns, 1>;
+  using Matrix7 = Eigen::Matrix<double, kUnknowns, kUnknowns>;
+  Vector7 x;
   x[kLevel] = y.front();
   x[kStep1] = first.amplitude;
   x[kStep2] = second.amplitude;
@@ -66,68 +69,55 @@ std::optional<BarEdges> fitBarProfile(const GreyProfile& p, const ProfileEdge& f
   x[kEdge2] = second.position;
   x[kBlur] = std::clamp(0.5 * (first.blur + second.blur), 0.3, 4.0);
   x[kSlope] = 0.0;
-  const auto residuals = [&](const std::array<double, kUnknowns>& v, std::vector<double>& r) {
+  // Residuals model - data, and their sum of squares.
+  const auto residuals = [&](const Vector7& v, std::vector<double>& r) {
     double sum = 0;
     for (std::size_t j = 0; j < s.size(); ++j) {
-      const double m = v[kLevel] + v[kStep1] * Phi((s[j] - v[kEdge1]) / v[kBlur]) +
-                       v[kStep2] * Phi((s[j] - v[kEdge2]) / v[kBlur]) + v[kSlope] * (s[j] - centre);
-      r[j] = y[j] - m;
+      r[j] = v[kLevel] + v[kStep1] * Phi((s[j] - v[kEdge1]) / v[kBlur]) +
+             v[kStep2] * Phi((s[j] - v[kEdge2]) / v[kBlur]) + v[kSlope] * (s[j] - centre) - y[j];
       sum += r[j] * r[j];
     }
     return sum;
   };
   std::vector<double> r(s.size()), trial(s.size());
-  double cost = residuals(x, r), lambda = 1e-3;
-  for (int it = 0; it < 50; ++it) {
-    std::array<std::array<double, kUnknowns>, kUnknowns> jtj{};
-    std::array<double, kUnknowns> jtr{};
-    for (std::size_t j = 0; j < s.size(); ++j) {
-      const double z1 = (s[j] - x[kEdge1]) / x[kBlur], z2 = (s[j] - x[kEdge2]) / x[kBlur];
-      const double g1 = std::exp(-0.5 * z1 * z1) * 0.3989422804014327;
-      const double g2 = std::exp(-0.5 * z2 * z2) * 0.3989422804014327;
-      std::array<double, kUnknowns> jac;
-      jac[kLevel] = 1.0;
-      jac[kStep1] = Phi(z1);
-      jac[kStep2] = Phi(z2);
-      jac[kEdge1] = -x[kStep1] * g1 / x[kBlur];
-      jac[kEdge2] = -x[kStep2] * g2 / x[kBlur];
-      jac[kBlur] = -(x[kStep1] * g1 * z1 + x[kStep2] * g2 * z2) / x[kBlur];
-      jac[kSlope] = s[j] - centre;
-      for (int a = 0; a < kUnknowns; ++a) {
-        jtr[a] += jac[a] * r[j];
-        for (int b = 0; b <= a; ++b) jtj[a][b] += jac[a] * jac[b];
-      }
-    }
-    bool improved = false;
-    while (lambda < 1e8) {
-      auto a = jtj;
-      auto d = jtr;
-      for (int k = 0; k < kUnknowns; ++k) a[k][k] *= 1.0 + lambda;
-      if (!solveSpd<kUnknowns>(a, d)) {
-        lambda *= 10;
-        continue;
-      }
-      std::array<double, kUnknowns> next = x;
-      for (int k = 0; k < kUnknowns; ++k) next[k] += d[k];
-      if (next[kBlur] < 0.3 || next[kBlur] > 4.0) {
-        lambda *= 10;
-        continue;
-      }
-      const double nextCost = residuals(next, trial);
-      if (nextCost <= cost) {
-        const double move = std::max(std::abs(d[kEdge1]), std::abs(d[kEdge2]));
-        x = next, cost = nextCost, r.swap(trial);
-        lambda = std::max(lambda / 10, 1e-9);
-        improved = true;
-        if (move < 1e-7) it = 50;  // converged
-        break;
-      }
-      lambda *= 10;
-    }
-    if (!improved) break;
-  }
-  const bool sane = std::isfinite(cost) && x[kEdge1] < x[kEdge2] && x[kEdge1] >= lo &&
-                    x[kEdge2] <= hi && (x[kStep1] > 0) == (first.amplitude > 0) &&
+  LevenbergMarquardtCallbacks problem{
+      [&](const Vector7& v) { return residuals(v, r); },
+      [&](int, const Vector7& v, Matrix7& jtj, Vector7& jtr, double&) {
+        jtj.setZero();
+        jtr.setZero();
+        Vector7 jac;
+        for (std::size_t j = 0; j < s.size(); ++j) {
+          const double z1 = (s[j] - v[kEdge1]) / v[kBlur], z2 = (s[j] - v[kEdge2]) / v[kBlur];
+          const double g1 = std::exp(-0.5 * z1 * z1) * 0.3989422804014327;
+          const double g2 = std::exp(-0.5 * z2 * z2) * 0.3989422804014327;
+          jac[kLevel] = 1.0;
+          jac[kStep1] = Phi(z1);
+          jac[kStep2] = Phi(z2);
+          jac[kEdge1] = -v[kStep1] * g1 / v[kBlur];
+          jac[kEdge2] = -v[kStep2] * g2 / v[kBlur];
+          jac[kBlur] = -(v[kStep1] * g1 * z1 + v[kStep2] * g2 * z2) / v[kBlur];
+          jac[kSlope] = s[j] - centre;
+          jtj.selfadjointView<Eigen::Lower>().rankUpdate(jac);
+          jtr += jac * r[j];
+        }
+        jtj = jtj.selfadjointView<Eigen::Lower>();
+      },
+      [&](const Vector7& v) -> std::optional<double> {
+        if (v[kBlur] < 0.3 || v[kBlur] > 4.0) return std::nullopt;
+        return residuals(v, trial);
+      },
+      [&] { r.swap(trial); },
+      [&](int, const Vector7& step) {
+        return std::max(std::abs(step[kEdge1]), std::abs(step[kEdge2])) < 1e-7;
+      }};
+  LevenbergMarquardtSettings settings;
+  settings.maxIterations = 50;
+  settings.initialDamping = 1e-3;
+  settings.maxTries = 12;
+  if (levenbergMarquardt<kUnknowns>(problem, x, settings) == LevenbergMarquardtStop::NonFiniteStep)
+    return std::nullopt;
+  const bool sane = x.allFinite() && x[kEdge1] < x[kEdge2] && x[kEdge1] >= lo && x[kEdge2] <= hi &&
+                    (x[kStep1] > 0) == (first.amplitude > 0) &&
                     (x[kStep2] > 0) == (second.amplitude > 0);
   if (!sane) return std::nullopt;
   BarEdges out{first, second};
