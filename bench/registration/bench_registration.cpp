@@ -220,7 +220,12 @@ void sequenceTable(const std::string& dir, const std::string& name, const char* 
   const int last = smoke ? 3 : 6;
   int met = 0;
   double oursMs = 0, siftMs = 0;
-  std::vector<std::pair<Outcome, Outcome>> outcomes;  // facet, SIFT per pair
+  struct PairRun {
+    cv::Mat imgN;
+    cv::Matx33d truth;
+    Outcome ours, sift;
+  };
+  std::vector<PairRun> runs;  // per pair, for the dense reference below
   for (int n = 2; n <= last; ++n) {
     const cv::Mat imgN =
         cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
@@ -244,7 +249,7 @@ void sequenceTable(const std::string& dir, const std::string& name, const char* 
                 sift.ms, sift.correct > 0 ? double(ours.correct) / sift.correct : 0.0,
                 ours.ms / sift.ms, good ? "target met" : "TARGET MISSED");
     if (!ours.ok) std::printf("  facet found no transform: %s\n", ours.failure.c_str());
-    outcomes.emplace_back(ours, sift);
+    runs.push_back({imgN, truth, ours, sift});
   }
   std::printf(
       "%s pairs meeting all targets: %d / %d; total CPU time facet %.0f ms, SIFT %.0f ms "
@@ -259,10 +264,7 @@ void sequenceTable(const std::string& dir, const std::string& name, const char* 
                 "facet <= SIFT");
     int closer = 0, solved = 0;
     for (int n = 2; n <= last; ++n) {
-      const auto& [ours, sift] = outcomes[n - 2];
-      const cv::Mat imgN =
-          cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
-      const cv::Matx33d published = readHomography(dir + "/H1to" + std::to_string(n) + "p");
+      const auto& [imgN, published, ours, sift] = runs[n - 2];
       const std::optional<DenseReference> dense = denseReference(img1, imgN, published);
       if (!dense) {
         std::printf("1-%d   | ECC did not converge\n", n);
