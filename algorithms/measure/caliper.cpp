@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "algorithms/measure/bar_profile_fit.hpp"
+#include "algorithms/measure/edge_cluster_fit.hpp"
 
 namespace facet {
 namespace {
@@ -19,24 +19,6 @@ std::vector<T> choose(std::vector<T> items, EdgeSelect select, Strength strength
   if (select == EdgeSelect::Last) return {items.back()};
   return {*std::max_element(items.begin(), items.end(),
                             [&](const T& x, const T& y) { return strength(x) < strength(y); })};
-}
-
-// Neighbouring edges of opposite polarity whose blurs overlap are refitted as one bar
-// (bar_profile_fit.hpp); the others keep the single-edge estimate.
-void refitCrowdedBars(const GreyProfile& profile, std::vector<ProfileEdge>& edges,
-                      const ProfileEdgeParams& params) {
-  for (std::size_t i = 0; i + 1 < edges.size(); ++i) {
-    const ProfileEdge &a = edges[i], &b = edges[i + 1];
-    if ((a.amplitude > 0) == (b.amplitude > 0) || !blursOverlap(a, b, params.areaHalfWidth))
-      continue;
-    std::vector<ProfileEdge> others;
-    for (std::size_t k = 0; k < edges.size(); ++k)
-      if (k != i && k != i + 1) others.push_back(edges[k]);
-    if (const auto bar = fitBarProfile(profile, a, b, others, params.window)) {
-      edges[i] = bar->first, edges[i + 1] = bar->second;
-      ++i;  // an edge belongs to one bar
-    }
-  }
 }
 
 CaliperResult failed(MeasureFailure cause, std::string message, bool partial = false) {
@@ -64,8 +46,9 @@ CaliperResult measureCaliper(const cv::Mat& image, const MeasuringPath& path,
 
   ProfileEdgeParams ep = params.edges;
   ep.minAmplitude = params.minAmplitude;
-  std::vector<ProfileEdge> found = findProfileEdges(profile, ep);
-  refitCrowdedBars(profile, found, ep);
+  ProfileEdgeFinder finder(ep);
+  const std::vector<ProfileEdge> found =
+      refitCrowdedEdges(profile, finder.find(profile), finder.candidates(), ep);
   std::vector<CaliperEdge> all;
   for (const ProfileEdge& e : found)
     all.push_back({path.at(e.position, 0.0), e.position, e.amplitude, e.clipped});

@@ -8,29 +8,12 @@
 #include <Eigen/Dense>
 
 #include "algorithms/geometry/spd_solve.hpp"
+#include "algorithms/measure/standard_normal.hpp"
 
 namespace facet {
 namespace {
 
-// The standard normal density phi(z) and distribution Phi(z) from one exponential: erf by
-// Abramowitz & Stegun 7.1.26 (|error| < 1.5e-7, i.e. < 1e-4 grey levels on a 255 step). The step
-// fit evaluates them a few thousand times per edge; std::erfc costs several times more.
-struct Normal {
-  double density, cdf;
-};
-// From z and exp(-z^2 / 2).
-Normal normal(double z, double e) {
-  const double x = std::abs(z) * M_SQRT1_2;
-  const double t = 1.0 / (1.0 + 0.3275911 * x);
-  const double poly =
-      t *
-      (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
-  const double half = 0.5 * poly * e;  // 0.5 * erfc(x)
-  return {0.3989422804014327 * e, z >= 0 ? 1.0 - half : half};
-}
-Normal normal(double z) {
-  return normal(z, std::exp(-0.5 * z * z));
-}
+using standard_normal::normal;
 
 // exp(-z^2 / 2) at evenly spaced z = z0 + j dz, as the step fit needs it at every sample of its
 // window: each value is the last times exp(-z dz - dz^2 / 2), a ratio that shrinks by exp(-dz^2)
@@ -289,6 +272,7 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
 const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
   const ProfileEdgeParams& prm = params_;
   edges_.clear();
+  candidates_.clear();
   const int n = static_cast<int>(p.values.size());
   if (n < 6) return edges_;
   derivative(p);
@@ -330,6 +314,7 @@ const std::vector<ProfileEdge>& ProfileEdgeFinder::find(const GreyProfile& p) {
     st.b = d[i] * toStep;
     st.a = p.values[std::max(0, i - static_cast<int>(2.0 / p.step))];
     steps_.push_back(st);
+    candidates_.push_back({st.e, st.b, 0.0, false});
   }
   // Two passes: the second fits each step with its neighbours' fitted steps removed; steps whose
   // fit degenerated in the first pass no longer count as neighbours.

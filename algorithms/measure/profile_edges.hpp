@@ -68,6 +68,11 @@ class ProfileEdgeFinder {
   // As findProfileEdges(profile, params); the result lives until the next call.
   const std::vector<ProfileEdge>& find(const GreyProfile& profile);
 
+  // The last find()'s candidates, in axis order: the derivative's peaks strong enough to be
+  // fitted (position from the parabola through the peak, amplitude as the peak's height reads
+  // it, blur 0). Where edges crowd, a joint fit starts from them (edge_cluster_fit.hpp).
+  [[nodiscard]] const std::vector<ProfileEdge>& candidates() const { return candidates_; }
+
  private:
   struct Step;
   void derivative(const GreyProfile& profile);
@@ -86,7 +91,7 @@ class ProfileEdgeFinder {
   std::vector<double> faint_;       // positions of steps too faint to fit (window stops)
   std::vector<double> magnitudes_;  // |slope|, for the noise level
   std::vector<double> window_;      // the current step's samples, neighbours removed
-  std::vector<ProfileEdge> found_, edges_;
+  std::vector<ProfileEdge> found_, edges_, candidates_;
 };
 
 }  // namespace facet

@@ -1,5 +1,8 @@
 // Caliper: edges at subpixel positions at any angle and under both blur models, pairs, selection,
 // the arc variant, and every failure with its cause.
+#include <cstdint>
+#include <initializer_list>
+
 #include <gtest/gtest.h>
 
 #include "algorithms/measure/caliper.hpp"
@@ -50,9 +53,10 @@ TEST(Caliper, IsUnbiasedWhetherTheBlurActsBeforeOrAfterThePixel) {
 }
 
 // A light bar `width` px wide across the axis, its middle at `centre` on the axis.
-cv::Mat barImage(const MeasuringRect& rect, double centre, double width, double dark, double light,
-                 double noise = 1.0, double blur = 0.9,
-                 scene::BlurModel model = scene::BlurModel::PixelGrid) {
+// Light bars `width` px wide across the caliper, centred at `centres` along its axis.
+cv::Mat barsImage(const MeasuringRect& rect, std::initializer_list<double> centres, double width,
+                  double dark, double light, double noise = 1.0, double blur = 0.9,
+                  scene::BlurModel model = scene::BlurModel::PixelGrid, std::uint64_t seed = 1) {
   scene::SceneSpec spec;
   spec.size = {80, 80};
   spec.background = dark;
@@ -60,13 +64,23 @@ cv::Mat barImage(const MeasuringRect& rect, double centre, double width, double 
   spec.blurModel = model;
   spec.noiseSigma = noise;
   spec.subrows = 64;
+  spec.seed = seed;
   scene::Scene s(spec);
   const cv::Point2d d = axisOf(rect.angle), t(-d.y, d.x);
-  const cv::Point2d m = cv::Point2d(rect.cx, rect.cy) + centre * d;
-  const double h = width / 2, far = 100;
-  s.addPolygon({m - h * d - far * t, m + h * d - far * t, m + h * d + far * t, m - h * d + far * t},
-               light);
+  for (const double centre : centres) {
+    const cv::Point2d m = cv::Point2d(rect.cx, rect.cy) + centre * d;
+    const double h = width / 2, far = 100;
+    s.addPolygon(
+        {m - h * d - far * t, m + h * d - far * t, m + h * d + far * t, m - h * d + far * t},
+        light);
+  }
   return s.render();
+}
+
+cv::Mat barImage(const MeasuringRect& rect, double centre, double width, double dark, double light,
+                 double noise = 1.0, double blur = 0.9,
+                 scene::BlurModel model = scene::BlurModel::PixelGrid) {
+  return barsImage(rect, {centre}, width, dark, light, noise, blur, model);
 }
 
 TEST(Caliper, PairsGiveTheWidthAndCentreOfABarFourPixelsWide) {
@@ -113,6 +127,52 @@ TEST(Caliper, BarsNarrowerThanTheirBlurKeepTheirWidth) {
       }
   EXPECT_LT(worstWidth, 0.05);
   EXPECT_LT(worstCentre, 0.03);
+}
+
+// Two bars of 4 px, 3 and 4 px apart, under a blur of 1.5 px (a comb whose pitch is under five
+// blur widths): the single-edge fits of the inner edges degenerate (steps of thousands of grey
+// levels, or none), the joint fit of the four edges keeps every edge and width.
+TEST(Caliper, CombFinerThanItsBlurKeepsEveryEdge) {
+  CaliperParams p;
+  p.pairs = true;
+  double worst = 0;
+  for (const auto model : {scene::BlurModel::PixelGrid, scene::BlurModel::Lens})
+    for (const double gap : {3.0, 4.0})
+      for (int k = 0; k < 4; ++k) {
+        const MeasuringRect rect{40.3, 39.6, 40, 20, 13.0 + 41.0 * k};
+        const double c0 = -0.3 + 0.13 * k, half = 0.5 * (4.0 + gap);
+        const cv::Mat image =
+            barsImage(rect, {c0 - half, c0 + half}, 4.0, 60, 170, 0.0, 1.5, model);
+        const CaliperResult r = measureCaliper(image, MeasuringPath(rect), p);
+        ASSERT_TRUE(r.status.ok()) << r.status.message;
+        ASSERT_EQ(r.edges.size(), 4u) << "gap " << gap << " angle " << rect.angle;
+        ASSERT_EQ(r.pairs.size(), 2u);
+        for (const CaliperEdge& e : r.edges) EXPECT_NEAR(std::abs(e.amplitude), 110.0, 5.0);
+        for (int i = 0; i < 2; ++i) {
+          worst = std::max(worst, std::abs(r.pairs[i].width - 4.0));
+          worst = std::max(worst, std::abs(r.pairs[i].position - (c0 + (i ? half : -half))));
+        }
+      }
+  EXPECT_LT(worst, 0.05);
+}
+
+// The same comb with noise: every edge and no other, none of them made up (a step no larger than
+// the grey values span), on many noise draws.
+TEST(Caliper, NoisyCombFinerThanItsBlurMakesUpNoEdge) {
+  CaliperParams p;
+  p.pairs = true;
+  for (std::uint64_t seed = 1; seed <= 24; ++seed) {
+    const MeasuringRect rect{40.3, 39.6, 40, 20, 7.0 * static_cast<double>(seed)};
+    const double gap = seed % 2 ? 3.0 : 4.0, half = 0.5 * (4.0 + gap);
+    const auto model = seed % 3 ? scene::BlurModel::Lens : scene::BlurModel::PixelGrid;
+    const cv::Mat image = barsImage(rect, {-half, half}, 4.0, 60, 170, 2.0, 1.5, model, seed);
+    const CaliperResult r = measureCaliper(image, MeasuringPath(rect), p);
+    ASSERT_TRUE(r.status.ok()) << r.status.message;
+    ASSERT_EQ(r.edges.size(), 4u) << "seed " << seed;
+    ASSERT_EQ(r.pairs.size(), 2u) << "seed " << seed;
+    for (const CaliperEdge& e : r.edges) EXPECT_LT(std::abs(e.amplitude), 140.0) << seed;
+    for (const CaliperPair& pr : r.pairs) EXPECT_NEAR(pr.width, 4.0, 0.5) << seed;
+  }
 }
 
 // A dark bar in a backlight 1.6 times the sensor's clip (it reads 255 on both sides): its edges

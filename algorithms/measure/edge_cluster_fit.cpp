@@ -1,0 +1,277 @@
+#include "algorithms/measure/edge_cluster_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "algorithms/geometry/levenberg_marquardt.hpp"
+#include "algorithms/measure/standard_normal.hpp"
+
+namespace facet {
+namespace {
+
+// Another edge's step as it appears in the window (the convention of ProfileEdgeFinder: edges
+// ahead add their rising part, edges behind subtract the part not yet completed).
+double otherStep(const ProfileEdge& o, double centre, double s) {
+  const double z = (s - o.position) / std::max(o.blur, 0.3);
+  if (std::abs(z) > 8) return 0.0;
+  const double cdf = standard_normal::normal(z).cdf;
+  return o.position > centre ? o.amplitude * cdf : o.amplitude * (cdf - 1.0);
+}
+
+// The unknowns, in this order: the level before the first edge, the n steps, the n edges, the
+// common blur and the background's slope.
+struct Layout {
+  int n;
+  [[nodiscard]] int step(int k) const { return 1 + k; }
+  [[nodiscard]] int edge(int k) const { return 1 + n + k; }
+  [[nodiscard]] int blur() const { return 1 + 2 * n; }
+  [[nodiscard]] int slope() const { return 2 + 2 * n; }
+  [[nodiscard]] int unknowns() const { return 3 + 2 * n; }
+};
+
+// Whether the single-edge estimates of two neighbouring edges see each other's model error: the
+// blur of one (3 w) reaches into the span over which the other balances its area
+// (ProfileEdgeParams::areaHalfWidth). Below that the single-edge estimate is unbiased (bars of
+// 4.2 w: 0.002 px noise-free), above it the joint fit is (bars of 2.6 w: 0.12 px before, 0.01 px).
+bool blursOverlap(const ProfileEdge& first, const ProfileEdge& second, double areaHalfWidth) {
+  const double blur = std::max(first.blur, second.blur);
+  return std::abs(second.position - first.position) < 3.0 * blur + areaHalfWidth;
+}
+
+// Fits the cluster `starts` (two or more edges in axis order, each with a start position,
+// amplitude and blur) over its span and up to `window` pixels beyond its end edges, short of the
+// midpoint to any edge of `others` (the profile's other edges, whose fitted steps are subtracted
+// first). The edges keep their order and polarity; they report the common blur. Empty when the
+// fit degenerates or leaves the span.
+std::optional<std::vector<ProfileEdge>> fitEdgeCluster(const GreyProfile& p,
+                                                       std::span<const ProfileEdge> starts,
+                                                       std::span<const ProfileEdge> others,
+                                                       double window) {
+  const int n = static_cast<int>(starts.size());
+  if (n < 2) return std::nullopt;
+  for (int k = 0; k + 1 < n; ++k)
+    if (!(starts[k].position < starts[k + 1].position)) return std::nullopt;
+  const Layout at{n};
+  const double firstEdge = starts.front().position, lastEdge = starts.back().position;
+  const double centre = 0.5 * (firstEdge + lastEdge);
+  double lo = std::max(p.start, firstEdge - window);
+  double hi = std::min(p.end(), lastEdge + window);
+  for (const ProfileEdge& o : others) {
+    if (o.position < firstEdge) lo = std::max(lo, 0.5 * (o.position + firstEdge));
+    if (o.position > lastEdge) hi = std::min(hi, 0.5 * (o.position + lastEdge));
+  }
+  const int i0 = static_cast<int>(std::ceil((lo - p.start) / p.step - 1e-9));
+  const int i1 = static_cast<int>(std::floor((hi - p.start) / p.step + 1e-9));
+  if (i1 - i0 + 1 < 2 * at.unknowns()) return std::nullopt;
+  std::vector<double> s(i1 - i0 + 1), y(i1 - i0 + 1);
+  for (int i = i0; i <= i1; ++i) {
+    s[i - i0] = p.positionAt(i);
+    y[i - i0] = p.values[i];
+    for (const ProfileEdge& o : others) y[i - i0] -= otherStep(o, centre, s[i - i0]);
+  }
+
+  // Levenberg-Marquardt from the starts; the level before the cluster from the window's first
+  // sample.
+  using Vector = Eigen::VectorXd;
+  using Matrix = Eigen::MatrixXd;
+  Vector x(at.unknowns());
+  x[0] = y.front();
+  double blurSum = 0;
+  for (int k = 0; k < n; ++k) {
+    x[at.step(k)] = starts[k].amplitude;
+    x[at.edge(k)] = starts[k].position;
+    blurSum += starts[k].blur;
+  }
+  x[at.blur()] = std::clamp(blurSum / n, 0.3, 4.0);
+  x[at.slope()] = 0.0;
+  // The model at v: residuals model - data and their sum of squares, with every sample's Phi and
+  // phi of every edge kept for the normal equations (computed once per evaluated point: a trial
+  // that is accepted is the next iteration's point). An edge farther than kReach blurs from a
+  // sample is a constant there (its Phi differs from 0 or 1 by < 1e-15).
+  constexpr double kReach = 8.0;
+  struct Evaluation {
+    std::vector<double> r, cdf, density;
+  };
+  const std::size_t m = s.size();
+  const auto evaluate = [&](const Vector& v, Evaluation& ev) {
+    ev.r.resize(m), ev.cdf.resize(m * n), ev.density.resize(m * n);
+    const double w = v[at.blur()];
+    double sum = 0;
+    for (std::size_t j = 0; j < m; ++j) {
+      double model = v[0] + v[at.slope()] * (s[j] - centre);
+      for (int k = 0; k < n; ++k) {
+        const double z = (s[j] - v[at.edge(k)]) / w;
+        const standard_normal::Normal nz = std::abs(z) > kReach
+                                               ? standard_normal::Normal{0.0, z > 0 ? 1.0 : 0.0}
+                                               : standard_normal::normal(z);
+        ev.cdf[j * n + k] = nz.cdf, ev.density[j * n + k] = nz.density;
+        model += v[at.step(k)] * nz.cdf;
+      }
+      ev.r[j] = model - y[j];
+      sum += ev.r[j] * ev.r[j];
+    }
+    return sum;
+  };
+  Evaluation current, trial;
+  Matrix jacobian(m, at.unknowns());
+  LevenbergMarquardtCallbacks problem{
+      [&](const Vector& v) { return evaluate(v, current); },
+      [&](int, const Vector& v, Matrix& jtj, Vector& jtr, double&) {
+        const double w = v[at.blur()];
+        for (std::size_t j = 0; j < m; ++j) {
+          auto row = jacobian.row(static_cast<Eigen::Index>(j));
+          row[0] = 1.0;
+          row[at.blur()] = 0.0;
+          for (int k = 0; k < n; ++k) {
+            const double z = (s[j] - v[at.edge(k)]) / w;
+            const double g = current.density[j * n + k];
+            row[at.step(k)] = current.cdf[j * n + k];
+            row[at.edge(k)] = -v[at.step(k)] * g / w;
+            row[at.blur()] -= v[at.step(k)] * g * z / w;
+          }
+          row[at.slope()] = s[j] - centre;
+        }
+        jtj.noalias() = jacobian.transpose() * jacobian;
+        jtr.noalias() = jacobian.transpose() * Eigen::Map<const Vector>(current.r.data(), m);
+      },
+      [&](const Vector& v) -> std::optional<double> {
+        if (v[at.blur()] < 0.3 || v[at.blur()] > 4.0) return std::nullopt;
+        return evaluate(v, trial);
+      },
+      [&] { std::swap(current, trial); },
+      [&](int, const Vector& step) {
+        return step.segment(at.edge(0), n).cwiseAbs().maxCoeff() < 1e-7;
+      }};
+  LevenbergMarquardtSettings settings;
+  settings.maxIterations = 50;
+  settings.initialDamping = 1e-3;
+  settings.maxTries = 12;
+  if (levenbergMarquardt<Eigen::Dynamic>(problem, x, settings) ==
+      LevenbergMarquardtStop::NonFiniteStep)
+    return std::nullopt;
+  if (!x.allFinite() || x[at.edge(0)] < lo || x[at.edge(n - 1)] > hi) return std::nullopt;
+  // Whether the sensor clipped the profile within the window (ProfileEdge::clipped; the limits
+  // up to the bilinear weights' rounding).
+  bool clipped = false;
+  for (int i = i0; i <= i1 && !clipped; ++i)
+    clipped = p.values[i] >= p.clipLevel - 1e-6 || p.values[i] <= 1e-6;
+  std::vector<ProfileEdge> out(starts.begin(), starts.end());
+  for (int k = 0; k < n; ++k) {
+    out[k].clipped = clipped;
+    if ((k + 1 < n && !(x[at.edge(k)] < x[at.edge(k + 1)])) ||
+        (x[at.step(k)] > 0) != (starts[k].amplitude > 0))
+      return std::nullopt;
+    out[k].position = x[at.edge(k)];
+    out[k].amplitude = x[at.step(k)];
+    out[k].blur = x[at.blur()];
+  }
+  return out;
+}
+
+// A single-edge fit that degenerated: a step far beyond the grey values the profile spans (the
+// inner edges of a comb finer than its blur fit as two opposite steps of thousands of grey levels
+// on one place).
+bool implausible(const ProfileEdge& e, double span) {
+  return std::abs(e.amplitude) > 1.5 * span;
+}
+
+}  // namespace
+
+std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
+                                           const std::vector<ProfileEdge>& single,
+                                           const std::vector<ProfileEdge>& peaks,
+                                           const ProfileEdgeParams& params) {
+  const auto [lo, hi] = std::minmax_element(profile.values.begin(), profile.values.end());
+  const double span = *hi - *lo;
+  std::vector<ProfileEdge> plausible;
+  for (const ProfileEdge& e : single)
+    if (!implausible(e, span)) plausible.push_back(e);
+  // A peak without a fit starts with the blur typical of the profile's plausible fits.
+  std::vector<double> blurs;
+  for (const ProfileEdge& e : plausible) blurs.push_back(e.blur);
+  double typicalBlur = 1.0;
+  if (!blurs.empty()) {
+    std::nth_element(blurs.begin(), blurs.begin() + blurs.size() / 2, blurs.end());
+    typicalBlur = blurs[blurs.size() / 2];
+  }
+
+  struct Member {
+    ProfileEdge anchor;   // where the edge shows: its peak, or a fit's own position
+    ProfileEdge start;    // the joint fit's start: the peak's fit, else the peak
+    bool peak = false;    // a peak (a start of the joint fit); else a fit that came from none
+    bool fitted = false;  // `start` is a plausible single-edge fit
+  };
+  std::vector<Member> members;
+  std::vector<bool> taken(plausible.size(), false);
+  for (ProfileEdge pk : peaks) {
+    pk.blur = typicalBlur;
+    Member m{pk, pk, true, false};
+    std::size_t from = plausible.size();
+    double nearest = 1.0;
+    for (std::size_t k = 0; k < plausible.size(); ++k) {
+      const double d = std::abs(plausible[k].position - pk.position);
+      if (!taken[k] && (plausible[k].amplitude > 0) == (pk.amplitude > 0) && d < nearest)
+        nearest = d, from = k;
+    }
+    if (from < plausible.size()) {
+      taken[from] = true;
+      m.start = plausible[from];
+      m.anchor.blur = plausible[from].blur;
+      m.fitted = true;
+    }
+    members.push_back(m);
+  }
+  for (std::size_t k = 0; k < plausible.size(); ++k)
+    if (!taken[k]) members.push_back({plausible[k], plausible[k], false, true});
+  std::sort(members.begin(), members.end(),
+            [](const Member& a, const Member& b) { return a.anchor.position < b.anchor.position; });
+
+  // Neighbours are one cluster where their blurs overlap, or where one is a peak whose single
+  // fit failed (degenerated, died or came out too weak) and the other lay within its window: the
+  // failure is what a neighbour does to a single fit. A weak peak joins a cluster only to be
+  // left out of it again.
+  const auto crowded = [&](const Member& a, const Member& b) {
+    const bool failed = (a.peak && !a.fitted) || (b.peak && !b.fitted);
+    return blursOverlap(a.anchor, b.anchor, params.areaHalfWidth) ||
+           (failed && b.anchor.position - a.anchor.position < params.window);
+  };
+  std::vector<ProfileEdge> out;
+  for (std::size_t i = 0; i < members.size();) {
+    std::size_t j = i + 1;
+    while (j < members.size() && crowded(members[j - 1], members[j])) ++j;
+    std::vector<ProfileEdge> starts, fits;
+    for (std::size_t k = i; k < j; ++k) {
+      if (members[k].peak) starts.push_back(members[k].start);
+      if (members[k].fitted) fits.push_back(members[k].start);
+    }
+    std::vector<ProfileEdge> others;
+    for (std::size_t k = 0; k < members.size(); ++k)
+      if ((k < i || k >= j) && members[k].fitted) others.push_back(members[k].start);
+    std::optional<std::vector<ProfileEdge>> joint;
+    while (starts.size() >= 2) {
+      joint = fitEdgeCluster(profile, starts, others, params.window);
+      if (!joint) break;
+      const auto weakest = std::min_element(joint->begin(), joint->end(),
+                                            [](const ProfileEdge& a, const ProfileEdge& b) {
+                                              return std::abs(a.amplitude) < std::abs(b.amplitude);
+                                            });
+      if (std::abs(weakest->amplitude) >= params.minAmplitude) break;
+      starts.erase(starts.begin() + (weakest - joint->begin()));
+      joint.reset();
+    }
+    const std::vector<ProfileEdge>& kept = joint ? *joint : fits;
+    out.insert(out.end(), kept.begin(), kept.end());
+    i = j;
+  }
+  std::sort(out.begin(), out.end(),
+            [](const ProfileEdge& a, const ProfileEdge& b) { return a.position < b.position; });
+  return out;
+}
+
+}  // namespace facet
