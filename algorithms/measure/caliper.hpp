@@ -5,10 +5,10 @@
 // The grey profile along the axis, averaged across the width (grey_profile.hpp), is searched for
 // step edges with a symmetric-area subpixel estimator (profile_edges.hpp); neighbouring edges
 // whose blurs overlap (a narrow bar or slot, the teeth of a comb a few blur widths apart) are
-// fitted together (edge_cluster_fit.hpp). Edges are filtered by polarity and minimum amplitude and selected (first,
-// last, strongest, all); pairs are neighbouring edges of opposite polarity whose first edge has
-// the requested polarity.
-// Positions are signed distances from the path's centre along its axis, in pixels.
+// fitted together (edge_cluster_fit.hpp). Edges are filtered by polarity and minimum amplitude and
+// selected (first, last, strongest, all); pairs are neighbouring edges of opposite polarity whose
+// first edge has the requested polarity. Positions are signed distances from the path's centre
+// along its axis, in pixels.
 
 #include <string>
 #include <vector>

@@ -181,6 +181,24 @@ bool implausible(const ProfileEdge& e, double span) {
   return std::abs(e.amplitude) > 1.5 * span;
 }
 
+// The usual profile, whose every peak gave a plausible fit and no two of whose edges crowd: the
+// single fits are the answer (what the general path below gives then), found without building
+// anything.
+bool noneCrowd(const std::vector<ProfileEdge>& single, const std::vector<ProfileEdge>& peaks,
+               double span, double areaHalfWidth) {
+  if (single.size() != peaks.size()) return false;
+  for (std::size_t k = 0; k < single.size(); ++k) {
+    if (implausible(single[k], span) || (single[k].amplitude > 0) != (peaks[k].amplitude > 0) ||
+        !(std::abs(single[k].position - peaks[k].position) < 1.0))
+      return false;
+    if (k == 0) continue;
+    ProfileEdge before = single[k - 1], here = single[k];
+    before.position = peaks[k - 1].position, here.position = peaks[k].position;
+    if (blursOverlap(before, here, areaHalfWidth)) return false;
+  }
+  return true;
+}
+
 }  // namespace
 
 std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
@@ -189,6 +207,7 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
                                            const ProfileEdgeParams& params) {
   const auto [lo, hi] = std::minmax_element(profile.values.begin(), profile.values.end());
   const double span = *hi - *lo;
+  if (noneCrowd(single, peaks, span, params.areaHalfWidth)) return single;
   std::vector<ProfileEdge> plausible;
   for (const ProfileEdge& e : single)
     if (!implausible(e, span)) plausible.push_back(e);

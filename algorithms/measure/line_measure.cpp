@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
+
+#include "algorithms/measure/edge_cluster_fit.hpp"
 
 namespace facet {
 namespace {
@@ -47,8 +50,12 @@ LineMeasurement measureLine(const cv::Mat& image, const MeasuringRect& rect,
     m.partial = m.partial || profile.partial;
     const auto [lo, hi] = std::minmax_element(profile.values.begin(), profile.values.end());
     if (*hi - *lo >= params.minAmplitude) ++contrasted;
+    // Edges that crowd (a thin slot or a comb beside the line) are fitted together: their single
+    // fits can degenerate into huge steps, which would be taken for the strongest.
     const ProfileEdge* best = nullptr;
-    for (const ProfileEdge& e : finder.find(profile)) {
+    const std::vector<ProfileEdge> edges =
+        refitCrowdedEdges(profile, finder.find(profile), finder.candidates(), ep);
+    for (const ProfileEdge& e : edges) {
       const bool wanted = params.polarity == EdgePolarity::Any ||
                           (params.polarity == EdgePolarity::Rising) == (e.amplitude > 0);
       if (wanted && (!best || std::abs(e.amplitude) > std::abs(best->amplitude))) best = &e;
