@@ -174,11 +174,21 @@ std::optional<std::vector<ProfileEdge>> fitEdgeCluster(const GreyProfile& p,
   return out;
 }
 
-// A single-edge fit that degenerated: a step far beyond the grey values the profile spans (the
-// inner edges of a comb finer than its blur fit as two opposite steps of thousands of grey levels
-// on one place).
-bool implausible(const ProfileEdge& e, double span) {
+// A single-edge fit that failed: a step well beyond the grey values the profile spans. The inner
+// edges of a comb finer than its blur fit as two opposite steps of 1000-7000 grey levels on one
+// place, cancelling; milder failures overshoot by twice the true step. The steps of a bar
+// narrower than its blur do exceed the span (it never reaches its level), but those edges crowd
+// anyway, and their joint fit starts from the derivative's peaks instead.
+bool failedFit(const ProfileEdge& e, double span) {
   return std::abs(e.amplitude) > 1.5 * span;
+}
+
+// A step of the joint fit that no object can make: larger than the sensor's range
+// (GreyProfile::clipLevel), with a fifth for noise and shading. Here the profile's span is no
+// bound: the joint model describes narrow bars, whose steps are rightly larger than the span (2.6
+// times for 2 px under blur 2).
+bool beyondSensor(const ProfileEdge& e, double clipLevel) {
+  return std::abs(e.amplitude) > 1.2 * clipLevel;
 }
 
 // The usual profile, whose every peak gave a plausible fit and no two of whose edges crowd: the
@@ -188,7 +198,7 @@ bool noneCrowd(const std::vector<ProfileEdge>& single, const std::vector<Profile
                double span, double areaHalfWidth) {
   if (single.size() != peaks.size()) return false;
   for (std::size_t k = 0; k < single.size(); ++k) {
-    if (implausible(single[k], span) || (single[k].amplitude > 0) != (peaks[k].amplitude > 0) ||
+    if (failedFit(single[k], span) || (single[k].amplitude > 0) != (peaks[k].amplitude > 0) ||
         !(std::abs(single[k].position - peaks[k].position) < 1.0))
       return false;
     if (k == 0) continue;
@@ -210,7 +220,7 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
   if (noneCrowd(single, peaks, span, params.areaHalfWidth)) return single;
   std::vector<ProfileEdge> plausible;
   for (const ProfileEdge& e : single)
-    if (!implausible(e, span)) plausible.push_back(e);
+    if (!failedFit(e, span)) plausible.push_back(e);
   // A peak without a fit starts with the blur typical of the profile's plausible fits.
   std::vector<double> blurs;
   for (const ProfileEdge& e : plausible) blurs.push_back(e.blur);
@@ -276,12 +286,16 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
     while (starts.size() >= 2) {
       joint = fitEdgeCluster(profile, starts, others, params.window);
       if (!joint) break;
-      const auto weakest = std::min_element(joint->begin(), joint->end(),
-                                            [](const ProfileEdge& a, const ProfileEdge& b) {
-                                              return std::abs(a.amplitude) < std::abs(b.amplitude);
-                                            });
-      if (std::abs(weakest->amplitude) >= params.minAmplitude) break;
-      starts.erase(starts.begin() + (weakest - joint->begin()));
+      const auto [weakest, strongest] = std::minmax_element(
+          joint->begin(), joint->end(), [](const ProfileEdge& a, const ProfileEdge& b) {
+            return std::abs(a.amplitude) < std::abs(b.amplitude);
+          });
+      // One start too many lets two steps grow huge and cancel: the larger goes first.
+      const auto dropped = beyondSensor(*strongest, profile.clipLevel)          ? strongest
+                           : std::abs(weakest->amplitude) < params.minAmplitude ? weakest
+                                                                                : joint->end();
+      if (dropped == joint->end()) break;
+      starts.erase(starts.begin() + (dropped - joint->begin()));
       joint.reset();
     }
     const std::vector<ProfileEdge>& kept = joint ? *joint : fits;
