@@ -174,37 +174,47 @@ std::optional<std::vector<ProfileEdge>> fitEdgeCluster(const GreyProfile& p,
   return out;
 }
 
-// A single-edge fit that failed: a step well beyond the grey values the profile spans. The inner
-// edges of a comb finer than its blur fit as two opposite steps of 1000-7000 grey levels on one
-// place, cancelling; milder failures overshoot by twice the true step. The steps of a bar
-// narrower than its blur do exceed the span (it never reaches its level), but those edges crowd
-// anyway, and their joint fit starts from the derivative's peaks instead.
-bool failedFit(const ProfileEdge& e, double span) {
-  return std::abs(e.amplitude) > 1.5 * span;
-}
-
-// A step of the joint fit that no object can make: larger than the sensor's range
-// (GreyProfile::clipLevel), with a fifth for noise and shading. Here the profile's span is no
-// bound: the joint model describes narrow bars, whose steps are rightly larger than the span (2.6
-// times for 2 px under blur 2).
+// A step that no object can make: larger than the sensor's range (GreyProfile::clipLevel), with a
+// fifth for noise and shading. For the joint fit the profile's span is no bound: the joint model
+// describes narrow bars, whose steps are rightly larger than the span (2.6 times for 2 px under
+// blur 2).
 bool beyondSensor(const ProfileEdge& e, double clipLevel) {
   return std::abs(e.amplitude) > 1.2 * clipLevel;
+}
+
+// A single-edge fit that failed: a step well beyond the grey values the profile spans, with
+// another peak within its window (`peaks` in axis order). The inner edges of a comb finer than
+// its blur fit as two opposite steps of 1000-7000 grey levels on one place, cancelling; milder
+// failures overshoot by twice the true step. The steps of a bar narrower than its blur do exceed
+// the span (it never reaches its level), but those edges crowd anyway, and their joint fit starts
+// from the derivative's peaks instead. A lone edge keeps its fit whatever its step: where the
+// profile ends within its blur (a line's station at the image's border) the step rightly exceeds
+// the span -- but never the sensor's range (beyondSensor), which no fit may.
+bool failedFit(const ProfileEdge& e, double span, const std::vector<ProfileEdge>& peaks,
+               double window, double clipLevel) {
+  if (beyondSensor(e, clipLevel)) return true;
+  if (!(std::abs(e.amplitude) > 1.5 * span)) return false;
+  const auto near = std::count_if(peaks.begin(), peaks.end(), [&](const ProfileEdge& p) {
+    return std::abs(p.position - e.position) < window;
+  });
+  return near >= 2;
 }
 
 // The usual profile, whose every peak gave a plausible fit and no two of whose edges crowd: the
 // single fits are the answer (what the general path below gives then), found without building
 // anything.
 bool noneCrowd(const std::vector<ProfileEdge>& single, const std::vector<ProfileEdge>& peaks,
-               double span, double areaHalfWidth) {
+               double span, double clipLevel, const ProfileEdgeParams& params) {
   if (single.size() != peaks.size()) return false;
   for (std::size_t k = 0; k < single.size(); ++k) {
-    if (failedFit(single[k], span) || (single[k].amplitude > 0) != (peaks[k].amplitude > 0) ||
+    if (failedFit(single[k], span, peaks, params.window, clipLevel) ||
+        (single[k].amplitude > 0) != (peaks[k].amplitude > 0) ||
         !(std::abs(single[k].position - peaks[k].position) < 1.0))
       return false;
     if (k == 0) continue;
     ProfileEdge before = single[k - 1], here = single[k];
     before.position = peaks[k - 1].position, here.position = peaks[k].position;
-    if (blursOverlap(before, here, areaHalfWidth)) return false;
+    if (blursOverlap(before, here, params.areaHalfWidth)) return false;
   }
   return true;
 }
@@ -217,10 +227,10 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
                                            const ProfileEdgeParams& params) {
   const auto [lo, hi] = std::minmax_element(profile.values.begin(), profile.values.end());
   const double span = *hi - *lo;
-  if (noneCrowd(single, peaks, span, params.areaHalfWidth)) return single;
+  if (noneCrowd(single, peaks, span, profile.clipLevel, params)) return single;
   std::vector<ProfileEdge> plausible;
   for (const ProfileEdge& e : single)
-    if (!failedFit(e, span)) plausible.push_back(e);
+    if (!failedFit(e, span, peaks, params.window, profile.clipLevel)) plausible.push_back(e);
   // A peak without a fit starts with the blur typical of the profile's plausible fits.
   std::vector<double> blurs;
   for (const ProfileEdge& e : plausible) blurs.push_back(e.blur);
