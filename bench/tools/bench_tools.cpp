@@ -4,7 +4,7 @@
 // seeds 1000001..1000000+N are held out and were never looked at while tuning.
 //
 //   bench_tools [--smoke] [--scenes N] [--blob-scenes N] [--noise SIGMA]
-//               [--only caliper|pairs|line|blob]
+//               [--only caliper|pairs|comb|line|blob]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -150,6 +150,55 @@ void pairTable(int scenes) {
       }
 }
 
+// Combs of three teeth (bars of 4-5 px, gaps of 3-4 px) at blur 0.9 and at 1.5, where the teeth
+// lie under five blur widths apart and the edges' blurs overlap. A comb is read when every edge
+// and tooth is found (6 and 3); widths and pitches (distance between neighbouring teeth's
+// middles) over those read. The classic caliper's edges are its derivative's peaks.
+void combTable(int scenes) {
+  const SceneNoise saved = gNoise;
+  std::printf(
+      "\nComb of three teeth (bars 4-5 px, gaps 3-4 px), 48x20 px caliper, noise %g, %d scenes per "
+      "row\n",
+      gNoise.noise, scenes);
+  std::printf("%-11s %-9s %-4s | %6s %12s %12s | %6s %12s | %6s | target\n", "blur model", "seeds",
+              "blur", "read", "facet width", "pitch", "read", "classic", "ratio");
+  for (double blur : {0.9, 1.5})
+    for (BlurModel model : kModels)
+      for (const SeedSet& set : kSets) {
+        gNoise.blur = blur;
+        std::vector<double> ew, ep, ec;
+        int readF = 0, readC = 0;
+        for (int i = 0; i < scenes; ++i) {
+          const CombScene s = makeCombScene(set.first + i, 3, 4.0, 3.0, model, gNoise);
+          CaliperParams p;
+          p.pairs = true;  // polarity any: the edges are all six, the pairs start at each tooth
+          const CaliperResult r = measureCaliper(s.image, MeasuringPath(s.rect), p);
+          if (r.status.ok() && r.edges.size() == 6 && r.pairs.size() == 3 &&
+              (r.edges[0].amplitude > 0) == s.light) {
+            ++readF;
+            for (int k = 0; k < 3; ++k) ew.push_back(r.pairs[k].width - s.widths[k]);
+            for (int k = 0; k < 2; ++k)
+              ep.push_back(r.pairs[k + 1].position - r.pairs[k].position -
+                           (s.centres[k + 1] - s.centres[k]));
+          }
+          // Classic: six peaks of alternating sign, the first of the teeth's polarity.
+          const auto c = classicCaliper(s.image, s.rect);
+          bool alternate = c.size() == 6;
+          for (std::size_t k = 0; alternate && k < c.size(); ++k)
+            alternate = (c[k].derivative > 0) == (s.light == (k % 2 == 0));
+          if (alternate) {
+            ++readC;
+            for (int k = 0; k < 3; ++k)
+              ec.push_back(c[2 * k + 1].position - c[2 * k].position - s.widths[k]);
+          }
+        }
+        std::printf("%-11s %-9s %-4.1f | %6d %12.4f %12.4f | %6d %12.4f | %6.2f | -\n",
+                    blurModelName(model), set.name, blur, readF, rms(ew), rms(ep), readC, rms(ec),
+                    rms(ew) / rms(ec));
+      }
+  gNoise = saved;
+}
+
 void lineTable(int scenes, Timing& time) {
   std::printf(
       "\nLine, 200x16 px rectangle on a 200 px edge, blur 0.9, noise %g, %d scenes per row\n",
@@ -235,7 +284,7 @@ void blobTable(int scenes, Timing& time) {
 
 int main(int argc, char** argv) {
   int scenes = 300, lineScenes = 100, blobScenes = 6;
-  std::string only;  // caliper, pairs, line or blob: run that table alone
+  std::string only;  // caliper, pairs, comb, line or blob: run that table alone
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke"))
       scenes = 10, lineScenes = 4, blobScenes = 1;
@@ -250,7 +299,7 @@ int main(int argc, char** argv) {
     else {
       std::fprintf(stderr,
                    "usage: bench_tools [--smoke] [--scenes N] [--blob-scenes N] [--noise SIGMA]\n"
-                   "                   [--only caliper|pairs|line|blob]\n");
+                   "                   [--only caliper|pairs|comb|line|blob]\n");
       return 1;
     }
   }
@@ -261,6 +310,7 @@ int main(int argc, char** argv) {
   Timing caliperTime, lineTime, blobTime;
   if (only.empty() || only == "caliper") caliperTable(scenes, caliperTime);
   if (only.empty() || only == "pairs") pairTable(scenes);
+  if (only.empty() || only == "comb") combTable(std::max(1, scenes / 3));
   if (only.empty() || only == "line") lineTable(lineScenes, lineTime);
   if (only.empty() || only == "blob") blobTable(blobScenes, blobTime);
   std::printf(

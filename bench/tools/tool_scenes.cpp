@@ -88,6 +88,36 @@ BarScene makeBarScene(std::uint64_t seed, double barWidth, BlurModel model, Scen
   return bs;
 }
 
+CombScene makeCombScene(std::uint64_t seed, int teeth, double barWidth, double gapWidth,
+                        BlurModel model, SceneNoise n) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  const double dark = 30 + 40 * u(rng), light = 140 + 60 * u(rng);
+  CombScene cs;
+  cs.rect = {31.5 + u(rng), 31.5 + u(rng), 48, 20, 360 * u(rng)};
+  cs.light = u(rng) < 0.5;
+  const double tilt = (-5 + 10 * u(rng)) * kDeg;
+  const cv::Point2d nrm = axisOf(cs.rect.angle + tilt / kDeg), t(-nrm.y, nrm.x);
+  std::vector<double> w(teeth), gap(teeth - 1);
+  double span = 0;
+  for (int k = 0; k < teeth; ++k) span += w[k] = barWidth + u(rng);
+  for (int k = 0; k + 1 < teeth; ++k) span += gap[k] = gapWidth + u(rng);
+  // Along the normal from the comb's start; along the axis distances grow by 1 / cos(tilt).
+  double at = -span / 2 + (-3 + 6 * u(rng));
+  scene::Scene s(spec({64, 64}, cs.light ? dark : light, n, seed));
+  const cv::Point2d origin(cs.rect.cx, cs.rect.cy);
+  const double far = 200;
+  for (int k = 0; k < teeth; ++k) {
+    const cv::Point2d a = origin + at * nrm, b = origin + (at + w[k]) * nrm;
+    s.addPolygon({a - far * t, b - far * t, b + far * t, a + far * t}, cs.light ? light : dark);
+    cs.widths.push_back(w[k] / std::cos(tilt));
+    cs.centres.push_back((at + w[k] / 2) / std::cos(tilt));
+    if (k + 1 < teeth) at += w[k] + gap[k];
+  }
+  cs.image = render(s, model, 6);
+  return cs;
+}
+
 LineScene makeLineScene(std::uint64_t seed, BlurModel model, SceneNoise n) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0, 1);

@@ -39,6 +39,18 @@ struct BarScene {
 };
 BarScene makeBarScene(std::uint64_t seed, double barWidth, BlurModel model, SceneNoise n = {});
 
+// Light (or dark) teeth of a comb across a caliper 48 px long: `teeth` bars of barWidth..+1 px,
+// gaps of gapWidth..+1 px, the same grey, subpixel places, tilted up to 5 degrees.
+struct CombScene {
+  cv::Mat image;
+  MeasuringRect rect;
+  std::vector<double> widths;   // true widths along the axis, in axis order
+  std::vector<double> centres;  // true signed positions of the teeth's middles
+  bool light = true;            // light teeth on dark ground: rising edge first
+};
+CombScene makeCombScene(std::uint64_t seed, int teeth, double barWidth, double gapWidth,
+                        BlurModel model, SceneNoise n = {});
+
 struct LineScene {
   cv::Mat image;
   MeasuringRect rect;            // along the line
