@@ -38,6 +38,21 @@ cv::Point2d axisOf(double deg) {
   return {std::cos(deg * kDeg), -std::sin(deg * kDeg)};
 }
 
+// The draws every caliper scene starts with, in this order (each seed's scene depends on it): the
+// two greys, then the caliper's place and angle.
+struct CaliperStart {
+  std::mt19937_64 rng;
+  double dark, light;
+  MeasuringRect rect;
+};
+CaliperStart startCaliperScene(std::uint64_t seed, double length) {
+  CaliperStart c{std::mt19937_64(seed), 0, 0, {}};
+  std::uniform_real_distribution<double> u(0, 1);
+  c.dark = 30 + 40 * u(c.rng), c.light = 140 + 60 * u(c.rng);
+  c.rect = {31.5 + u(c.rng), 31.5 + u(c.rng), length, 20, 360 * u(c.rng)};
+  return c;
+}
+
 }  // namespace
 
 const char* blurModelName(BlurModel model) {
@@ -45,11 +60,10 @@ const char* blurModelName(BlurModel model) {
 }
 
 EdgeScene makeEdgeScene(std::uint64_t seed, BlurModel model, SceneNoise n) {
-  std::mt19937_64 rng(seed);
+  auto [rng, dark, light, rect] = startCaliperScene(seed, 40);
   std::uniform_real_distribution<double> u(0, 1);
-  const double dark = 30 + 40 * u(rng), light = 140 + 60 * u(rng);
   EdgeScene es;
-  es.rect = {31.5 + u(rng), 31.5 + u(rng), 40, 20, 360 * u(rng)};
+  es.rect = rect;
   es.rising = u(rng) < 0.5;
   es.contrast = light - dark;
   // The edge crosses the axis at `position`, its normal tilted up to 5 degrees off the axis.
@@ -65,11 +79,10 @@ EdgeScene makeEdgeScene(std::uint64_t seed, BlurModel model, SceneNoise n) {
 }
 
 BarScene makeBarScene(std::uint64_t seed, double barWidth, BlurModel model, SceneNoise n) {
-  std::mt19937_64 rng(seed);
+  auto [rng, dark, light, rect] = startCaliperScene(seed, 40);
   std::uniform_real_distribution<double> u(0, 1);
-  const double dark = 30 + 40 * u(rng), light = 140 + 60 * u(rng);
   BarScene bs;
-  bs.rect = {31.5 + u(rng), 31.5 + u(rng), 40, 20, 360 * u(rng)};
+  bs.rect = rect;
   bs.light = u(rng) < 0.5;
   const double w = barWidth + u(rng);  // subpixel width
   bs.centre = -4 + 8 * u(rng);
@@ -90,11 +103,10 @@ BarScene makeBarScene(std::uint64_t seed, double barWidth, BlurModel model, Scen
 
 CombScene makeCombScene(std::uint64_t seed, int teeth, double barWidth, double gapWidth,
                         BlurModel model, SceneNoise n) {
-  std::mt19937_64 rng(seed);
+  auto [rng, dark, light, rect] = startCaliperScene(seed, 48);
   std::uniform_real_distribution<double> u(0, 1);
-  const double dark = 30 + 40 * u(rng), light = 140 + 60 * u(rng);
   CombScene cs;
-  cs.rect = {31.5 + u(rng), 31.5 + u(rng), 48, 20, 360 * u(rng)};
+  cs.rect = rect;
   cs.light = u(rng) < 0.5;
   const double tilt = (-5 + 10 * u(rng)) * kDeg;
   const cv::Point2d nrm = axisOf(cs.rect.angle + tilt / kDeg), t(-nrm.y, nrm.x);
