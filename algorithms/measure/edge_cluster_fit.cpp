@@ -200,6 +200,10 @@ bool failedFit(const ProfileEdge& e, double span, const std::vector<ProfileEdge>
   return near >= 2;
 }
 
+// The most edges fitted together: a comb of six teeth. The joint fit's cost grows with the cube of
+// its edges; a longer chain of crowded edges keeps its single fits.
+constexpr std::size_t kMaxClusterEdges = 12;
+
 // The usual profile, whose every peak gave a plausible fit and no two of whose edges crowd: the
 // single fits are the answer (what the general path below gives then), found without building
 // anything.
@@ -264,6 +268,10 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
       m.anchor.blur = plausible[from].blur;
       m.fitted = true;
     }
+    // A peak weaker than an edge with no fit of its own is texture or noise: a joint fit would
+    // only leave it out again (on a textured surface, chains of such peaks made clusters of
+    // dozens).
+    if (!m.fitted && std::abs(pk.amplitude) < params.minAmplitude) continue;
     members.push_back(m);
   }
   for (std::size_t k = 0; k < plausible.size(); ++k)
@@ -293,7 +301,7 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
     for (std::size_t k = 0; k < members.size(); ++k)
       if ((k < i || k >= j) && members[k].fitted) others.push_back(members[k].start);
     std::optional<std::vector<ProfileEdge>> joint;
-    while (starts.size() >= 2) {
+    while (starts.size() >= 2 && starts.size() <= kMaxClusterEdges) {
       joint = fitEdgeCluster(profile, starts, others, params.window);
       if (!joint) break;
       const auto [weakest, strongest] = std::minmax_element(
