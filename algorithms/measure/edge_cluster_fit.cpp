@@ -36,9 +36,8 @@ struct Layout {
 };
 
 // Whether the single-edge estimates of two neighbouring edges see each other's model error: the
-// blur of one (3 w) reaches into the span over which the other balances its area
-// (ProfileEdgeParams::areaHalfWidth). Below that the single-edge estimate is unbiased (bars of
-// 4.2 w: 0.002 px noise-free), above it the joint fit is (bars of 2.6 w: 0.12 px before, 0.01 px).
+// blur of one (3 w) reaches into the span over which the other balances its area (see the
+// header).
 bool blursOverlap(const ProfileEdge& first, const ProfileEdge& second, double areaHalfWidth) {
   const double blur = std::max(first.blur, second.blur);
   return std::abs(second.position - first.position) < 3.0 * blur + areaHalfWidth;
@@ -281,8 +280,8 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
 
   // Neighbours are one cluster where their blurs overlap, or where one is a peak whose single
   // fit failed (degenerated, died or came out too weak) and the other lay within its window: the
-  // failure is what a neighbour does to a single fit. A weak peak joins a cluster only to be
-  // left out of it again.
+  // failure is what a neighbour does to a single fit. A peak whose fit came out too weak is left
+  // out again when the joint fit finds it weak too.
   const auto crowded = [&](const Member& a, const Member& b) {
     const bool failed = (a.peak && !a.fitted) || (b.peak && !b.fitted);
     return blursOverlap(a.anchor, b.anchor, params.areaHalfWidth) ||

@@ -23,21 +23,26 @@
 namespace facet {
 
 // The caliper's edges (ProfileEdgeFinder::find, `single`, and its candidates(), `peaks`) with
-// those that crowd refitted together; the others keep the single-edge estimate. Neighbours crowd
-// where their blurs overlap (3 w reaches into the span over which the other balances its area,
-// ProfileEdgeParams::areaHalfWidth: below that the single-edge estimate is unbiased, bars of
-// 4.2 w: 0.002 px noise-free; above it the joint fit is, bars of 2.6 w: 0.12 px before, 0.01 px),
-// or where one is a peak whose single fit failed (degenerated into a step well beyond the grey
-// values the profile spans, died, or came out too weak) and the other lies within its window:
-// that failure is what a neighbour does to a single fit. Crowding is judged on the derivative's
-// peaks, where the edges show: a single fit next to a neighbour that died is pulled away from its
-// own peak. A cluster's joint fit starts at each peak from the plausible single fit that came
-// from it (same polarity, within a pixel), else from the peak itself with the profile's typical
-// fitted blur; a step of the joint fit larger than the sensor's range (1.2 GreyProfile::clipLevel:
-// one start too many, two steps grown huge that cancel), else one weaker than
-// `params.minAmplitude`, is left out and the rest fitted again; plausible fits that came from no
-// peak are replaced by the joint fit of the cluster they lie in. A cluster whose joint fit fails
-// keeps its plausible single fits: a step far beyond the profile's grey values is never reported.
+// those that crowd refitted together; the others keep the single-edge estimate.
+// - Neighbours crowd where their blurs overlap (3 w reaches into the span over which the other
+//   balances its area, ProfileEdgeParams::areaHalfWidth: below that the single-edge estimate is
+//   unbiased, bars of 4.2 w: 0.002 px noise-free; above it the joint fit is, bars of 2.6 w:
+//   0.12 px before, 0.01 px), or where one is a peak whose single fit failed -- died, came out
+//   weaker than an edge, or degenerated into a step well beyond the grey values the profile spans
+//   while another peak lay in its window -- and the other lies within its window: that failure
+//   is what a neighbour does to a single fit. Crowding is judged on the derivative's peaks, where
+//   the edges show: a single fit next to a neighbour that died is pulled away from its own peak.
+//   A peak weaker than `params.minAmplitude` without a fit of its own (texture, noise) takes no
+//   part.
+// - A cluster's joint fit starts at each peak from the plausible single fit that came from it
+//   (same polarity, within a pixel), else from the peak itself with the profile's typical fitted
+//   blur. A step of the joint fit larger than the sensor's range (1.2 GreyProfile::clipLevel: one
+//   start too many, two steps grown huge that cancel), else one weaker than the minimum
+//   amplitude, is left out and the rest fitted again. Plausible fits that came from no peak are
+//   replaced by the joint fit of the cluster they lie in.
+// - A cluster whose joint fit fails, or of more than 12 edges (the fit's cost grows with the cube
+//   of its edges), keeps its plausible single fits. Neither a failed single fit nor a step larger
+//   than the sensor's range is ever reported.
 // Sorted by position.
 std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
                                            const std::vector<ProfileEdge>& single,
