@@ -200,8 +200,38 @@ bool failedFit(const ProfileEdge& e, double span, const std::vector<ProfileEdge>
 }
 
 // The most edges fitted together: a comb of six teeth. The joint fit's cost grows with the cube of
-// its edges; a longer chain of crowded edges keeps its single fits.
+// its edges; a longer chain of crowded edges is fitted in blocks (fitLongChain).
 constexpr std::size_t kMaxClusterEdges = 12;
+
+// A chain of more crowded edges than one fit takes (a comb of many teeth, a row of connector
+// pins): blocks of at most kMaxClusterEdges consecutive edges, each fitted with the rest of the
+// chain's current estimates subtracted, twice over (the first pass subtracts the starts, the
+// second the first pass's fits). Steps then weaker than the minimum amplitude are left out.
+// Empty when a block's fit fails or makes a step beyond the sensor's range.
+std::optional<std::vector<ProfileEdge>> fitLongChain(const GreyProfile& profile,
+                                                     const std::vector<ProfileEdge>& starts,
+                                                     const std::vector<ProfileEdge>& others,
+                                                     const ProfileEdgeParams& params) {
+  const std::size_t n = starts.size();
+  const std::size_t blocks = (n + kMaxClusterEdges - 1) / kMaxClusterEdges;
+  std::vector<ProfileEdge> current = starts;
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::size_t b = 0; b < blocks; ++b) {
+      const std::size_t b0 = b * n / blocks, b1 = (b + 1) * n / blocks;
+      std::vector<ProfileEdge> rest = others;
+      rest.insert(rest.end(), current.begin(), current.begin() + static_cast<std::ptrdiff_t>(b0));
+      rest.insert(rest.end(), current.begin() + static_cast<std::ptrdiff_t>(b1), current.end());
+      const std::span<const ProfileEdge> block(current.data() + b0, b1 - b0);
+      const auto fitted = fitEdgeCluster(profile, block, rest, params.window);
+      if (!fitted) return std::nullopt;
+      for (const ProfileEdge& e : *fitted)
+        if (beyondSensor(e, profile.clipLevel)) return std::nullopt;
+      std::copy(fitted->begin(), fitted->end(), current.begin() + static_cast<std::ptrdiff_t>(b0));
+    }
+  std::erase_if(current,
+                [&](const ProfileEdge& e) { return std::abs(e.amplitude) < params.minAmplitude; });
+  return current;
+}
 
 // The usual profile, whose every peak gave a plausible fit and no two of whose edges crowd: the
 // single fits are the answer (what the general path below gives then), found without building
@@ -300,6 +330,7 @@ std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
     for (std::size_t k = 0; k < members.size(); ++k)
       if ((k < i || k >= j) && members[k].fitted) others.push_back(members[k].start);
     std::optional<std::vector<ProfileEdge>> joint;
+    if (starts.size() > kMaxClusterEdges) joint = fitLongChain(profile, starts, others, params);
     while (starts.size() >= 2 && starts.size() <= kMaxClusterEdges) {
       joint = fitEdgeCluster(profile, starts, others, params.window);
       if (!joint) break;

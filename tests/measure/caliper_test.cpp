@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <initializer_list>
 #include <random>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -156,6 +157,41 @@ TEST(Caliper, CombFinerThanItsBlurKeepsEveryEdge) {
         }
       }
   EXPECT_LT(worst, 0.05);
+}
+
+// A comb of eight such teeth (sixteen crowded edges, more than one joint fit takes): fitted in
+// blocks, every tooth is read.
+TEST(Caliper, LongCombFinerThanItsBlurKeepsEveryTooth) {
+  CaliperParams p;
+  p.pairs = true;
+  for (const auto model : {scene::BlurModel::PixelGrid, scene::BlurModel::Lens}) {
+    const MeasuringRect rect{40.3, 39.6, 78, 20, 17.0};
+    std::vector<double> centres;
+    for (int k = 0; k < 8; ++k) centres.push_back(0.2 + 8.0 * (k - 3.5));
+    scene::SceneSpec spec;
+    spec.size = {80, 80};
+    spec.background = 60;
+    spec.blurSigma = 1.5;
+    spec.blurModel = model;
+    spec.noiseSigma = 0.0;
+    spec.subrows = 64;
+    scene::Scene s(spec);
+    const cv::Point2d d = axisOf(rect.angle), t(-d.y, d.x);
+    for (const double c : centres) {
+      const cv::Point2d m = cv::Point2d(rect.cx, rect.cy) + c * d;
+      s.addPolygon(
+          {m - 2 * d - 100 * t, m + 2 * d - 100 * t, m + 2 * d + 100 * t, m - 2 * d + 100 * t},
+          170);
+    }
+    const CaliperResult r = measureCaliper(s.render(), MeasuringPath(rect), p);
+    ASSERT_TRUE(r.status.ok()) << r.status.message;
+    ASSERT_EQ(r.edges.size(), 16u);
+    ASSERT_EQ(r.pairs.size(), 8u);
+    for (int k = 0; k < 8; ++k) {
+      EXPECT_NEAR(r.pairs[k].width, 4.0, 0.1) << k;
+      EXPECT_NEAR(r.pairs[k].position, centres[k], 0.05) << k;
+    }
+  }
 }
 
 // The same comb with noise: every edge and no other, none of them made up (a step no larger than
