@@ -2,7 +2,6 @@
 // the arc variant, and every failure with its cause.
 #include <cmath>
 #include <cstdint>
-#include <initializer_list>
 #include <random>
 #include <vector>
 
@@ -57,7 +56,7 @@ TEST(Caliper, IsUnbiasedWhetherTheBlurActsBeforeOrAfterThePixel) {
 
 // A light bar `width` px wide across the axis, its middle at `centre` on the axis.
 // Light bars `width` px wide across the caliper, centred at `centres` along its axis.
-cv::Mat barsImage(const MeasuringRect& rect, std::initializer_list<double> centres, double width,
+cv::Mat barsImage(const MeasuringRect& rect, const std::vector<double>& centres, double width,
                   double dark, double light, double noise = 1.0, double blur = 0.9,
                   scene::BlurModel model = scene::BlurModel::PixelGrid, std::uint64_t seed = 1) {
   scene::SceneSpec spec;
@@ -168,22 +167,8 @@ TEST(Caliper, LongCombFinerThanItsBlurKeepsEveryTooth) {
     const MeasuringRect rect{40.3, 39.6, 78, 20, 17.0};
     std::vector<double> centres;
     for (int k = 0; k < 8; ++k) centres.push_back(0.2 + 8.0 * (k - 3.5));
-    scene::SceneSpec spec;
-    spec.size = {80, 80};
-    spec.background = 60;
-    spec.blurSigma = 1.5;
-    spec.blurModel = model;
-    spec.noiseSigma = 0.0;
-    spec.subrows = 64;
-    scene::Scene s(spec);
-    const cv::Point2d d = axisOf(rect.angle), t(-d.y, d.x);
-    for (const double c : centres) {
-      const cv::Point2d m = cv::Point2d(rect.cx, rect.cy) + c * d;
-      s.addPolygon(
-          {m - 2 * d - 100 * t, m + 2 * d - 100 * t, m + 2 * d + 100 * t, m - 2 * d + 100 * t},
-          170);
-    }
-    const CaliperResult r = measureCaliper(s.render(), MeasuringPath(rect), p);
+    const cv::Mat image = barsImage(rect, centres, 4.0, 60, 170, 0.0, 1.5, model);
+    const CaliperResult r = measureCaliper(image, MeasuringPath(rect), p);
     ASSERT_TRUE(r.status.ok()) << r.status.message;
     ASSERT_EQ(r.edges.size(), 16u);
     ASSERT_EQ(r.pairs.size(), 8u);
