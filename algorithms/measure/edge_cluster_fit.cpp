@@ -200,33 +200,39 @@ bool failedFit(const ProfileEdge& e, double span, const std::vector<ProfileEdge>
 }
 
 // The most edges fitted together: a comb of six teeth. The joint fit's cost grows with the cube of
-// its edges; a longer chain of crowded edges is fitted in blocks (fitLongChain).
+// its edges; a longer chain of crowded edges is fitted in overlapping blocks (fitLongChain).
 constexpr std::size_t kMaxClusterEdges = 12;
 
 // A chain of more crowded edges than one fit takes (a comb of many teeth, a row of connector
-// pins): blocks of at most kMaxClusterEdges consecutive edges, each fitted with the rest of the
-// chain's current estimates subtracted, twice over (the first pass subtracts the starts, the
-// second the first pass's fits). Steps then weaker than the minimum amplitude are left out.
-// Empty when a block's fit fails or makes a step beyond the sensor's range.
+// pins): blocks of consecutive edges, each fitted together with kOverlap edges either side (at
+// most kMaxClusterEdges in all) and the rest of the chain's current estimates subtracted; a block
+// keeps only its own edges, which so see their neighbours modelled, not cut off at a window's
+// end. Twice over (the first pass subtracts the starts, the second the first pass's fits). Steps
+// then weaker than the minimum amplitude are left out. Empty when a fit fails or makes a step
+// beyond the sensor's range.
+constexpr std::size_t kOverlap = 2;
 std::optional<std::vector<ProfileEdge>> fitLongChain(const GreyProfile& profile,
                                                      const std::vector<ProfileEdge>& starts,
                                                      const std::vector<ProfileEdge>& others,
                                                      const ProfileEdgeParams& params) {
-  const std::size_t n = starts.size();
-  const std::size_t blocks = (n + kMaxClusterEdges - 1) / kMaxClusterEdges;
+  const std::size_t n = starts.size(), kept = kMaxClusterEdges - 2 * kOverlap;
+  const std::size_t blocks = (n + kept - 1) / kept;
   std::vector<ProfileEdge> current = starts;
+  const auto at = [&](std::size_t i) { return current.begin() + static_cast<std::ptrdiff_t>(i); };
   for (int pass = 0; pass < 2; ++pass)
     for (std::size_t b = 0; b < blocks; ++b) {
       const std::size_t b0 = b * n / blocks, b1 = (b + 1) * n / blocks;
+      const std::size_t f0 = b0 >= kOverlap ? b0 - kOverlap : 0, f1 = std::min(n, b1 + kOverlap);
       std::vector<ProfileEdge> rest = others;
-      rest.insert(rest.end(), current.begin(), current.begin() + static_cast<std::ptrdiff_t>(b0));
-      rest.insert(rest.end(), current.begin() + static_cast<std::ptrdiff_t>(b1), current.end());
-      const std::span<const ProfileEdge> block(current.data() + b0, b1 - b0);
-      const auto fitted = fitEdgeCluster(profile, block, rest, params.window);
-      if (!fitted) return std::nullopt;
-      for (const ProfileEdge& e : *fitted)
+      rest.insert(rest.end(), current.begin(), at(f0));
+      rest.insert(rest.end(), at(f1), current.end());
+      const std::span<const ProfileEdge> fitted(current.data() + f0, f1 - f0);
+      const auto fit = fitEdgeCluster(profile, fitted, rest, params.window);
+      if (!fit) return std::nullopt;
+      for (const ProfileEdge& e : *fit)
         if (beyondSensor(e, profile.clipLevel)) return std::nullopt;
-      std::copy(fitted->begin(), fitted->end(), current.begin() + static_cast<std::ptrdiff_t>(b0));
+      std::copy(fit->begin() + static_cast<std::ptrdiff_t>(b0 - f0),
+                fit->begin() + static_cast<std::ptrdiff_t>(b1 - f0), at(b0));
     }
   std::erase_if(current,
                 [&](const ProfileEdge& e) { return std::abs(e.amplitude) < params.minAmplitude; });

@@ -41,8 +41,9 @@ namespace facet {
 //   amplitude, is left out and the rest fitted again. Plausible fits that came from no peak are
 //   replaced by the joint fit of the cluster they lie in.
 // - A cluster of more than 12 edges (the fit's cost grows with the cube of its edges: a long comb,
-//   a row of connector pins) is fitted in blocks of at most 12, each with the rest of the chain
-//   subtracted, in two passes. A cluster whose joint fit fails keeps its plausible single fits.
+//   a row of connector pins) is fitted in blocks of up to 8, each together with two edges either
+//   side and the rest of the chain subtracted, in two passes. A cluster whose joint fit fails
+//   keeps its plausible single fits.
 //   Neither a failed single fit nor a step larger than the sensor's range is ever reported.
 // Sorted by position.
 std::vector<ProfileEdge> refitCrowdedEdges(const GreyProfile& profile,
