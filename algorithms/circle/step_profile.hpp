@@ -11,6 +11,7 @@
 #include <numbers>
 
 #include "algorithms/circle/pixel_pass.hpp"
+#include "algorithms/geometry/standard_normal.hpp"
 
 namespace facet::step_profile {
 
@@ -50,15 +51,11 @@ inline double gaussian(double z) {
   return expNonPositive(-0.5 * z * z);
 }
 
-// Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): Abramowitz & Stegun
-// 7.1.26 for erfc (absolute error below 1.5e-7), which reuses the exponential the Jacobian needs.
+// Upper tail 1 - Phi(z) of the standard normal, given gauss = exp(-z^2 / 2): the Abramowitz &
+// Stegun erfc of standard_normal.hpp (absolute error below 1.5e-7), which reuses the exponential
+// the Jacobian needs.
 inline double upperTail(double z, double gauss) {
-  const double x = std::abs(z) / std::numbers::sqrt2;
-  const double t = 1.0 / (1.0 + 0.3275911 * x);
-  const double poly =
-      t *
-      (0.254829592 + t * (-0.284496736 + t * (1.421413741 + t * (-1.453152027 + t * 1.061405429))));
-  const double tail = 0.5 * poly * gauss;  // 0.5 erfc(x) with exp(-x^2) = gauss
+  const double tail = standard_normal::halfErfc(std::abs(z) / std::numbers::sqrt2, gauss);
   return z >= 0.0 ? tail : 1.0 - tail;
 }
 

@@ -10,7 +10,7 @@
 #include <Eigen/Dense>
 
 #include "algorithms/geometry/levenberg_marquardt.hpp"
-#include "algorithms/measure/standard_normal.hpp"
+#include "algorithms/geometry/standard_normal.hpp"
 
 namespace facet {
 namespace {

@@ -8,7 +8,7 @@
 #include <Eigen/Dense>
 
 #include "algorithms/geometry/spd_solve.hpp"
-#include "algorithms/measure/standard_normal.hpp"
+#include "algorithms/geometry/standard_normal.hpp"
 
 namespace facet {
 namespace {

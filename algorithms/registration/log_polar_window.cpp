@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
@@ -20,6 +21,35 @@ bool bilinear(const cv::Mat& img, double x, double y, double& value) {
   value =
       (1 - fy) * ((1 - fx) * r0[x0] + fx * r0[x0 + 1]) + fy * ((1 - fx) * r1[x0] + fx * r1[x0 + 1]);
   return true;
+}
+
+// For A angle samples: their cosines and sines, and the DFT's in the order each frequency k meets
+// them (k * t mod A), laid out so that no ring indexes them by a division. The same for every
+// window: made once per thread for the last A asked for.
+struct AngleTables {
+  int angles = 0;
+  std::vector<double> cosines, sines;
+  std::vector<double> cosinesByFrequency, sinesByFrequency;  // frequencies 1 .. A / 2, A each
+};
+const AngleTables& angleTables(int A) {
+  thread_local AngleTables tables;
+  if (tables.angles == A) return tables;
+  tables.angles = A;
+  tables.cosines.resize(A), tables.sines.resize(A);
+  for (int t = 0; t < A; ++t) {
+    tables.cosines[t] = std::cos(2.0 * std::numbers::pi * t / A);
+    tables.sines[t] = std::sin(2.0 * std::numbers::pi * t / A);
+  }
+  const int K = A / 2;
+  tables.cosinesByFrequency.resize(static_cast<std::size_t>(K) * A);
+  tables.sinesByFrequency.resize(static_cast<std::size_t>(K) * A);
+  for (int k = 1; k <= K; ++k)
+    for (int t = 0; t < A; ++t) {
+      const int phase = (k * t) % A;
+      tables.cosinesByFrequency[static_cast<std::size_t>(k - 1) * A + t] = tables.cosines[phase];
+      tables.sinesByFrequency[static_cast<std::size_t>(k - 1) * A + t] = tables.sines[phase];
+    }
+  return tables;
 }
 
 }  // namespace
@@ -52,11 +82,8 @@ LogPolarWindow sampleLogPolar(const std::vector<cv::Mat>& pyramid, cv::Point2d c
   const cv::Mat& img = pyramid[octave];
   const double inv = std::ldexp(1.0, -octave);
 
-  std::vector<double> cosines(A), sines(A);
-  for (int t = 0; t < A; ++t) {
-    cosines[t] = std::cos(2.0 * std::numbers::pi * t / A);
-    sines[t] = std::sin(2.0 * std::numbers::pi * t / A);
-  }
+  const AngleTables& tables = angleTables(A);
+  const std::vector<double>&cosines = tables.cosines, &sines = tables.sines;
   w.samples.assign(static_cast<std::size_t>(w.rows) * 2 * A, 0);
   for (int r = 0; r < w.rows; ++r) {
     const double rho = p.innerRadius * std::pow(p.ringRatio, r - p.ringShifts);
@@ -87,22 +114,12 @@ LogPolarWindow sampleLogPolar(const std::vector<cv::Mat>& pyramid, cv::Point2d c
     w.ringSquares[r + 1] = w.ringSquares[r] + s2;
   }
   const int K = A / 2;
-  // The DFT's cosines and sines in the order each frequency k meets them (k * t mod A), laid out
-  // once per window rather than indexed by a division for every ring.
-  std::vector<double> cosinesByFrequency(static_cast<std::size_t>(K) * A);
-  std::vector<double> sinesByFrequency(static_cast<std::size_t>(K) * A);
-  for (int k = 1; k <= K; ++k)
-    for (int t = 0; t < A; ++t) {
-      const int phase = (k * t) % A;  // cos/sin tables are indexed by angle sample
-      cosinesByFrequency[static_cast<std::size_t>(k - 1) * A + t] = cosines[phase];
-      sinesByFrequency[static_cast<std::size_t>(k - 1) * A + t] = sines[phase];
-    }
   w.ringSpectrum.assign(static_cast<std::size_t>(w.rows) * K, 0.f);
   for (int r = 0; r < w.rows; ++r) {
     const std::int16_t* row = w.row(r);
     for (int k = 1; k <= K; ++k) {
-      const double* cosK = cosinesByFrequency.data() + static_cast<std::size_t>(k - 1) * A;
-      const double* sinK = sinesByFrequency.data() + static_cast<std::size_t>(k - 1) * A;
+      const double* cosK = tables.cosinesByFrequency.data() + static_cast<std::size_t>(k - 1) * A;
+      const double* sinK = tables.sinesByFrequency.data() + static_cast<std::size_t>(k - 1) * A;
       double re = 0, im = 0;
       for (int t = 0; t < A; ++t) {
         re += row[t] * cosK[t];
