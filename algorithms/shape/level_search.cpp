@@ -28,6 +28,23 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
     posedAt.emplace_back(cv::Vec2d(a, sc), posePoints(s.level->points, a, sc));
     return posedAt.back().second;
   };
+  // The centre's own score first, as the bar the others must reach: most poses around a tracked
+  // candidate score below it, and the early termination then abandons them sooner. The pose
+  // kept is the same (the first of the best in the loop's order) because a pose that ties or beats
+  // the centre is never abandoned: the bar lies below the centre's score by what the bound can
+  // miss: a direction's rounded components make it up to 127.71 long against the 127 the bound
+  // assumes (and a deformable score's model direction 128.71 against 128), so a point may add up
+  // to 1.011 to a score. Only for the safe termination (greediness 0): a greedy one may abandon
+  // the centre itself.
+  constexpr double kPointOvershoot = 0.012;
+  const double bar =
+      s.greediness > 0.0
+          ? -1.0
+          : scorePose(
+                *s.field,
+                pose(clampAngle(s.angles, c.angle), std::clamp(c.scale, s.scaleMin, s.scaleMax)),
+                cv::Point(cvRound(c.x), cvRound(c.y)), s.polarity, s.minScore, 0.0, s.spread) -
+                kPointOvershoot;
   for (int climb = 0; climb < 6; ++climb) {
     Candidate centre = climb == 0 ? c : best;
     bool onBorder = false;
@@ -41,7 +58,7 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
           for (int dx = -radius; dx <= radius; ++dx) {
             const cv::Point at(cvRound(centre.x) + dx, cvRound(centre.y) + dy);
             const double score =
-                scorePose(*s.field, posed, at, s.polarity, std::max(s.minScore, best.score),
+                scorePose(*s.field, posed, at, s.polarity, std::max({s.minScore, best.score, bar}),
                           s.greediness, s.spread);
             if (score > best.score) {
               best = {double(at.x), double(at.y), a, sc, score};
