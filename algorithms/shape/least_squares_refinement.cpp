@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -20,6 +21,58 @@ constexpr double kMinCos = 0.8;  // direction agreement of a correspondence (abo
 // bracket's whole region lies in that band; a 1126x973 template's region does not.
 constexpr int kBandPixels = 16;
 }  // namespace
+
+template <int Radius>
+double LeastSquaresRefinement::correspondWithin(const Pose2D& at, bool anySign, double sign,
+                                                std::vector<Pair>& pairs,
+                                                const std::vector<std::uint8_t>& visible) const {
+  static_assert(Radius >= 1 && 2 * Radius <= kCellBorder);
+  const double c = std::cos(at.angle), s = std::sin(at.angle);
+  const Pose2D::Map toImage = at.map();
+  double polaritySum = 0.0;
+  pairs.clear();
+  for (std::size_t i = 0; i < model_.finePoints.size(); ++i) {
+    if (!visible.empty() && !visible[i]) continue;
+    const auto& mp = model_.finePoints[i];
+    const double px = mp.position.x, py = mp.position.y;
+    const cv::Point2d q = toImage({px, py});
+    const int cx = cvRound(q.x) - roi_.x, cy = cvRound(q.y) - roi_.y;
+    // A window that meets the region lies within its frame of empty cells (2 Radius wide at
+    // most): it is scanned whole, with no clipping, in the same order.
+    if (cx < -Radius || cy < -Radius || cx >= roi_.width + Radius || cy >= roi_.height + Radius)
+      continue;
+    const double dx = c * mp.direction.x + s * mp.direction.y;
+    const double dy = -s * mp.direction.x + c * mp.direction.y;
+    int bestIdx = -1;
+    double bestD2 = 1e30, bestDot = 0.0;
+    for (int v = cy - Radius; v <= cy + Radius; ++v) {
+      const int* row = cell_.ptr<int>(v + kCellBorder) + kCellBorder;
+      for (int u = cx - Radius; u <= cx + Radius; ++u) {
+        if (row[u] < 0) continue;
+        const EdgePoint& e = edges_.points[row[u]];
+        const double dot = e.normal.x * dx + e.normal.y * dy;
+        const double agree = polarity_ == Polarity::IgnoreLocal    ? std::abs(dot)
+                             : polarity_ == Polarity::IgnoreGlobal ? sign * dot
+                                                                   : dot;
+        if (agree < kMinCos && !(anySign && std::abs(dot) >= kMinCos)) continue;
+        const double d2 = (e.position.x - q.x) * (e.position.x - q.x) +
+                          (e.position.y - q.y) * (e.position.y - q.y);
+        if (d2 < bestD2) bestD2 = d2, bestIdx = row[u], bestDot = dot;
+      }
+    }
+    if (bestIdx < 0) continue;
+    polaritySum += bestDot;
+    const EdgePoint& e = edges_.points[bestIdx];
+    const double r = e.normal.x * (q.x - e.position.x) + e.normal.y * (q.y - e.position.y);
+    // q = t + s R(a) p: dq/da = s R'(a) p, dq/ds = R(a) p.
+    const double rpx = c * px + s * py, rpy = -s * px + c * py;
+    pairs.push_back(
+        {Eigen::Vector4d(e.normal.x, e.normal.y, at.scale * (e.normal.x * rpy - e.normal.y * rpx),
+                         e.normal.x * rpx + e.normal.y * rpy),
+         r});
+  }
+  return polaritySum;
+}
 
 cv::Mat LeastSquaresRefinement::contourBand(const std::vector<Pose2D>& starts,
                                             double scaleFreedom) const {
@@ -67,13 +120,14 @@ LeastSquaresRefinement::LeastSquaresRefinement(const cv::Mat& image, const Shape
   edgeParams.fitProfile = model.edgeEstimator == EdgeEstimator::ProfileFit;
   edges_ = detectSubpixelEdges(image, edgeParams);
 
-  // Edge points indexed by the pixel that holds them.
-  cell_ = cv::Mat(roi_.size(), CV_32S, cv::Scalar(-1));
+  // Edge points indexed by the pixel that holds them, in a frame of kCellBorder empty cells.
+  cell_ =
+      cv::Mat(roi_.height + 2 * kCellBorder, roi_.width + 2 * kCellBorder, CV_32S, cv::Scalar(-1));
   for (int i = 0; i < static_cast<int>(edges_.points.size()); ++i) {
     const cv::Point p(cvRound(edges_.points[i].position.x) - roi_.x,
                       cvRound(edges_.points[i].position.y) - roi_.y);
     if (!cv::Rect(0, 0, roi_.width, roi_.height).contains(p)) continue;
-    int& slot = cell_.at<int>(p);
+    int& slot = cell_.at<int>(p.y + kCellBorder, p.x + kCellBorder);
     if (slot < 0 || edges_.points[slot].magnitude < edges_.points[i].magnitude) slot = i;
   }
 }
@@ -81,49 +135,16 @@ LeastSquaresRefinement::LeastSquaresRefinement(const cv::Mat& image, const Shape
 double LeastSquaresRefinement::correspond(const Pose2D& at, int radius, bool anySign, double sign,
                                           std::vector<Pair>& pairs,
                                           const std::vector<std::uint8_t>& visible) const {
-  const double c = std::cos(at.angle), s = std::sin(at.angle);
-  const Pose2D::Map toImage = at.map();
-  double polaritySum = 0.0;
-  pairs.clear();
-  for (std::size_t i = 0; i < model_.finePoints.size(); ++i) {
-    if (!visible.empty() && !visible[i]) continue;
-    const auto& mp = model_.finePoints[i];
-    const double px = mp.position.x, py = mp.position.y;
-    const cv::Point2d q = toImage({px, py});
-    const double dx = c * mp.direction.x + s * mp.direction.y;
-    const double dy = -s * mp.direction.x + c * mp.direction.y;
-    const int cx = cvRound(q.x) - roi_.x, cy = cvRound(q.y) - roi_.y;
-    int bestIdx = -1;
-    double bestD2 = 1e30, bestDot = 0.0;
-    const int u0 = std::max(cx - radius, 0), u1 = std::min(cx + radius, roi_.width - 1);
-    const int v0 = std::max(cy - radius, 0), v1 = std::min(cy + radius, roi_.height - 1);
-    for (int v = v0; v <= v1; ++v) {
-      const int* row = cell_.ptr<int>(v);
-      for (int u = u0; u <= u1; ++u) {
-        if (row[u] < 0) continue;
-        const EdgePoint& e = edges_.points[row[u]];
-        const double dot = e.normal.x * dx + e.normal.y * dy;
-        const double agree = polarity_ == Polarity::IgnoreLocal    ? std::abs(dot)
-                             : polarity_ == Polarity::IgnoreGlobal ? sign * dot
-                                                                   : dot;
-        if (agree < kMinCos && !(anySign && std::abs(dot) >= kMinCos)) continue;
-        const double d2 = (e.position.x - q.x) * (e.position.x - q.x) +
-                          (e.position.y - q.y) * (e.position.y - q.y);
-        if (d2 < bestD2) bestD2 = d2, bestIdx = row[u], bestDot = dot;
-      }
-    }
-    if (bestIdx < 0) continue;
-    polaritySum += bestDot;
-    const EdgePoint& e = edges_.points[bestIdx];
-    const double r = e.normal.x * (q.x - e.position.x) + e.normal.y * (q.y - e.position.y);
-    // q = t + s R(a) p: dq/da = s R'(a) p, dq/ds = R(a) p.
-    const double rpx = c * px + s * py, rpy = -s * px + c * py;
-    pairs.push_back(
-        {Eigen::Vector4d(e.normal.x, e.normal.y, at.scale * (e.normal.x * rpy - e.normal.y * rpx),
-                         e.normal.x * rpx + e.normal.y * rpy),
-         r});
+  switch (radius) {
+    case 1:
+      return correspondWithin<1>(at, anySign, sign, pairs, visible);
+    case 2:
+      return correspondWithin<2>(at, anySign, sign, pairs, visible);
+    case 3:
+      return correspondWithin<3>(at, anySign, sign, pairs, visible);
+    default:
+      throw std::logic_error("LeastSquaresRefinement: a correspondence radius of 1-3 pixels");
   }
-  return polaritySum;
 }
 
 // A smooth weight, not a count within a threshold: two poses a few hundredths of a pixel apart

@@ -85,13 +85,19 @@ class LeastSquaresRefinement {
   // `radius` pixels; returns the sum of the pairs' direction agreements (the global polarity).
   double correspond(const Pose2D& at, int radius, bool anySign, double sign,
                     std::vector<Pair>& pairs, const std::vector<std::uint8_t>& visible = {}) const;
+  template <int Radius>
+  double correspondWithin(const Pose2D& at, bool anySign, double sign, std::vector<Pair>& pairs,
+                          const std::vector<std::uint8_t>& visible) const;
   double support(const Pose2D& at, double sign, double cutoff) const;
 
   const ShapeModel& model_;
   Polarity polarity_;
   cv::Rect roi_;
   EdgeContours edges_;
-  cv::Mat cell_;  // index of the strongest edge point in each pixel of the region, -1 for none
+  // Index of the strongest edge point in each pixel of the region, -1 for none; framed by
+  // kCellBorder empty cells on every side, so that a correspondence window never needs clipping.
+  static constexpr int kCellBorder = 6;
+  cv::Mat cell_;
 };
 
 }  // namespace facet::shape_detail
