@@ -31,11 +31,11 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
   // The centre's own score first, as the bar the others must reach: most poses around a tracked
   // candidate score below it, and the early termination then abandons them sooner. The pose
   // kept is the same (the first of the best in the loop's order) because a pose that ties or beats
-  // the centre is never abandoned: the bar lies below the centre's score by what the bound can
-  // miss: a direction's rounded components make it up to 127.71 long against the 127 the bound
-  // assumes (and a deformable score's model direction 128.71 against 128), so a point may add up
-  // to 1.011 to a score. Only for the safe termination (greediness 0): a greedy one may abandon
-  // the centre itself.
+  // the centre is never abandoned. For that the bar lies below the centre's score by what the
+  // bound can miss. The bound assumes a point adds at most 1, but a direction's rounded components
+  // make it up to 127.71 long against 127 (a deformable score's model direction 128.71 against
+  // 128), so a point may add up to 1.011. Only for the safe termination (greediness 0): a greedy
+  // one may abandon the centre itself.
   constexpr double kPointOvershoot = 0.012;
   const double bar =
       s.greediness > 0.0
