@@ -30,13 +30,11 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
   };
   // The centre's own score first, as the bar the others must reach: most poses around a tracked
   // candidate score below it, and the early termination then abandons them sooner. The pose
-  // kept is the same (the first of the best in the loop's order) because a pose that ties or beats
-  // the centre is never abandoned. For that the bar lies below the centre's score by what the
-  // bound can miss. The bound assumes a point adds at most 1, but a direction's rounded components
-  // make it up to 127.71 long against 127 (a deformable score's model direction 128.71 against
-  // 128), so a point may add up to 1.011. Only for the safe termination (greediness 0): a greedy
-  // one may abandon the centre itself.
-  constexpr double kPointOvershoot = 0.012;
+  // kept is the same (the first of the best in the loop's order): the safe termination never
+  // abandons a pose that ties or beats the bar, which lies below the centre's score by more than
+  // the rounding of the directions and of the bound (at the last point it is minScore up to the
+  // rounding of its share). Only for the safe termination (greediness 0): a greedy one may abandon
+  // the centre itself.
   const double bar =
       s.greediness > 0.0
           ? -1.0
@@ -44,7 +42,7 @@ Candidate refineOnLevel(const LevelSearch& s, Candidate c, int radius, int angle
                 *s.field,
                 pose(clampAngle(s.angles, c.angle), std::clamp(c.scale, s.scaleMin, s.scaleMax)),
                 cv::Point(cvRound(c.x), cvRound(c.y)), s.polarity, s.minScore, 0.0, s.spread) -
-                kPointOvershoot;
+                1e-6;
   for (int climb = 0; climb < 6; ++climb) {
     Candidate centre = climb == 0 ? c : best;
     bool onBorder = false;

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <numbers>
 #include <optional>
 
 #include <opencv2/core/hal/intrin.hpp>
@@ -30,6 +31,21 @@ PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, doub
 }
 
 namespace {
+
+// The most one point can add to a score, which the safe early termination assumes of every point
+// not yet read. Not 1: an image direction's components are rounded to integers, so it is up to
+// 127 + 0.5 sqrt(2) = 127.71 long against the 127 it is divided by; the deformation-tolerant
+// score's rounded model direction (128 long) adds as much again. Bounding with 1 abandoned poses
+// that would have scored up to that much above the bar: the local search then kept a worse pose
+// beside the best (1.00018 for 1.00227, deformation 1 px).
+constexpr double kMostPerPoint = (127.0 + 0.5 * std::numbers::sqrt2) / 127.0;
+constexpr double kMostPerSpreadPoint = kMostPerPoint * (128.0 + 0.5 * std::numbers::sqrt2) / 128.0;
+
+// The early termination's bound after a share f of the points: between every remaining point
+// adding `most` (greediness 0) and each adding minScore (greediness 1).
+double abandonBelow(double minScore, double greediness, double f, double most) {
+  return (1.0 - greediness) * (minScore - most * (1.0 - f)) + greediness * minScore * f;
+}
 
 // The best dot product of a turned model direction (mx, my; 128 long) with the image directions in
 // a window of `side` (<= 8) pixels a row, rows v0..v1, starting at column u0, with at least 8
@@ -62,7 +78,6 @@ double scoreSpreadPose(const cv::Mat& field, const PosedPoints& posed, cv::Point
                        Polarity polarity, double minScore, double greediness, int spread) {
   const int n = static_cast<int>(posed.offsets.size());
   const double invN = 1.0 / n, unit = 1.0 / (127.0 * 128.0);
-  const double safe = minScore - 1.0, greedy = minScore;
   const bool local = polarity == Polarity::IgnoreLocal;
   const int w = field.cols, h = field.rows;
   long sum = 0;
@@ -90,7 +105,7 @@ double scoreSpreadPose(const cv::Mat& field, const PosedPoints& posed, cv::Point
     sum += best;
     if ((j & 7) == 7 && minScore > 0.0) {
       const double f = (j + 1) * invN;
-      if (sum * unit * invN < (1.0 - greediness) * (safe + f) + greediness * greedy * f)
+      if (sum * unit * invN < abandonBelow(minScore, greediness, f, kMostPerSpreadPoint))
         return -1.0;
     }
   }
@@ -104,7 +119,6 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
   if (spread > 0) return scoreSpreadPose(field, posed, at, polarity, minScore, greediness, spread);
   const int n = static_cast<int>(posed.offsets.size());
   const double invN = 1.0 / n;
-  const double safe = minScore - 1.0, greedy = minScore;
   double sum = 0.0;
   const auto w = static_cast<unsigned>(field.cols), h = static_cast<unsigned>(field.rows);
   // Plain pointers and blocks of eight points between the checks: the loop is most of the
@@ -128,8 +142,7 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
       }
     }
     if (j1 - j0 == 8 && check) {
-      const double f = j1 * invN;
-      const double bound = (1.0 - greediness) * (safe + f) + greediness * greedy * f;
+      const double bound = abandonBelow(minScore, greediness, j1 * invN, kMostPerPoint);
       const double partial = (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
       if (partial < bound) return -1.0;
     }

@@ -24,8 +24,8 @@ PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, doub
 
 // The similarity at an integer position of a direction field (CV_8SC2, DirectionField), with
 // early termination: after j of n points the pose is abandoned when the partial mean falls below a
-// bound between the safe one (every remaining point matches perfectly, greediness 0) and the
-// greedy one (the remaining points match at exactly minScore, greediness 1). Returns the score,
+// bound between the safe one (every remaining point adds the most a point can, greediness 0) and
+// the greedy one (the remaining points match at exactly minScore, greediness 1). Returns the score,
 // or -1 if abandoned. With `spread` > 0 each point inside the image takes the best direction within
 // `spread` pixels in x and y (FindParams::maxDeformation); not with Polarity::IgnoreGlobal.
 double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, Polarity polarity,
