@@ -15,15 +15,6 @@
 namespace facet {
 namespace {
 
-// Another edge's step as it appears in the window (the convention of ProfileEdgeFinder: edges
-// ahead add their rising part, edges behind subtract the part not yet completed).
-double otherStep(const ProfileEdge& o, double centre, double s) {
-  const double z = (s - o.position) / std::max(o.blur, 0.3);
-  if (std::abs(z) > 8) return 0.0;
-  const double cdf = standard_normal::normal(z).cdf;
-  return o.position > centre ? o.amplitude * cdf : o.amplitude * (cdf - 1.0);
-}
-
 // The unknowns, in this order: the level before the first edge, the n steps, the n edges, the
 // common blur and the background's slope.
 struct Layout {
@@ -72,7 +63,8 @@ std::optional<std::vector<ProfileEdge>> fitEdgeCluster(const GreyProfile& p,
   for (int i = i0; i <= i1; ++i) {
     s[i - i0] = p.positionAt(i);
     y[i - i0] = p.values[i];
-    for (const ProfileEdge& o : others) y[i - i0] -= otherStep(o, centre, s[i - i0]);
+    for (const ProfileEdge& o : others)
+      y[i - i0] -= neighbourStep(o.position, o.amplitude, std::max(o.blur, 0.3), centre, s[i - i0]);
   }
 
   // Levenberg-Marquardt from the starts; the level before the cluster from the window's first
@@ -155,11 +147,7 @@ std::optional<std::vector<ProfileEdge>> fitEdgeCluster(const GreyProfile& p,
       LevenbergMarquardtStop::NonFiniteStep)
     return std::nullopt;
   if (!x.allFinite() || x[at.edge(0)] < lo || x[at.edge(n - 1)] > hi) return std::nullopt;
-  // Whether the sensor clipped the profile within the window (ProfileEdge::clipped; the limits
-  // up to the bilinear weights' rounding).
-  bool clipped = false;
-  for (int i = i0; i <= i1 && !clipped; ++i)
-    clipped = p.values[i] >= p.clipLevel - 1e-6 || p.values[i] <= 1e-6;
+  const bool clipped = p.clippedWithin(i0, i1);  // ProfileEdge::clipped
   std::vector<ProfileEdge> out(starts.begin(), starts.end());
   for (int k = 0; k < n; ++k) {
     out[k].clipped = clipped;

@@ -34,6 +34,14 @@ struct GreyProfile {
   double clipLevel = 255.0;
 
   [[nodiscard]] double positionAt(double index) const { return start + index * step; }
+  // Whether samples first..last hold one the sensor clipped: at clipLevel or at 0, up to the
+  // rounding of the bilinear weights' sum.
+  [[nodiscard]] bool clippedWithin(int first, int last) const {
+    constexpr double kRounding = 1e-6;
+    for (int i = first; i <= last; ++i)
+      if (values[i] >= clipLevel - kRounding || values[i] <= kRounding) return true;
+    return false;
+  }
   [[nodiscard]] double end() const {
     return start + static_cast<double>(values.empty() ? 0 : values.size() - 1) * step;
   }

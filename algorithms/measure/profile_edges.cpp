@@ -68,9 +68,6 @@ double integrate(const double* y, int n, double x0, double h, double lo, double 
 constexpr double kCoreWindow = 4.0;
 // The faintest step (grey levels, 8-bit scale) that stops a window, however clean the profile.
 constexpr double kFaintStep = 2.0;
-// A sample this close to a limit (0 or GreyProfile::clipLevel) averages clipped pixels only: the
-// bilinear weights' sum in floating point.
-constexpr double kClipRounding = 1e-6;
 
 // The step fit's unknowns: the level before the edge, the step, the edge, its width, and the
 // background's slope along the profile.
@@ -150,11 +147,8 @@ void ProfileEdgeFinder::findNear(std::size_t self) {
 // their rising part, steps behind subtract the part of their step not yet completed.
 double ProfileEdgeFinder::neighbours(std::size_t self, double s) const {
   double sum = 0;
-  for (std::size_t k : near_) {
-    const double z = (s - steps_[k].e) / steps_[k].w;
-    if (std::abs(z) > 8) continue;
-    sum += steps_[k].e > steps_[self].e ? steps_[k].b * Phi(z) : steps_[k].b * (Phi(z) - 1.0);
-  }
+  for (std::size_t k : near_)
+    sum += neighbourStep(steps_[k].e, steps_[k].b, steps_[k].w, steps_[self].e, s);
   return sum;
 }
 
@@ -187,9 +181,7 @@ bool ProfileEdgeFinder::fitStep(const GreyProfile& p, std::size_t self) {
   const double* y = window_.data() + (i0 - j0);
   const int count = i1 - i0 + 1;
   // Whether the sensor clipped the profile within the window (ProfileEdge::clipped).
-  st.clipped = false;
-  for (int j = i0; j <= i1 && !st.clipped; ++j)
-    st.clipped = p.values[j] >= p.clipLevel - kClipRounding || p.values[j] <= kClipRounding;
+  st.clipped = p.clippedWithin(i0, i1);
 
   // Gauss-Newton on (a, b, e, w, g): the model a + b Phi((s - e) / w) + g (s - s0), started with
   // the linear fit of the levels and slope at the current e, w. The slope is shading: where the

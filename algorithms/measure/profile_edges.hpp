@@ -26,8 +26,10 @@
 //     (an erf standing in for erf convolved with the pixel's footprint) cannot bias the position.
 //     The area uses the exact integral of the linearly interpolated samples.
 
+#include <cmath>
 #include <vector>
 
+#include "algorithms/geometry/standard_normal.hpp"
 #include "algorithms/measure/grey_profile.hpp"
 
 namespace facet {
@@ -50,6 +52,18 @@ struct ProfileEdge {
   // model of the profile alone undoes it; lower the exposure.
   bool clipped = false;
 };
+
+// Another edge's blurred step (at `edge`, step `amplitude`, erf width `width`) at axis position s,
+// as an edge at `self` sees it in its window: one ahead adds its rising part, one behind
+// subtracts the part it has not yet completed, so that the window keeps the level its own edge
+// starts from. 0 beyond 8 widths. The single-edge fits and the joint fits of crowded edges
+// (edge_cluster_fit.hpp) subtract their neighbours this way.
+inline double neighbourStep(double edge, double amplitude, double width, double self, double s) {
+  const double z = (s - edge) / width;
+  if (std::abs(z) > 8) return 0.0;
+  const double cdf = standard_normal::normal(z).cdf;
+  return edge > self ? amplitude * cdf : amplitude * (cdf - 1.0);
+}
 
 // Every edge of either polarity with |amplitude| >= minAmplitude, sorted by position.
 std::vector<ProfileEdge> findProfileEdges(const GreyProfile& profile,
