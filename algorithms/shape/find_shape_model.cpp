@@ -442,12 +442,20 @@ struct Tracker {
           auto& out = tracked[static_cast<std::size_t>(i)];
           out[0] = refineOnLevel(search, c, 2);
           out[1].score = -1.0;
-          // Only around a candidate that holds on this level, and only for a peak that could
-          // still be chosen over the near one (as the finish does: within kClusterMargin).
-          if (wideSteps > 1 && out[0].score >= search.minScore) {
+          // Also around a candidate whose near look fails but which scored this level's bar on
+          // the top level: it has lost its angle rather than its part (on a texture the top
+          // level's best angle at the part's pixel lay 2.3 of its steps from the part's; the near
+          // look from there scored 0.47, the wider one climbed to 0.95, and a part scoring 0.99
+          // was missed). There a look of 3x3 positions is enough, the angle is what it seeks.
+          // Beside a candidate that holds, only a peak that could still be chosen over it (as
+          // the finish does: within kClusterMargin).
+          const bool holds = out[0].score >= search.minScore;
+          if (wideSteps > 1 &&
+              (holds || candidates[static_cast<std::size_t>(i)].score >= search.minScore)) {
             LevelSearch wideSearch = search;
-            wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);
-            const Candidate wide = refineOnLevel(wideSearch, c, 2, wideSteps);
+            if (holds)
+              wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);
+            const Candidate wide = refineOnLevel(wideSearch, c, holds ? 2 : 1, wideSteps);
             if (wide.score >= wideSearch.minScore &&
                 !sameLevelPose(wide, out[0], search.level->angleStep))
               out[1] = wide;
