@@ -49,6 +49,14 @@ TEST(RefinementChoice, AnExactFitMayLoseMoreScoreThanADisplacedFeatureHolds) {
       << "a part held at a scale it does not have is judged by the score";
 }
 
+TEST(RefinementChoice, AStartAHairFromTheFitDoesNotOutweighIt) {
+  // An exact part: the start 0.017 px off the fit's pose lays 592.3 of 600 points on edges, the
+  // fit 591.3; the fit is kept wherever it started. A tenth more (a displaced hole) is not a hair.
+  EXPECT_TRUE(keepsRefinedPose(outcome(0.9999, 0.9999, 592.270, 591.342, true, true)));
+  EXPECT_TRUE(keepsRefinedPose(outcome(0.9999, 0.9999, 592.270, 591.342)));
+  EXPECT_FALSE(keepsRefinedPose(outcome(0.9999, 0.9999, 592.270, 592.270 * 0.985, true, true)));
+}
+
 TEST(RefinementChoice, APartHeldAtAScaleItDoesNotHaveIsJudgedByTheScore) {
   EXPECT_TRUE(keepsRefinedPose(outcome(0.90, 0.91, 300.0, 200.0, false)));
   EXPECT_FALSE(keepsRefinedPose(outcome(0.91, 0.90, 200.0, 300.0, false)));
