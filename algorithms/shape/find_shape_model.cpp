@@ -533,10 +533,15 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   const int top = levels - 1;
   const ShapeLevel& topLevel = model.levels[top];
   fields[top].ensureAll();
+  // A second peak in angle at a pixel is tracked where it already scores the bar of the level
+  // below. A model with near-symmetric turns has them tracked instead (addSymmetricTurns): its
+  // score peaks at every such turn, and the second peaks only doubled the candidates (a candy).
+  const double separatePeaks = model.symmetries.empty() ? kMiddleFactor * params.minScore : 2.0;
   std::vector<Candidate> candidates = shape_detail::searchTopLevel(
       fields[top].directions(), topLevel.points, angleSamples(*angles, topLevel.angleStep),
       scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params.polarity,
-      spreadOnLevel(params.maxDeformation, top), kTopFactor * params.minScore, params.threads);
+      spreadOnLevel(params.maxDeformation, top), kTopFactor * params.minScore, separatePeaks,
+      params.threads);
 
   // Every top-level candidate is tracked: the top level sees a small part coarsest, and on a
   // busy photograph a part a third hidden ranked 100th-220th there behind clutter (a crystal on

@@ -136,13 +136,38 @@ class MapPlanes {
   std::int8_t* data_ = nullptr;
 };
 
+// Angle steps between two templates (scale-major, angles inner), around the circle when the
+// angles cover it.
+constexpr int kApartSteps = 2;  // the reach of the wider look below the top (find_shape_model.cpp)
+constexpr double kPeakMargin = 0.1;  // kClusterMargin of find_shape_model.cpp
+class AngleSteps {
+ public:
+  explicit AngleSteps(const std::vector<double>& angles) : n_(static_cast<int>(angles.size())) {
+    if (n_ >= 3) {
+      const double step = std::abs(angles[1] - angles[0]);
+      circle_ = std::abs(step * n_ - kTwoPi) < 0.5 * step;
+    }
+  }
+  // Whether templates a and b lie more than kApartSteps angle steps apart.
+  [[nodiscard]] bool apart(std::int32_t a, std::int32_t b) const {
+    int d = std::abs(a % n_ - b % n_);
+    if (circle_) d = std::min(d, n_ - d);
+    return d > kApartSteps;
+  }
+
+ private:
+  int n_;
+  bool circle_ = false;
+};
+
 }  // namespace
 
 std::vector<Candidate> searchTopLevel(const cv::Mat& field,
                                       const std::vector<ShapePoint>& modelPoints,
                                       const std::vector<double>& angles,
                                       const std::vector<double>& scales, Polarity polarity,
-                                      int spread, double threshold, int threads) {
+                                      int spread, double threshold, double separateThreshold,
+                                      int threads) {
   std::vector<ShapePoint> points = modelPoints;
   if (points.size() > kMaxTopPoints) {
     std::vector<ShapePoint> kept;
@@ -278,32 +303,51 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
     }
   }
 
-  // Best template per pixel (the first one of equal sums).
+  // Per pixel, the best template (the first one of equal sums) and the best of those more than
+  // kApartSteps angle steps from it: a second peak in angle. Where the top level's score has two
+  // peaks in angle at the part's pixel (a chessboard's quarter turns, the near-symmetric turns
+  // of a texture), the best angle alone could be the wrong one, tracked down to a wrong pose,
+  // while the part's own angle was suppressed (a part scoring 0.99 missed, 0.87 returned).
+  const AngleSteps steps(angles);
   std::vector<std::int16_t> best(static_cast<std::size_t>(paddedW) * h, 0);
+  std::vector<std::int16_t> second(best.size(), 0);
   std::vector<std::int32_t> bestTemplate(best.size(), -1);
+  std::vector<std::int32_t> secondTemplate(best.size(), -1);
   const bool global = polarity == Polarity::IgnoreGlobal;
   auto work = [&](int y0, int y1) {
     alignas(16) std::int16_t sums[kSumBlock];
     for (int y = y0; y < y1; ++y) {
       const std::int8_t* row = maps + static_cast<std::ptrdiff_t>(y + border) * stride + border;
-      std::int16_t* bestRow = best.data() + static_cast<std::size_t>(y) * paddedW;
-      std::int32_t* bestIdx = bestTemplate.data() + static_cast<std::size_t>(y) * paddedW;
+      const std::size_t rowStart = static_cast<std::size_t>(y) * paddedW;
+      std::int16_t* bestRow = best.data() + rowStart;
+      std::int16_t* secondRow = second.data() + rowStart;
+      std::int32_t* bestIdx = bestTemplate.data() + rowStart;
+      std::int32_t* secondIdx = secondTemplate.data() + rowStart;
       for (int x0 = 0; x0 < paddedW; x0 += blockW) {
         if (!live[static_cast<std::size_t>(y) * blocksPerRow + x0 / blockW]) continue;
         const int n = std::min(blockW, paddedW - x0);
         for (std::size_t t = 0; t < templates.size(); ++t) {
           const std::vector<std::ptrdiff_t>& sources = templates[t].sources;
           sumResponses(row + x0, sources.data(), sources.size(), n, sums);
+          const auto ti = static_cast<std::int32_t>(t);
           for (int k = 0; k < n; k += 8) {
             cv::v_int16x8 v = cv::v_load_aligned(sums + k);
             if (global) v = cv::v_reinterpret_as_s16(cv::v_abs(v));
-            std::int16_t* b = bestRow + x0 + k;
-            // Improvements become rare after the first templates: test 8 pixels at once.
-            if (!cv::v_check_any(v > cv::v_load(b))) continue;
+            // Improvements become rare after the first templates: test 8 pixels at once (the
+            // second is never above the best).
+            if (!cv::v_check_any(v > cv::v_load(secondRow + x0 + k))) continue;
             cv::v_store_aligned(sums + k, v);
-            for (int j = k; j < k + 8; ++j)
-              if (sums[j] > b[j - k])
-                b[j - k] = sums[j], bestIdx[x0 + j] = static_cast<std::int32_t>(t);
+            for (int j = x0 + k; j < x0 + k + 8; ++j) {
+              const std::int16_t u = sums[j - x0];
+              if (u <= secondRow[j]) continue;
+              const bool apart = bestIdx[j] >= 0 && steps.apart(ti, bestIdx[j]);
+              if (u > bestRow[j]) {
+                if (apart) secondRow[j] = bestRow[j], secondIdx[j] = bestIdx[j];
+                bestRow[j] = u, bestIdx[j] = ti;
+              } else if (apart) {
+                secondRow[j] = u, secondIdx[j] = ti;
+              }
+            }
           }
         }
       }
@@ -311,28 +355,65 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   };
   inStripes(work);
 
-  // Local maxima above the threshold.
-  std::vector<Candidate> candidates;
+  // Candidates. A pixel's best is one where no pixel within r has a higher best (a local maximum
+  // over position, whatever the angle), as far as it reaches `threshold`. Where the score has two
+  // peaks in angle, the part's can be the lower one, or lie beside a neighbour's higher peak at
+  // another angle: an entry (a pixel's best or second) is a candidate too where no entry within r
+  // pixels and kApartSteps angle steps is higher (a maximum over position and angle), it reaches
+  // `separateThreshold`, and it lies within kPeakMargin of the best within r pixels: only such a
+  // peak could still be the part's (as the finish picks among a part's alternatives). On a
+  // texture every pixel's best angle differs from its neighbours'; the maxima over position and
+  // angle alone were three times as many candidates as those over position.
+  const auto peakMargin = static_cast<int>(std::lround(kPeakMargin * norm));
+  const auto separateSum =
+      static_cast<std::int16_t>(std::min(32767.0, std::max(threshold, separateThreshold) * norm));
+  const std::array<const std::int16_t*, 2> value{best.data(), second.data()};
+  const std::array<const std::int32_t*, 2> index{bestTemplate.data(), secondTemplate.data()};
   constexpr int r = 2;
+  // Calls f(dx, dy, offset) for the pixels within r of (x, y), until it returns false.
+  auto forNeighbours = [&](int x, int y, auto f) {
+    for (int dy = -r; dy <= r; ++dy)
+      for (int dx = -r; dx <= r; ++dx) {
+        const int xx = x + dx, yy = y + dy;
+        if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
+        if (!f(dx, dy, static_cast<std::size_t>(yy) * paddedW + xx)) return false;
+      }
+    return true;
+  };
+  std::vector<Candidate> candidates;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
-      const std::int16_t v = best[static_cast<std::size_t>(y) * paddedW + x];
-      if (v < minSum || v <= 0) continue;
-      bool isMax = true;
-      for (int dy = -r; dy <= r && isMax; ++dy)
-        for (int dx = -r; dx <= r; ++dx) {
-          const int xx = x + dx, yy = y + dy;
-          if ((dx == 0 && dy == 0) || xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
-          const std::int16_t u = best[static_cast<std::size_t>(yy) * paddedW + xx];
-          // Strict on one side so that a plateau yields one maximum.
-          if (u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0)))) {
-            isMax = false;
-            break;
-          }
+      const std::size_t at = static_cast<std::size_t>(y) * paddedW + x;
+      for (int layer = 0; layer < 2; ++layer) {
+        const std::int16_t v = value[layer][at];
+        if (v < minSum || v <= 0) continue;
+        const std::int32_t t = index[layer][at];
+        // Strict on one side so that a plateau yields one maximum.
+        const bool positionMax = layer == 0 && forNeighbours(x, y, [&](int dx, int dy, auto n) {
+                                   const std::int16_t u = best[n];
+                                   return (dx == 0 && dy == 0) ||
+                                          !(u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0))));
+                                 });
+        if (!positionMax) {
+          if (v < separateSum) continue;
+          const bool nearBest =
+              forNeighbours(x, y, [&](int, int, auto n) { return v >= best[n] - peakMargin; });
+          if (!nearBest) continue;
+          const bool poseMax = forNeighbours(x, y, [&](int dx, int dy, auto n) {
+            for (int other = 0; other < 2; ++other) {
+              if (dx == 0 && dy == 0 && other == layer) continue;
+              const std::int16_t u = value[other][n];
+              if (u < v || index[other][n] < 0 || steps.apart(t, index[other][n])) continue;
+              if (u > v || dy < 0 || (dy == 0 && (dx < 0 || (dx == 0 && other < layer))))
+                return false;
+            }
+            return true;
+          });
+          if (!poseMax) continue;
         }
-      if (!isMax) continue;
-      const TopTemplate& tpl = templates[bestTemplate[static_cast<std::size_t>(y) * paddedW + x]];
-      candidates.push_back({double(x), double(y), tpl.angle, tpl.scale, v / norm});
+        const TopTemplate& tpl = templates[static_cast<std::size_t>(t)];
+        candidates.push_back({double(x), double(y), tpl.angle, tpl.scale, v / norm});
+      }
     }
   }
   std::sort(candidates.begin(), candidates.end(),

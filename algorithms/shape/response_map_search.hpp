@@ -21,7 +21,9 @@ struct Candidate {
 };
 
 // Local maxima (over position, best template per pixel) scoring at least `threshold`, best first,
-// all of them (the caller decides which to track first). `field` is the top level's
+// all of them (the caller decides which to track first); and where the score has a second peak in
+// angle, the maxima over position and angle scoring at least `separateThreshold` as well
+// (response_map_search.cpp). `field` is the top level's
 // DirectionField; the search splits its rows over `threads` threads. With `spread` > 0 each point
 // takes the best response within `spread` pixels in x and y (a part whose contour differs from the
 // model's by that much; not with Polarity::IgnoreGlobal, whose sums would need the worst response
@@ -29,6 +31,7 @@ struct Candidate {
 std::vector<Candidate> searchTopLevel(const cv::Mat& field, const std::vector<ShapePoint>& points,
                                       const std::vector<double>& angles,
                                       const std::vector<double>& scales, Polarity polarity,
-                                      int spread, double threshold, int threads);
+                                      int spread, double threshold, double separateThreshold,
+                                      int threads);
 
 }  // namespace facet::shape_detail
