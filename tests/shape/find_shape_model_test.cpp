@@ -576,6 +576,44 @@ TEST(FindShapeModel, AnOccludersBorderOnAPhotographDoesNotPullThePose) {
   }
 }
 
+// A photograph of tests/data/photos turned about its centre (cubic), with noise of sigma 1.5 drawn
+// from `noiseSeed` (none for 0), and where the centre of `region` lands in it.
+struct TurnedPhoto {
+  cv::Mat scene;
+  cv::Point2d centre;
+};
+TurnedPhoto turnedPhoto(const cv::Mat& photo, const cv::Rect& region, double angleDeg, double scale,
+                        int noiseSeed) {
+  const cv::Mat turn = cv::getRotationMatrix2D(
+      cv::Point2f((photo.cols - 1) / 2.0F, (photo.rows - 1) / 2.0F), angleDeg, scale);
+  TurnedPhoto out;
+  cv::warpAffine(photo, out.scene, turn, photo.size(), cv::INTER_CUBIC, cv::BORDER_CONSTANT,
+                 cv::mean(photo));
+  if (noiseSeed > 0) {
+    cv::Mat noise(photo.size(), CV_32F), sum;
+    cv::setRNGSeed(noiseSeed);
+    cv::randn(noise, 0.0, 1.5);
+    out.scene.convertTo(sum, CV_32F);
+    sum += noise;
+    sum.convertTo(out.scene, CV_8U);
+  }
+  const cv::Matx23d m = turn;
+  const cv::Point2d c(region.x + (region.width - 1) / 2.0, region.y + (region.height - 1) / 2.0);
+  out.centre = {m(0, 0) * c.x + m(0, 1) * c.y + m(0, 2), m(1, 0) * c.x + m(1, 1) * c.y + m(1, 2)};
+  return out;
+}
+
+// The search's one match is the region of the turned photograph, within 0.1 px and 0.1 degrees.
+void expectTheRegion(const ShapeModel& model, const TurnedPhoto& turned, double angleDeg,
+                     double scale, double minScore) {
+  const auto found = findShapeModel(turned.scene, model);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_LT(std::hypot(found[0].x - turned.centre.x, found[0].y - turned.centre.y), 0.1);
+  EXPECT_NEAR(found[0].angle, radians(angleDeg), radians(0.1));
+  EXPECT_NEAR(found[0].scale, scale, 0.002);
+  EXPECT_GT(found[0].score, minScore);
+}
+
 // A texture (tests/data/photos/baboon.png: fur) turned by -96.88 degrees, with noise: on the top
 // pyramid level the best angle at the part's pixel lay 2.3 of that level's steps from the part's,
 // the usual look on the level below found nothing there (0.47), and the part, scoring 0.99, was
@@ -587,28 +625,9 @@ TEST(FindShapeModel, ATexturedPartWhoseTopLevelAngleIsOffIsFound) {
   const cv::Rect region(129, 285, 88, 107);
   const ShapeModel model = createShapeModel(photo(region));
   const double angle = -96.88;
-  const cv::Mat turn = cv::getRotationMatrix2D(
-      cv::Point2f((photo.cols - 1) / 2.0F, (photo.rows - 1) / 2.0F), angle, 1.0);
-  cv::Mat turned;
-  cv::warpAffine(photo, turned, turn, photo.size(), cv::INTER_CUBIC, cv::BORDER_CONSTANT,
-                 cv::mean(photo));
-  const cv::Matx23d m = turn;
-  const cv::Point2d centre(region.x + (region.width - 1) / 2.0,
-                           region.y + (region.height - 1) / 2.0);
-  const cv::Point2d truth(m(0, 0) * centre.x + m(0, 1) * centre.y + m(0, 2),
-                          m(1, 0) * centre.x + m(1, 1) * centre.y + m(1, 2));
   for (const int seed : {3, 4, 5}) {
-    cv::Mat noise(photo.size(), CV_32F), scene;
-    cv::setRNGSeed(seed);
-    cv::randn(noise, 0.0, 1.5);
-    turned.convertTo(scene, CV_32F);
-    scene += noise;
-    scene.convertTo(scene, CV_8U);
-    const auto found = findShapeModel(scene, model);
-    ASSERT_EQ(found.size(), 1u) << "noise seed " << seed;
-    EXPECT_LT(std::hypot(found[0].x - truth.x, found[0].y - truth.y), 0.1) << "seed " << seed;
-    EXPECT_NEAR(found[0].angle, radians(angle), radians(0.1)) << "seed " << seed;
-    EXPECT_GT(found[0].score, 0.95) << "seed " << seed;
+    SCOPED_TRACE("noise seed " + std::to_string(seed));
+    expectTheRegion(model, turnedPhoto(photo, region, angle, 1.0, seed), angle, 1.0, 0.95);
   }
 }
 
@@ -624,32 +643,9 @@ TEST(FindShapeModel, APartWhoseTopLevelScorePeaksAtAQuarterTurnIsFound) {
   const cv::Rect region(247, 171, 149, 129);
   const ShapeModel model = createShapeModel(photo(region));
   const double angle = -134.84, scale = 1.01;
-  const cv::Mat turn = cv::getRotationMatrix2D(
-      cv::Point2f((photo.cols - 1) / 2.0F, (photo.rows - 1) / 2.0F), angle, scale);
-  cv::Mat turned;
-  cv::warpAffine(photo, turned, turn, photo.size(), cv::INTER_CUBIC, cv::BORDER_CONSTANT,
-                 cv::mean(photo));
-  const cv::Matx23d m = turn;
-  const cv::Point2d centre(region.x + (region.width - 1) / 2.0,
-                           region.y + (region.height - 1) / 2.0);
-  const cv::Point2d truth(m(0, 0) * centre.x + m(0, 1) * centre.y + m(0, 2),
-                          m(1, 0) * centre.x + m(1, 1) * centre.y + m(1, 2));
   for (const int seed : {0, 1}) {
-    cv::Mat scene = turned;
-    if (seed > 0) {
-      cv::Mat noise(photo.size(), CV_32F);
-      cv::setRNGSeed(seed);
-      cv::randn(noise, 0.0, 1.5);
-      turned.convertTo(scene, CV_32F);
-      scene += noise;
-      scene.convertTo(scene, CV_8U);
-    }
-    const auto found = findShapeModel(scene, model);
-    ASSERT_EQ(found.size(), 1u) << "noise seed " << seed;
-    EXPECT_LT(std::hypot(found[0].x - truth.x, found[0].y - truth.y), 0.1) << "seed " << seed;
-    EXPECT_NEAR(found[0].angle, radians(angle), radians(0.1)) << "seed " << seed;
-    EXPECT_NEAR(found[0].scale, scale, 0.002) << "seed " << seed;
-    EXPECT_GT(found[0].score, 0.99) << "seed " << seed;
+    SCOPED_TRACE("noise seed " + std::to_string(seed));
+    expectTheRegion(model, turnedPhoto(photo, region, angle, scale, seed), angle, scale, 0.99);
   }
 }
 
