@@ -136,10 +136,14 @@ class MapPlanes {
   std::int8_t* data_ = nullptr;
 };
 
+// Two peaks in angle at a pixel are separate beyond the reach of the wider look below the top
+// (find_shape_model.cpp), and only one within kClusterMargin (find_shape_model.cpp) of the best
+// nearby could still be the part's.
+constexpr int kApartSteps = 2;
+constexpr double kPeakMargin = 0.1;
+
 // Angle steps between two templates (scale-major, angles inner), around the circle when the
 // angles cover it.
-constexpr int kApartSteps = 2;  // the reach of the wider look below the top (find_shape_model.cpp)
-constexpr double kPeakMargin = 0.1;  // kClusterMargin of find_shape_model.cpp
 class AngleSteps {
  public:
   explicit AngleSteps(const std::vector<double>& angles) : n_(static_cast<int>(angles.size())) {

@@ -23,11 +23,11 @@ struct Candidate {
 // Local maxima (over position, best template per pixel) scoring at least `threshold`, best first,
 // all of them (the caller decides which to track first); and where the score has a second peak in
 // angle, the maxima over position and angle scoring at least `separateThreshold` as well
-// (response_map_search.cpp). `field` is the top level's
-// DirectionField; the search splits its rows over `threads` threads. With `spread` > 0 each point
-// takes the best response within `spread` pixels in x and y (a part whose contour differs from the
-// model's by that much; not with Polarity::IgnoreGlobal, whose sums would need the worst response
-// as well).
+// (response_map_search.cpp; a `separateThreshold` above 1 keeps the maxima over position only).
+// `field` is the top level's DirectionField; the search splits its rows over `threads` threads.
+// With `spread` > 0 each point takes the best response within `spread` pixels in x and y (a part
+// whose contour differs from the model's by that much; not with Polarity::IgnoreGlobal, whose sums
+// would need the worst response as well).
 std::vector<Candidate> searchTopLevel(const cv::Mat& field, const std::vector<ShapePoint>& points,
                                       const std::vector<double>& angles,
                                       const std::vector<double>& scales, Polarity polarity,
