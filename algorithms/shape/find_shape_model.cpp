@@ -450,8 +450,7 @@ struct Tracker {
           // Beside a candidate that holds, only a peak that could still be chosen over it (as
           // the finish does: within kClusterMargin).
           const bool holds = out[0].score >= search.minScore;
-          if (wideSteps > 1 &&
-              (holds || candidates[static_cast<std::size_t>(i)].score >= search.minScore)) {
+          if (wideSteps > 1 && (holds || c.score >= search.minScore)) {  // c.score: the top's
             LevelSearch wideSearch = search;
             if (holds)
               wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);

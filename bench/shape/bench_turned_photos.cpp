@@ -20,8 +20,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
+#include <numbers>
 #include <random>
 #include <sstream>
 #include <string>
@@ -32,17 +32,14 @@
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model.hpp"
+#include "bench/machine_state.hpp"
 #include "bench/shape/pyramid_ncc.hpp"
 
 namespace facet {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 double cpuMs() {
-  timespec t{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
-  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+  return 1e3 * bench::cpuSeconds();
 }
 
 // The photographs of tests/data/photos come from these files: they are bench_shape_real's.
@@ -213,7 +210,7 @@ int main(int argc, char** argv) {
         double t0 = cpuMs();
         const auto found = findShapeModel(c.scene, model);
         ours.add(!found.empty(), found.empty() ? 0 : found[0].x, found.empty() ? 0 : found[0].y,
-                 found.empty() ? 0 : found[0].angle * 180.0 / kPi, c, cpuMs() - t0);
+                 found.empty() ? 0 : found[0].angle * 180.0 / std::numbers::pi, c, cpuMs() - t0);
         t0 = cpuMs();
         const auto peaks = bench::findByPyramidNcc(c.scene, c.templ, 1);
         ncc.add(!peaks.empty(), peaks.empty() ? 0 : peaks[0].x, peaks.empty() ? 0 : peaks[0].y,

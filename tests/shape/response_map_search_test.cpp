@@ -141,7 +141,8 @@ TEST_P(TopLevelSearchSpread, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
     return x >= 0 && y >= 0 && x < field.cols && y < field.rows;
   };
   std::vector<std::array<int, 3>> expected;  // x, y, template
-  int seconds = 0;  // candidates that are no maximum over position
+  // Candidates that are no maximum over position.
+  int seconds = 0;
   for (int y = 0; y < field.rows; ++y)
     for (int x = 0; x < field.cols; ++x)
       for (int layer = 0; layer < 2; ++layer) {
