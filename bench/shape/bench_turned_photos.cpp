@@ -11,7 +11,14 @@
 // pattern or a symmetric shape another place or angle may score as high: no matcher can tell);
 // missed where nothing reaches the minimum score (facet's 0.7, NCC's 0.6).
 //
-//   bench_turned_photos [--smoke] [--data DIR] [--seeds S1,S2,...]
+// A wrong or missed facet case is then told apart: where facet's own score at the true pose
+// (searched within 1 degree of it around the true place) beats what the full search returned by
+// more than 0.01, or reaches the minimum where the search returned nothing, the search lost a part
+// it could have found ("lost"); otherwise another pose scores as high and the case is ambiguous.
+// --show prints each lost case (photograph, template rectangle, turn, both scores); --save DIR
+// writes its template and scene there as PNG (seed_photo_x_y_template.png, ..._scene.png).
+//
+//   bench_turned_photos [--smoke] [--show] [--save DIR] [--data DIR] [--seeds S1,S2,...]
 // Times are the median CPU time of one search (all threads), ms.
 
 #include <algorithm>
@@ -53,6 +60,7 @@ bool inThePhotoSet(const std::string& name) {
 struct Case {
   std::string name;
   cv::Mat templ, scene;
+  cv::Rect region;     // where the template was cut from the photograph
   cv::Point2d centre;  // the template's centre in the scene
   double angleDeg = 0.0, scale = 1.0;
 };
@@ -106,6 +114,7 @@ std::vector<Case> casesOf(const std::string& name, const cv::Mat& photo, int cou
     scene.convertTo(scene, CV_8U);
     Case c;
     c.name = name;
+    c.region = region;
     c.templ = photo(region).clone();
     c.scene = scene;
     c.centre = map(region.x + (region.width - 1) / 2.0, region.y + (region.height - 1) / 2.0);
@@ -119,22 +128,43 @@ std::vector<Case> casesOf(const std::string& name, const cv::Mat& photo, int cou
 struct Tally {
   int right = 0, wrong = 0, missed = 0;
   std::vector<double> error, ms;  // pose error of the right ones, px; time per search
-  void add(bool found, double x, double y, double angleDeg, const Case& c, double time) {
+  // Returns whether the match is right.
+  bool add(bool found, double x, double y, double angleDeg, const Case& c, double time) {
     ms.push_back(time);
     if (!found) {
       ++missed;
-      return;
+      return false;
     }
     const double d = std::hypot(x - c.centre.x, y - c.centre.y);
     const double turn = std::remainder(angleDeg - c.angleDeg, 360.0);
     if (d < 1.0 && std::abs(turn) < 1.0) {
       ++right;
       error.push_back(d);
-    } else {
-      ++wrong;
+      return true;
     }
+    ++wrong;
+    return false;
   }
 };
+
+// facet's score at the case's true pose: the best match within 1 degree of the true angle in a
+// window around the true place, if it lies within 1 px of it; -1 where it does not (another place
+// scores higher even at the true angle).
+double scoreAtTruth(const Case& c, const ShapeModel& model) {
+  const int reach = static_cast<int>(std::hypot(c.templ.cols, c.templ.rows) / 2.0) + 8;
+  const cv::Rect window = cv::Rect(static_cast<int>(c.centre.x) - reach,
+                                   static_cast<int>(c.centre.y) - reach, 2 * reach, 2 * reach) &
+                          cv::Rect(0, 0, c.scene.cols, c.scene.rows);
+  FindParams near;
+  near.minScore = 0.3;
+  near.angleStart = (c.angleDeg - 1.0) * std::numbers::pi / 180.0;
+  near.angleExtent = 2.0 * std::numbers::pi / 180.0;
+  const auto found = findShapeModel(c.scene(window), model, near);
+  if (found.empty()) return -1.0;
+  const double d =
+      std::hypot(found[0].x + window.x - c.centre.x, found[0].y + window.y - c.centre.y);
+  return d < 1.0 ? found[0].score : -1.0;
+}
 
 double quantile(std::vector<double> v, double q) {
   if (v.empty()) return NAN;
@@ -148,12 +178,18 @@ double quantile(std::vector<double> v, double q) {
 int main(int argc, char** argv) {
   using namespace facet;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
-  bool smoke = false;
+  bool smoke = false, show = false;
+  std::filesystem::path saveDir;
   std::filesystem::path data = "/usr/share/doc/opencv-doc/examples/data";
   std::vector<unsigned> seeds{41, 59};
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) {
       smoke = true;
+    } else if (!std::strcmp(argv[i], "--show")) {
+      show = true;
+    } else if (!std::strcmp(argv[i], "--save") && i + 1 < argc) {
+      saveDir = argv[++i];
+      std::filesystem::create_directories(saveDir);
     } else if (!std::strcmp(argv[i], "--data") && i + 1 < argc) {
       data = argv[++i];
     } else if (!std::strcmp(argv[i], "--seeds") && i + 1 < argc) {
@@ -161,7 +197,9 @@ int main(int argc, char** argv) {
       std::stringstream list(argv[++i]);
       for (std::string s; std::getline(list, s, ',');) seeds.push_back(std::stoul(s));
     } else {
-      std::fprintf(stderr, "usage: bench_turned_photos [--smoke] [--data DIR] [--seeds S1,S2]\n");
+      std::fprintf(stderr,
+                   "usage: bench_turned_photos [--smoke] [--show] [--save DIR] [--data DIR] "
+                   "[--seeds S1,S2]\n");
       return 2;
     }
   }
@@ -189,13 +227,14 @@ int main(int argc, char** argv) {
       "noise 1.5; defaults (facet: min score 0.7; NCC: 0.6); right = within 1 px and 1 deg\n\n",
       photos.size(), data.c_str());
   std::printf(
-      "| seed | cases | facet right / wrong / missed | facet pos px: median, 90%% | facet ms | "
-      "NCC right / wrong / missed | NCC pos px: median, 90%% | NCC ms |\n"
-      "|---|---|---|---|---|---|---|---|\n");
+      "| seed | cases | facet right / wrong / missed | facet lost | facet pos px: median, 90%% | "
+      "facet ms | NCC right / wrong / missed | NCC pos px: median, 90%% | NCC ms |\n"
+      "|---|---|---|---|---|---|---|---|---|\n");
   for (const unsigned seed : seeds) {
     std::mt19937_64 rng(seed);
     Tally ours, ncc;
-    int cases = 0;
+    int cases = 0, lost = 0;
+    std::string lostCases;
     for (const auto& path : photos) {
       const cv::Mat photo = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
       if (photo.empty()) continue;
@@ -209,8 +248,31 @@ int main(int argc, char** argv) {
         ++cases;
         double t0 = cpuMs();
         const auto found = findShapeModel(c.scene, model);
-        ours.add(!found.empty(), found.empty() ? 0 : found[0].x, found.empty() ? 0 : found[0].y,
-                 found.empty() ? 0 : found[0].angle * 180.0 / std::numbers::pi, c, cpuMs() - t0);
+        const double time = cpuMs() - t0;
+        const bool right =
+            ours.add(!found.empty(), found.empty() ? 0 : found[0].x, found.empty() ? 0 : found[0].y,
+                     found.empty() ? 0 : found[0].angle * 180.0 / std::numbers::pi, c, time);
+        if (!right) {
+          const double returned = found.empty() ? 0.0 : found[0].score;
+          const double truth = scoreAtTruth(c, model);
+          if (found.empty() ? truth >= FindParams{}.minScore : truth > returned + 0.01) {
+            ++lost;
+            char line[256];
+            std::snprintf(line, sizeof line,
+                          "  lost: %s template %d,%d %dx%d, turn %.2f deg scale %.2f: returned "
+                          "%.3f, true pose %.3f\n",
+                          c.name.c_str(), c.region.x, c.region.y, c.region.width, c.region.height,
+                          c.angleDeg, c.scale, returned, truth);
+            lostCases += line;
+            if (!saveDir.empty()) {
+              const std::string stem = std::to_string(seed) + "_" + c.name + "_" +
+                                       std::to_string(c.region.x) + "_" +
+                                       std::to_string(c.region.y) + "_";
+              cv::imwrite((saveDir / (stem + "template.png")).string(), c.templ);
+              cv::imwrite((saveDir / (stem + "scene.png")).string(), c.scene);
+            }
+          }
+        }
         t0 = cpuMs();
         const auto peaks = bench::findByPyramidNcc(c.scene, c.templ, 1);
         ncc.add(!peaks.empty(), peaks.empty() ? 0 : peaks[0].x, peaks.empty() ? 0 : peaks[0].y,
@@ -218,10 +280,11 @@ int main(int argc, char** argv) {
       }
     }
     std::printf(
-        "| %u | %d | %d / %d / %d | %.3f, %.3f | %.1f | %d / %d / %d | %.3f, %.3f | %.1f |\n", seed,
-        cases, ours.right, ours.wrong, ours.missed, quantile(ours.error, 0.5),
+        "| %u | %d | %d / %d / %d | %d | %.3f, %.3f | %.1f | %d / %d / %d | %.3f, %.3f | %.1f |\n",
+        seed, cases, ours.right, ours.wrong, ours.missed, lost, quantile(ours.error, 0.5),
         quantile(ours.error, 0.9), quantile(ours.ms, 0.5), ncc.right, ncc.wrong, ncc.missed,
         quantile(ncc.error, 0.5), quantile(ncc.error, 0.9), quantile(ncc.ms, 0.5));
+    if (show) std::printf("%s", lostCases.c_str());
   }
   return 0;
 }
