@@ -13,6 +13,7 @@
 #include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/least_squares_refinement.hpp"
 #include "algorithms/shape/level_search.hpp"
+#include "algorithms/shape/model_symmetry.hpp"
 #include "algorithms/shape/refinement_choice.hpp"
 #include "algorithms/shape/response_map_search.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
@@ -533,9 +534,15 @@ std::vector<ShapeMatch> findShapeModel(const cv::Mat& image, const ShapeModel& m
   const ShapeLevel& topLevel = model.levels[top];
   fields[top].ensureAll();
   // A second peak in angle at a pixel is tracked where it already scores the bar of the level
-  // below. A model with near-symmetric turns has them tracked instead (addSymmetricTurns): its
-  // score peaks at every such turn, and the second peaks only doubled the candidates (a candy).
-  const double separatePeaks = model.symmetries.empty() ? kMiddleFactor * params.minScore : 2.0;
+  // below; not for a model that every turn maps onto itself (a candy: its score is flat in angle,
+  // and the second peaks only doubled the candidates). A model's near-symmetric turns, tracked by
+  // addSymmetricTurns, do not make them redundant: on a patch of a calibration chessboard, whose
+  // top level has near-symmetries at 73 and -75 degrees, the part's pixel was suppressed by a
+  // neighbouring square's pose at a half turn and the part (0.999) was missed; of 9 patches of one
+  // such photograph whose part was missed or outscored, 8 are found with the second peaks.
+  const double separatePeaks = mapsOntoItselfAtEveryTurn(topLevel.points, topLevel.angleStep)
+                                   ? 2.0
+                                   : kMiddleFactor * params.minScore;
   std::vector<Candidate> candidates = shape_detail::searchTopLevel(
       fields[top].directions(), topLevel.points, angleSamples(*angles, topLevel.angleStep),
       scaleSamples(scaleMin, scaleMax, topLevel.scaleStep), params.polarity,

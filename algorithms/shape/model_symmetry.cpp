@@ -141,6 +141,17 @@ std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& po
   return out;
 }
 
+bool mapsOntoItselfAtEveryTurn(const std::vector<ShapePoint>& points, double angleStep,
+                               double minScore) {
+  if (points.size() < 8 || !(angleStep > 0.0)) return false;
+  const Cloud cloud = cloudOf(points);
+  const int n = std::max(8, static_cast<int>(std::ceil(kTwoPi / angleStep)));
+  const int guard = std::max(3, n / 36);  // as findModelSymmetries: the identity's own peak
+  for (int k = guard; k <= n / 2; ++k)
+    if (selfSimilarity(points, cloud.raster, cloud.centre, k * kTwoPi / n) < minScore) return false;
+  return true;
+}
+
 std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& levels) {
   if (levels.empty()) return {};
   const ShapeLevel& base = levels.front();

@@ -27,6 +27,12 @@ std::vector<ModelSymmetry> findModelSymmetries(const std::vector<ShapePoint>& po
                                                double angleStep, double minScore = 0.6,
                                                int maxCount = 3);
 
+// Whether every turn (from a few `angleStep`s to a half turn) about the points' centroid maps
+// them onto themselves with at least `minScore`, as a disc or a ring does: such a model's score is
+// flat in angle, and its near-symmetries (findModelSymmetries) are just some of its turns.
+bool mapsOntoItselfAtEveryTurn(const std::vector<ShapePoint>& points, double angleStep,
+                               double minScore = 0.6);
+
 // The near-symmetries a search must try for a model with these pyramid levels (level 0 first):
 // those of level 0, and those of the top level, where the search starts and sees the part
 // coarsest. A rectangular part with an off-centre feature is no symmetry on level 0 (its turn

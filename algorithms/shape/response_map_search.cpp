@@ -136,6 +136,9 @@ class MapPlanes {
   std::int8_t* data_ = nullptr;
 };
 
+// Pixels: a kept maximum over position suppresses the weaker ones this close.
+constexpr int kPeakReach = 2;
+
 // Two peaks in angle at a pixel are separate beyond the reach of the wider look below the top
 // (find_shape_model.cpp), and only one within kClusterMargin (find_shape_model.cpp) of the best
 // nearby could still be the part's.
@@ -359,31 +362,75 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
   };
   inStripes(work);
 
-  // Candidates. A pixel's best is one where no pixel within r has a higher best (a local maximum
-  // over position, whatever the angle), as far as it reaches `threshold`. Where the score has two
-  // peaks in angle, the part's can be the lower one, or lie beside a neighbour's higher peak at
-  // another angle: an entry (a pixel's best or second) is a candidate too where no entry within r
-  // pixels and kApartSteps angle steps is higher (a maximum over position and angle), it reaches
-  // `separateThreshold`, and it lies within kPeakMargin of the best within r pixels: only such a
-  // peak could still be the part's (as the finish picks among a part's alternatives). On a
-  // texture every pixel's best angle differs from its neighbours'; the maxima over position and
-  // angle alone were three times as many candidates as those over position.
+  // Candidates. The maxima over position (whatever the angle), as far as they reach `threshold`:
+  // the pixels' bests that are maxima of their 3x3 neighbourhood, strongest first, each kept where
+  // no kept one lies within r pixels (greedy suppression) and no best within r lies more than
+  // kPeakMargin above it. Keeping only the bests that no best within r beats lost parts on
+  // periodic patterns: on a chessboard seen at 1/16 the part's pixel (0.75) lay on a ridge rising
+  // to a neighbouring square's peak (0.84, 3 px away) and was suppressed by the ridge's next pixel
+  // (0.76), which that peak suppressed in turn; a part scoring 0.999 was missed and the square
+  // returned at 0.76. Those maxima are all kept here too.
+  // Where the score has two peaks in angle, the part's can be the lower one, or lie beside a
+  // neighbour's higher peak at another angle: an entry (a pixel's best or second) is a candidate
+  // too where no entry within r pixels and kApartSteps angle steps is higher (a maximum over
+  // position and angle), it reaches `separateThreshold`, and it lies within kPeakMargin of the best
+  // within r pixels: only such a peak could still be the part's (as the finish picks among a
+  // part's alternatives). On a texture every pixel's best angle differs from its neighbours'; the
+  // maxima over position and angle alone were three times as many candidates as those over
+  // position.
   const auto peakMargin = static_cast<int>(std::lround(kPeakMargin * norm));
   const auto separateSum =
       static_cast<std::int16_t>(std::min(32767.0, std::max(threshold, separateThreshold) * norm));
   const std::array<const std::int16_t*, 2> value{best.data(), second.data()};
   const std::array<const std::int32_t*, 2> index{bestTemplate.data(), secondTemplate.data()};
-  constexpr int r = 2;
-  // Calls f(dx, dy, offset) for the pixels within r of (x, y), until it returns false.
-  auto forNeighbours = [&](int x, int y, auto f) {
-    for (int dy = -r; dy <= r; ++dy)
-      for (int dx = -r; dx <= r; ++dx) {
+  constexpr int r = kPeakReach;
+  // Calls f(dx, dy, offset) for the pixels within `reach` of (x, y), until it returns false.
+  auto forNeighbours = [&](int x, int y, auto f, int reach = kPeakReach) {
+    for (int dy = -reach; dy <= reach; ++dy)
+      for (int dx = -reach; dx <= reach; ++dx) {
         const int xx = x + dx, yy = y + dy;
         if (xx < 0 || yy < 0 || xx >= w || yy >= h) continue;
         if (!f(dx, dy, static_cast<std::size_t>(yy) * paddedW + xx)) return false;
       }
     return true;
   };
+  std::vector<std::uint8_t> positionMax(static_cast<std::size_t>(w) * h, 0);
+  {
+    struct Peak {
+      int x, y;
+      std::int16_t v;
+    };
+    std::vector<Peak> peaks;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::int16_t v = best[static_cast<std::size_t>(y) * paddedW + x];
+        if (v < minSum || v <= 0) continue;
+        // Strict on one side so that a plateau yields one maximum.
+        const bool localMax = forNeighbours(
+            x, y,
+            [&](int dx, int dy, auto n) {
+              const std::int16_t u = best[n];
+              return (dx == 0 && dy == 0) ||
+                     !(u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0))));
+            },
+            1);
+        if (localMax) peaks.push_back({x, y, v});
+      }
+    // Equal scores in raster order, as the strict side above.
+    std::stable_sort(peaks.begin(), peaks.end(),
+                     [](const Peak& a, const Peak& b) { return a.v > b.v; });
+    for (const Peak& p : peaks) {
+      bool free = true;
+      for (int yy = std::max(0, p.y - r); free && yy <= std::min(h - 1, p.y + r); ++yy)
+        for (int xx = std::max(0, p.x - r); free && xx <= std::min(w - 1, p.x + r); ++xx)
+          free = !positionMax[static_cast<std::size_t>(yy) * w + xx];
+      // Beside a higher best within r, only a maximum within kPeakMargin of it could still be
+      // the part's (as for the second peaks below; a maximum no best within r beats always is).
+      if (free &&
+          forNeighbours(p.x, p.y, [&](int, int, auto n) { return p.v >= best[n] - peakMargin; }))
+        positionMax[static_cast<std::size_t>(p.y) * w + p.x] = 1;
+    }
+  }
   std::vector<Candidate> candidates;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -392,13 +439,7 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
         const std::int16_t v = value[layer][at];
         if (v < minSum || v <= 0) continue;
         const std::int32_t t = index[layer][at];
-        // Strict on one side so that a plateau yields one maximum.
-        const bool positionMax = layer == 0 && forNeighbours(x, y, [&](int dx, int dy, auto n) {
-                                   const std::int16_t u = best[n];
-                                   return (dx == 0 && dy == 0) ||
-                                          !(u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0))));
-                                 });
-        if (!positionMax) {
+        if (layer != 0 || !positionMax[static_cast<std::size_t>(y) * w + x]) {
           if (v < separateSum) continue;
           const bool nearBest =
               forNeighbours(x, y, [&](int, int, auto n) { return v >= best[n] - peakMargin; });

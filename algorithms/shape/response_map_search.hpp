@@ -20,10 +20,12 @@ struct Candidate {
   double score = 0.0;
 };
 
-// Local maxima (over position, best template per pixel) scoring at least `threshold`, best first,
-// all of them (the caller decides which to track first); and where the score has a second peak in
-// angle, the maxima over position and angle scoring at least `separateThreshold` as well
-// (response_map_search.cpp; a `separateThreshold` above 1 keeps the maxima over position only).
+// Maxima over position (best template per pixel; maxima of their 3x3 neighbourhood, strongest
+// first, kept unless a kept one lies within 2 pixels or a best there lies 0.1 above) scoring at
+// least `threshold`, best first, all of them (the caller decides which to track first); and where
+// the score has a second peak in angle, the maxima over position and angle scoring at least
+// `separateThreshold` as well (response_map_search.cpp; a `separateThreshold` above 1 keeps the
+// maxima over position only).
 // `field` is the top level's DirectionField; the search splits its rows over `threads` threads.
 // With `spread` > 0 each point takes the best response within `spread` pixels in x and y (a part
 // whose contour differs from the model's by that much; not with Polarity::IgnoreGlobal, whose sums

@@ -5,11 +5,15 @@
 // part.
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include <opencv2/imgproc.hpp>
+
 #include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/model_symmetry.hpp"
 #include "tests/shape/bracket_scenes.hpp"
 #include "tests/support/scene/parts.hpp"
 
@@ -153,6 +157,23 @@ TEST(FindShapeModelSafety, ModelSymmetriesAreTheCrossQuarterTurnsAndNoneOfTheBra
   EXPECT_NEAR(turns[1], 90, 1.0);
   EXPECT_NEAR(std::abs(turns[2]), 180, 1.0);
   EXPECT_TRUE(createShapeModel(bracketTemplate()).symmetries.empty());
+}
+
+// A disc maps onto itself at every turn (the search then seeks no second peaks in angle, its
+// score being flat in angle); the near-symmetric cross and the bracket do not.
+TEST(FindShapeModelSafety, OnlyADiscMapsOntoItselfAtEveryTurn) {
+  cv::Mat disc(90, 90, CV_8U, cv::Scalar(60));
+  cv::circle(disc, {45, 45}, 30, cv::Scalar(190), cv::FILLED, cv::LINE_AA);
+  cv::GaussianBlur(disc, disc, {}, 1.0);
+  const cv::Mat crossTemplate =
+      scene::templateScene(nearSymmetricCross(), bracketSpec({}, 31), testing::kPartGrey).render();
+  for (const auto& [templ, every] : std::vector<std::pair<cv::Mat, bool>>{
+           {disc, true}, {crossTemplate, false}, {bracketTemplate(), false}}) {
+    const ShapeModel model = createShapeModel(templ);
+    for (const ShapeLevel& level : {model.levels.front(), model.levels.back()})
+      EXPECT_EQ(mapsOntoItselfAtEveryTurn(level.points, level.angleStep), every)
+          << templ.cols << "x" << templ.rows << " template, " << level.points.size() << " points";
+  }
 }
 
 TEST(FindShapeModelSafety, FullSearchReturnsTheBestOfNearSymmetricPoses) {

@@ -88,7 +88,11 @@ TEST_P(TopLevelSearchSpread, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
   const std::vector<ShapePoint>& points = model.levels[top].points;
   ASSERT_GT(points.size(), 10u);
   ASSERT_LE(points.size(), 250u);  // the search subsamples beyond 250 points; the sums here do not
-  cv::Mat grey = testing::bracketScene({640, 480}, {{300, 220, 0.4, 1.0}, {150, 330, -2.0, 1.0}});
+  cv::Mat grey = testing::bracketScene({640, 480}, {{300, 220, 0.4, 1.0},
+                                                    {150, 330, -2.0, 1.0},
+                                                    {470, 110, 1.6, 1.0},
+                                                    {480, 360, 2.9, 1.0},
+                                                    {560, 240, -0.7, 1.0}});
   for (int l = 0; l < top; ++l) cv::pyrDown(grey, grey);
   shape_detail::DirectionField directions(grey, model.minContrast);
   directions.ensureAll();
@@ -134,13 +138,55 @@ TEST_P(TopLevelSearchSpread, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
         }
       }
 
-  // The candidates by definition: a pixel's best that no best within 2 px beats (strict towards
-  // the top-left), from `threshold`; and from `separate`, an entry (best or second) that no entry
-  // within 2 px and 2 angle steps beats, within 0.1 of every best within 2 px.
+  // The candidates by definition: from `threshold`, the pixels' bests that no best within 1 px
+  // beats (strict towards the top-left), taken strongest first (equal ones in raster order) and
+  // kept where no kept one lies within 2 px and no best there lies 0.1 above; and from `separate`,
+  // an entry (best or second) that no entry within 2 px and 2 angle steps beats, within 0.1 of
+  // every best within 2 px.
   const auto inField = [&](int x, int y) {
     return x >= 0 && y >= 0 && x < field.cols && y < field.rows;
   };
-  std::vector<std::array<int, 3>> expected;  // x, y, template
+  const auto beatenWithin = [&](int x, int y, int reach) {
+    const int v = value[0].at<int>(y, x);
+    for (int dy = -reach; dy <= reach; ++dy)
+      for (int dx = -reach; dx <= reach; ++dx) {
+        if (!inField(x + dx, y + dy) || (dx == 0 && dy == 0)) continue;
+        const int u = value[0].at<int>(y + dy, x + dx);
+        if (u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0)))) return true;
+      }
+    return false;
+  };
+  std::vector<std::array<int, 3>> peaks;  // value, y, x of the 3x3 maxima
+  for (int y = 0; y < field.rows; ++y)
+    for (int x = 0; x < field.cols; ++x) {
+      const int v = value[0].at<int>(y, x);
+      if (v > 0 && v >= static_cast<int>(threshold * norm) && !beatenWithin(x, y, 1))
+        peaks.push_back({v, y, x});
+    }
+  std::sort(peaks.begin(), peaks.end(), [](const auto& a, const auto& b) {
+    return a[0] != b[0] ? a[0] > b[0] : (a[1] != b[1] ? a[1] < b[1] : a[2] < b[2]);
+  });
+  cv::Mat kept(field.size(), CV_8U, cv::Scalar(0));
+  int strictMaxima = 0;  // maxima within 2 px: the greedy rule keeps them and more
+  for (const auto& p : peaks) {
+    const int y = p[1], x = p[2];
+    bool free = true;
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dx = -2; dx <= 2; ++dx)
+        if (inField(x + dx, y + dy) && kept.at<uchar>(y + dy, x + dx)) free = false;
+    for (int dy = -2; dy <= 2; ++dy)
+      for (int dx = -2; dx <= 2; ++dx)
+        if (inField(x + dx, y + dy) &&
+            p[0] < value[0].at<int>(y + dy, x + dx) - static_cast<int>(std::lround(0.1 * norm)))
+          free = false;
+    if (free) kept.at<uchar>(y, x) = 1;
+    if (!beatenWithin(x, y, 2)) {
+      ++strictMaxima;
+      EXPECT_TRUE(free) << "a maximum within 2 px at " << x << "," << y << " was suppressed";
+    }
+  }
+  EXPECT_GT(cv::countNonZero(kept), strictMaxima);  // the scenes have ridges: the rule is exercised
+  std::vector<std::array<int, 3>> expected;         // x, y, template
   // Candidates that are no maximum over position.
   int seconds = 0;
   for (int y = 0; y < field.rows; ++y)
@@ -148,14 +194,13 @@ TEST_P(TopLevelSearchSpread, ScoresAreTheDirectSumsAndNoLocalMaximumIsMissed) {
       for (int layer = 0; layer < 2; ++layer) {
         const int v = value[layer].at<int>(y, x), t = index[layer].at<int>(y, x);
         if (v <= 0 || v < static_cast<int>(threshold * norm)) continue;
-        bool positionMax = layer == 0, poseMax = true, nearBest = true;
+        const bool positionMax = layer == 0 && kept.at<uchar>(y, x);
+        bool poseMax = true, nearBest = true;
         for (int dy = -2; dy <= 2; ++dy)
           for (int dx = -2; dx <= 2; ++dx) {
             const int xx = x + dx, yy = y + dy;
             if (!inField(xx, yy)) continue;
             const int u = value[0].at<int>(yy, xx);
-            if ((dx != 0 || dy != 0) && (u > v || (u == v && (dy < 0 || (dy == 0 && dx < 0)))))
-              positionMax = false;
             if (v < u - static_cast<int>(std::lround(0.1 * norm))) nearBest = false;
             for (int other = 0; other < 2; ++other) {
               if (dx == 0 && dy == 0 && other == layer) continue;
