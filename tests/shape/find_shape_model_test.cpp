@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <initializer_list>
 #include <random>
 #include <sstream>
 #include <string>
@@ -614,21 +615,35 @@ void expectTheRegion(const ShapeModel& model, const TurnedPhoto& turned, double 
   EXPECT_GT(found[0].score, minScore);
 }
 
+// tests/data/photos/<file>, grey (empty, with a failure, when it is missing).
+cv::Mat testPhoto(const std::string& file) {
+  const std::string path = FACET_TEST_DATA_DIR "/photos/" + file;
+  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (photo.empty()) ADD_FAILURE() << "missing " << path;
+  return photo;
+}
+
+// expectTheRegion on copies of `photo` turned by `angleDeg` at `scale`, one per noise seed.
+void expectTheRegionInTurnedCopies(const cv::Mat& photo, const cv::Rect& region,
+                                   const ShapeModel& model, double angleDeg, double scale,
+                                   std::initializer_list<int> seeds, double minScore) {
+  for (const int seed : seeds) {
+    SCOPED_TRACE("noise seed " + std::to_string(seed));
+    expectTheRegion(model, turnedPhoto(photo, region, angleDeg, scale, seed), angleDeg, scale,
+                    minScore);
+  }
+}
+
 // A texture (tests/data/photos/baboon.png: fur) turned by -96.88 degrees, with noise: on the top
 // pyramid level the best angle at the part's pixel lay 2.3 of that level's steps from the part's,
 // the usual look on the level below found nothing there (0.47), and the part, scoring 0.99, was
 // missed. The wider look below the top is taken from such a candidate too.
 TEST(FindShapeModel, ATexturedPartWhoseTopLevelAngleIsOffIsFound) {
-  const std::string dir = FACET_TEST_DATA_DIR "/photos/";
-  const cv::Mat photo = cv::imread(dir + "baboon.png", cv::IMREAD_GRAYSCALE);
-  ASSERT_FALSE(photo.empty()) << "missing " << dir << "baboon.png";
+  const cv::Mat photo = testPhoto("baboon.png");
+  ASSERT_FALSE(photo.empty());
   const cv::Rect region(129, 285, 88, 107);
   const ShapeModel model = createShapeModel(photo(region));
-  const double angle = -96.88;
-  for (const int seed : {3, 4, 5}) {
-    SCOPED_TRACE("noise seed " + std::to_string(seed));
-    expectTheRegion(model, turnedPhoto(photo, region, angle, 1.0, seed), angle, 1.0, 0.95);
-  }
+  expectTheRegionInTurnedCopies(photo, region, model, -96.88, 1.0, {3, 4, 5}, 0.95);
 }
 
 // A calibration chessboard photographed at an angle (tests/data/photos/left12.png), turned by
@@ -637,16 +652,11 @@ TEST(FindShapeModel, ATexturedPartWhoseTopLevelAngleIsOffIsFound) {
 // as the only peak there, it was tracked to a neighbouring square's pose (0.87, 67 px off) while
 // the part scored 0.999. The second peak in angle is a candidate too.
 TEST(FindShapeModel, APartWhoseTopLevelScorePeaksAtAQuarterTurnIsFound) {
-  const std::string dir = FACET_TEST_DATA_DIR "/photos/";
-  const cv::Mat photo = cv::imread(dir + "left12.png", cv::IMREAD_GRAYSCALE);
-  ASSERT_FALSE(photo.empty()) << "missing " << dir << "left12.png";
+  const cv::Mat photo = testPhoto("left12.png");
+  ASSERT_FALSE(photo.empty());
   const cv::Rect region(247, 171, 149, 129);
   const ShapeModel model = createShapeModel(photo(region));
-  const double angle = -134.84, scale = 1.01;
-  for (const int seed : {0, 1}) {
-    SCOPED_TRACE("noise seed " + std::to_string(seed));
-    expectTheRegion(model, turnedPhoto(photo, region, angle, scale, seed), angle, scale, 0.99);
-  }
+  expectTheRegionInTurnedCopies(photo, region, model, -134.84, 1.01, {0, 1}, 0.99);
 }
 
 // Another patch of the chessboard, turned by 82.13 degrees: on the top pyramid level (1/16) the
@@ -655,16 +665,11 @@ TEST(FindShapeModel, APartWhoseTopLevelScorePeaksAtAQuarterTurnIsFound) {
 // returned (0.82) and the part (0.999) missed. The top level's maxima over position are kept by
 // greedy suppression, which keeps the part's.
 TEST(FindShapeModel, APartOnARidgeOfTheTopLevelScoreIsFound) {
-  const std::string dir = FACET_TEST_DATA_DIR "/photos/";
-  const cv::Mat photo = cv::imread(dir + "left12.png", cv::IMREAD_GRAYSCALE);
-  ASSERT_FALSE(photo.empty()) << "missing " << dir << "left12.png";
+  const cv::Mat photo = testPhoto("left12.png");
+  ASSERT_FALSE(photo.empty());
   const cv::Rect region(306, 173, 176, 144);
   const ShapeModel model = createShapeModel(photo(region));
-  const double angle = 82.13;
-  for (const int seed : {0, 1}) {
-    SCOPED_TRACE("noise seed " + std::to_string(seed));
-    expectTheRegion(model, turnedPhoto(photo, region, angle, 1.0, seed), angle, 1.0, 0.99);
-  }
+  expectTheRegionInTurnedCopies(photo, region, model, 82.13, 1.0, {0, 1}, 0.99);
 }
 
 // A chessboard patch whose model has near-symmetric turns (its top level maps onto itself at
@@ -673,17 +678,12 @@ TEST(FindShapeModel, APartOnARidgeOfTheTopLevelScoreIsFound) {
 // 0.999. The second peaks in angle were off for models with near-symmetries; they are off now
 // only for a model that every turn maps onto itself.
 TEST(FindShapeModel, ANearSymmetricPartBesideAHalfTurnOfItsPatternIsFound) {
-  const std::string dir = FACET_TEST_DATA_DIR "/photos/";
-  const cv::Mat photo = cv::imread(dir + "left12.png", cv::IMREAD_GRAYSCALE);
-  ASSERT_FALSE(photo.empty()) << "missing " << dir << "left12.png";
+  const cv::Mat photo = testPhoto("left12.png");
+  ASSERT_FALSE(photo.empty());
   const cv::Rect region(334, 102, 174, 160);
   const ShapeModel model = createShapeModel(photo(region));
   ASSERT_FALSE(model.symmetries.empty());
-  const double angle = -56.13;
-  for (const int seed : {0, 1}) {
-    SCOPED_TRACE("noise seed " + std::to_string(seed));
-    expectTheRegion(model, turnedPhoto(photo, region, angle, 1.0, seed), angle, 1.0, 0.99);
-  }
+  expectTheRegionInTurnedCopies(photo, region, model, -56.13, 1.0, {0, 1}, 0.99);
 }
 
 // The photograph of 36 packaged LEDs (tests/data/photos, case leds; reference positions by NCC).
