@@ -364,27 +364,28 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
 
   // Candidates. The maxima over position (whatever the angle), as far as they reach `threshold`:
   // the pixels' bests that are maxima of their 3x3 neighbourhood, strongest first, each kept where
-  // no kept one lies within r pixels (greedy suppression) and no best within r lies more than
-  // kPeakMargin above it. Keeping only the bests that no best within r beats lost parts on
-  // periodic patterns: on a chessboard seen at 1/16 the part's pixel (0.75) lay on a ridge rising
-  // to a neighbouring square's peak (0.84, 3 px away) and was suppressed by the ridge's next pixel
-  // (0.76), which that peak suppressed in turn; a part scoring 0.999 was missed and the square
-  // returned at 0.76. Those maxima are all kept here too.
+  // no kept one lies within kPeakReach pixels (greedy suppression) and no best that close lies
+  // more than kPeakMargin above it. Keeping only the bests that no best that close beats lost parts
+  // on periodic patterns: on a chessboard seen at 1/16 the part's pixel (0.75) lay on a ridge
+  // rising to a neighbouring square's peak (0.84, 3 px away) and was suppressed by the ridge's next
+  // pixel (0.76), which that peak suppressed in turn; a part scoring 0.999 was missed and the
+  // square returned at 0.76. Those maxima are all kept here too.
+  //
   // Where the score has two peaks in angle, the part's can be the lower one, or lie beside a
   // neighbour's higher peak at another angle: an entry (a pixel's best or second) is a candidate
-  // too where no entry within r pixels and kApartSteps angle steps is higher (a maximum over
-  // position and angle), it reaches `separateThreshold`, and it lies within kPeakMargin of the best
-  // within r pixels: only such a peak could still be the part's (as the finish picks among a
-  // part's alternatives). On a texture every pixel's best angle differs from its neighbours'; the
-  // maxima over position and angle alone were three times as many candidates as those over
-  // position.
+  // too where no entry within kPeakReach pixels and kApartSteps angle steps is higher (a maximum
+  // over position and angle), it reaches `separateThreshold`, and it lies within kPeakMargin of the
+  // best within kPeakReach pixels: only such a peak could still be the part's (as the finish picks
+  // among a part's alternatives). On a texture every pixel's best angle differs from its
+  // neighbours'; the maxima over position and angle alone were three times as many candidates as
+  // those over position.
   const auto peakMargin = static_cast<int>(std::lround(kPeakMargin * norm));
   const auto separateSum =
       static_cast<std::int16_t>(std::min(32767.0, std::max(threshold, separateThreshold) * norm));
   const std::array<const std::int16_t*, 2> value{best.data(), second.data()};
   const std::array<const std::int32_t*, 2> index{bestTemplate.data(), secondTemplate.data()};
-  constexpr int r = kPeakReach;
   // Calls f(dx, dy, offset) for the pixels within `reach` of (x, y), until it returns false.
+  // Offsets index the per-pixel arrays (rows of paddedW).
   auto forNeighbours = [&](int x, int y, auto f, int reach = kPeakReach) {
     for (int dy = -reach; dy <= reach; ++dy)
       for (int dx = -reach; dx <= reach; ++dx) {
@@ -394,7 +395,12 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
       }
     return true;
   };
-  std::vector<std::uint8_t> positionMax(static_cast<std::size_t>(w) * h, 0);
+  // Whether `v` lies within kPeakMargin of every best within kPeakReach of (x, y): only such a peak
+  // could still be the part's beside a higher one.
+  auto nearTheBest = [&](int x, int y, int v) {
+    return forNeighbours(x, y, [&](int, int, auto n) { return v >= best[n] - peakMargin; });
+  };
+  std::vector<std::uint8_t> positionMax(best.size(), 0);
   {
     struct Peak {
       int x, y;
@@ -420,15 +426,10 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
     std::stable_sort(peaks.begin(), peaks.end(),
                      [](const Peak& a, const Peak& b) { return a.v > b.v; });
     for (const Peak& p : peaks) {
-      bool free = true;
-      for (int yy = std::max(0, p.y - r); free && yy <= std::min(h - 1, p.y + r); ++yy)
-        for (int xx = std::max(0, p.x - r); free && xx <= std::min(w - 1, p.x + r); ++xx)
-          free = !positionMax[static_cast<std::size_t>(yy) * w + xx];
-      // Beside a higher best within r, only a maximum within kPeakMargin of it could still be
-      // the part's (as for the second peaks below; a maximum no best within r beats always is).
-      if (free &&
-          forNeighbours(p.x, p.y, [&](int, int, auto n) { return p.v >= best[n] - peakMargin; }))
-        positionMax[static_cast<std::size_t>(p.y) * w + p.x] = 1;
+      const bool free = forNeighbours(p.x, p.y, [&](int, int, auto n) { return !positionMax[n]; });
+      // A maximum that no best within kPeakReach beats is always near the best.
+      if (free && nearTheBest(p.x, p.y, p.v))
+        positionMax[static_cast<std::size_t>(p.y) * paddedW + p.x] = 1;
     }
   }
   std::vector<Candidate> candidates;
@@ -439,11 +440,8 @@ std::vector<Candidate> searchTopLevel(const cv::Mat& field,
         const std::int16_t v = value[layer][at];
         if (v < minSum || v <= 0) continue;
         const std::int32_t t = index[layer][at];
-        if (layer != 0 || !positionMax[static_cast<std::size_t>(y) * w + x]) {
-          if (v < separateSum) continue;
-          const bool nearBest =
-              forNeighbours(x, y, [&](int, int, auto n) { return v >= best[n] - peakMargin; });
-          if (!nearBest) continue;
+        if (layer != 0 || !positionMax[at]) {
+          if (v < separateSum || !nearTheBest(x, y, v)) continue;
           const bool poseMax = forNeighbours(x, y, [&](int dx, int dy, auto n) {
             for (int other = 0; other < 2; ++other) {
               if (dx == 0 && dy == 0 && other == layer) continue;
