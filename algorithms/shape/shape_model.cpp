@@ -230,6 +230,33 @@ std::vector<ShapePoint> finePointsOf(const cv::Mat& templateImage, cv::Rect regi
   return points;
 }
 
+// The template region with the image around it. Each level's gradients near the region's border
+// then come from the pixels a search image has there too, as its pyramid is built from the whole
+// scene, rather than from the region reflected at its border. On a coarse level much of a small
+// template lies within reach of its border (a 176x144 region is 22x18 pixels at 1/8): the
+// reflected copy turned points up to 12 degrees from the image's gradient and smoothed away edges
+// that the scene's pyramid keeps there. Where the image ends, the reflection stays, as in the
+// search image's pyramid.
+struct TemplateSurroundings {
+  cv::Rect outer;    // in template image pixels
+  cv::Point offset;  // of the region within `outer`: a multiple of 2^(levels-1), so that every
+                     // level of the surroundings' pyramid samples the region's own grid
+};
+
+TemplateSurroundings templateSurroundings(const cv::Mat& image, cv::Rect region, int levels) {
+  const int grid = 1 << (levels - 1);
+  // A pixel of level l depends on level-0 pixels up to about 3 * 2^l away (the pyramid's 5-tap
+  // filters, then the 3x3 Sobel).
+  const int reach = 3 * grid;
+  const auto before = [&](int room) { return std::min(reach, room) / grid * grid; };
+  const int left = before(region.x), top = before(region.y);
+  const int right = std::min(reach, image.cols - region.br().x);
+  const int bottom = std::min(reach, image.rows - region.br().y);
+  return {cv::Rect(region.x - left, region.y - top, region.width + left + right,
+                   region.height + top + bottom),
+          cv::Point(left, top)};
+}
+
 void checkParams(const cv::Mat& image, const ShapeModelParams& p) {
   if (image.empty()) throw ShapeModelError("shape model: the template image is empty");
   if (image.channels() != 1 || (image.depth() != CV_8U && image.depth() != CV_16U))
@@ -286,15 +313,18 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   model.minContrast = params.minContrast;
   model.edgeEstimator = params.edgeEstimator.value_or(EdgeEstimator::ProfileFit);
 
-  cv::Mat grey = toGreyFloat(templateImage(region));
   const int wanted = params.numLevels > 0 ? params.numLevels : kMaxAutoLevels;
+  const TemplateSurroundings surroundings = templateSurroundings(templateImage, region, wanted);
+  cv::Mat grey = toGreyFloat(templateImage(surroundings.outer));
+  cv::Size regionSize = region.size();  // on the current level
   double radius0 = 0.0;
   cv::Mat modelEdges;  // level-0 edge pixels, widened by one pixel
   for (int level = 0; level < wanted; ++level) {
     if (level > 0) {
-      if (grey.cols < 4 || grey.rows < 4) break;
+      if (regionSize.width < 4 || regionSize.height < 4) break;
       cv::pyrDown(grey, grey);
-      if (!mask.empty()) cv::resize(mask, mask, grey.size(), 0, 0, cv::INTER_NEAREST);
+      regionSize = {(regionSize.width + 1) / 2, (regionSize.height + 1) / 2};
+      if (!mask.empty()) cv::resize(mask, mask, regionSize, 0, 0, cv::INTER_NEAREST);
     }
     const double f = std::ldexp(1.0, -level);
     // Level 0 decides (automatic: whether the short components are the part); the levels above
@@ -303,8 +333,16 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     const int minComponentSize = level == 0
                                      ? params.minComponentSize.value_or(kAutoMinComponentSize)
                                      : static_cast<int>(model.minComponentSize * f);
+    // The region on this level within the surroundings' pyramid; only its pixels give points.
+    const cv::Point offset(surroundings.offset.x >> level, surroundings.offset.y >> level);
+    const cv::Rect regionOnLevel(offset, regionSize);
+    cv::Mat levelMask(grey.size(), CV_8U, cv::Scalar(0));
+    if (mask.empty())
+      levelMask(regionOnLevel).setTo(255);
+    else
+      mask.copyTo(levelMask(regionOnLevel));
     LevelResult r = levelPoints(
-        grey, mask, model.referencePoint * f, params,
+        grey, levelMask, model.referencePoint * f + cv::Point2d(offset), params,
         level == 0 ? params.maxPoints
                    : (params.maxPoints > 0 ? std::min(params.maxPoints, kMaxUpperLevelPoints)
                                            : kMaxUpperLevelPoints),
@@ -322,7 +360,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
             ")");
       model.contrastLow = r.thresholds.low;
       model.contrastHigh = r.thresholds.high;
-      cv::dilate(r.edgeMask, modelEdges, cv::Mat());
+      cv::dilate(r.edgeMask(regionOnLevel), modelEdges, cv::Mat());
     }
     cv::Size2d box;
     const double radius = extentOf(r.points, box);

@@ -42,6 +42,8 @@ struct EdgeEstimatorTrial {
 
 struct ShapeModelParams {
   // Region of the template image that holds the part, image pixels; empty = the whole image.
+  // The image around the region is read too: every level sees near the region's border what a
+  // search image's pyramid sees there, but only the region's pixels give model points.
   cv::Rect roi;
   // Optional 8-bit mask of the template's size (or of the roi's size when roi is set): only
   // edges on non-zero pixels belong to the model. Empty = every pixel.

@@ -1,12 +1,17 @@
 // createShapeModel: what a trained model holds, and how each training parameter shapes it.
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "algorithms/shape/find_shape_model.hpp"
+#include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/shape_model.hpp"
+#include "algorithms/shape/shape_similarity.hpp"
 #include "tests/shape/bracket_scenes.hpp"
 
 namespace facet {
@@ -227,6 +232,69 @@ TEST(ShapeModel, SixteenBitTemplateGivesTheSameModel) {
   EXPECT_NEAR(static_cast<double>(m16.levels[0].points.size()),
               static_cast<double>(m8.levels[0].points.size()), 0.1 * m8.levels[0].points.size());
   EXPECT_NEAR(m8.radius(), m16.radius(), 1.0);
+}
+
+// How far, at worst, a model's points on each level point away from the gradient of the image's own
+// pyramid at their pixels (built as a search builds it, from the whole image), as the least dot
+// product of the two unit directions; and how many points lie outside `region`.
+struct LevelAgreement {
+  std::vector<double> leastDot;
+  int outside = 0;
+};
+
+LevelAgreement agreementWithImagePyramid(const cv::Mat& image, const ShapeModel& model,
+                                         cv::Rect region, cv::Point reference) {
+  LevelAgreement agreement;
+  cv::Mat grey = shape_detail::toGreyFloat(image);
+  for (int l = 0; l < model.numLevels(); ++l) {
+    if (l > 0) cv::pyrDown(grey, grey);
+    cv::Mat gx, gy;
+    shape_detail::sobelGradients(grey, gx, gy);
+    const cv::Rect onLevel(region.x >> l, region.y >> l, (region.width + (1 << l) - 1) >> l,
+                           (region.height + (1 << l) - 1) >> l);
+    double least = 1.0;
+    for (const ShapePoint& p : model.levels[static_cast<std::size_t>(l)].points) {
+      const cv::Point at(cvRound(p.position.x) + (reference.x >> l),
+                         cvRound(p.position.y) + (reference.y >> l));
+      if (!onLevel.contains(at)) {
+        ++agreement.outside;
+        continue;
+      }
+      const cv::Point2f g(gx.at<float>(at), gy.at<float>(at));
+      least = std::min(least, static_cast<double>(g.dot(p.direction)) / cv::norm(g));
+    }
+    agreement.leastDot.push_back(least);
+  }
+  return agreement;
+}
+
+// A region of a textured photograph trained in place: near the region's border a level's
+// gradients come from the photograph around it, as in the pyramid of a scene that shows the part,
+// so each point's direction is the one a search of that image finds there, on every level.
+// Trained from the region cut out, the points near its border read a reflected copy instead.
+TEST(ShapeModel, ARegionIsTrainedOnThePyramidOfItsImage) {
+  const std::string path = FACET_TEST_DATA_DIR "/photos/baboon.png";
+  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(photo.empty()) << "missing " << path;
+  // Corners and reference point on multiples of 32: whole pixels on every level.
+  const cv::Rect region(192, 160, 160, 128);
+  const cv::Point reference(192 + 96, 160 + 64);
+  ShapeModelParams inPlace;
+  inPlace.roi = region;
+  inPlace.referencePoint = cv::Point2d(reference);
+  const ShapeModel model = createShapeModel(photo, inPlace);
+  ASSERT_GE(model.numLevels(), 3);
+  const LevelAgreement trained = agreementWithImagePyramid(photo, model, region, reference);
+  EXPECT_EQ(trained.outside, 0);
+  for (const double dot : trained.leastDot) EXPECT_GT(dot, 0.9999);
+
+  ShapeModelParams cutOut;
+  cutOut.referencePoint = cv::Point2d(reference - region.tl());
+  const ShapeModel cutModel = createShapeModel(photo(region).clone(), cutOut);
+  const LevelAgreement cut = agreementWithImagePyramid(photo, cutModel, region, reference);
+  EXPECT_EQ(cut.outside, 0);
+  EXPECT_LT(*std::min_element(cut.leastDot.begin(), cut.leastDot.end()), 0.99)
+      << "the cut-out region's reflected border does not show: the test sees no difference";
 }
 
 }  // namespace
