@@ -235,11 +235,12 @@ std::vector<ShapePoint> finePointsOf(const cv::Mat& templateImage, cv::Rect regi
 // scene, rather than from the region reflected at its border. On a coarse level much of a small
 // template lies within reach of its border (a 176x144 region is 22x18 pixels at 1/8): the
 // reflected copy turned points up to 12 degrees from the image's gradient and smoothed away edges
-// that the scene's pyramid keeps there. Where the image ends, the reflection stays, as in the
-// search image's pyramid.
+// that the scene's pyramid keeps there. Where the image ends, it is reflected, as the search
+// image's pyramid reflects its own border; a template image holding only the part has no
+// surroundings at all, and is reflected at its border as before.
 struct TemplateSurroundings {
-  cv::Rect outer;    // in template image pixels
-  cv::Point offset;  // of the region within `outer`: a multiple of 2^(levels-1), so that every
+  cv::Mat pixels;    // the region and its surroundings
+  cv::Point offset;  // of the region within `pixels`: a multiple of 2^(levels-1), so that every
                      // level of the surroundings' pyramid samples the region's own grid
 };
 
@@ -248,13 +249,23 @@ TemplateSurroundings templateSurroundings(const cv::Mat& image, cv::Rect region,
   // A pixel of level l depends on level-0 pixels up to about 3 * 2^l away (the pyramid's 5-tap
   // filters, then the 3x3 Sobel).
   const int reach = 3 * grid;
-  const auto before = [&](int room) { return std::min(reach, room) / grid * grid; };
+  // Before the region the margin is whole top-level pixels; the image's own pixels where it has
+  // them, its reflection for the rest.
+  const auto before = [&](int room) { return std::min(reach, (room + grid - 1) / grid * grid); };
   const int left = before(region.x), top = before(region.y);
   const int right = std::min(reach, image.cols - region.br().x);
   const int bottom = std::min(reach, image.rows - region.br().y);
-  return {cv::Rect(region.x - left, region.y - top, region.width + left + right,
-                   region.height + top + bottom),
-          cv::Point(left, top)};
+  const int inLeft = std::min(left, region.x), inTop = std::min(top, region.y);
+  const cv::Rect inside(region.x - inLeft, region.y - inTop, region.width + inLeft + right,
+                        region.height + inTop + bottom);
+  TemplateSurroundings s{image(inside), cv::Point(left, top)};
+  if (inLeft < left || inTop < top) {
+    cv::Mat padded;
+    cv::copyMakeBorder(s.pixels, padded, top - inTop, 0, left - inLeft, 0,
+                       cv::BORDER_REFLECT_101 | cv::BORDER_ISOLATED);
+    s.pixels = padded;
+  }
+  return s;
 }
 
 void checkParams(const cv::Mat& image, const ShapeModelParams& p) {
@@ -315,7 +326,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
 
   const int wanted = params.numLevels > 0 ? params.numLevels : kMaxAutoLevels;
   const TemplateSurroundings surroundings = templateSurroundings(templateImage, region, wanted);
-  cv::Mat grey = toGreyFloat(templateImage(surroundings.outer));
+  cv::Mat grey = toGreyFloat(surroundings.pixels);
   cv::Size regionSize = region.size();  // on the current level
   double radius0 = 0.0;
   cv::Mat modelEdges;  // level-0 edge pixels, widened by one pixel

@@ -297,5 +297,26 @@ TEST(ShapeModel, ARegionIsTrainedOnThePyramidOfItsImage) {
       << "the cut-out region's reflected border does not show: the test sees no difference";
 }
 
+// Regions on or near the image's edges, where the image is reflected as the search image's pyramid
+// reflects it: trained without error, level 0 exactly as the image's own gradients.
+TEST(ShapeModel, ARegionAtTheImagesEdgeIsTrainedInPlace) {
+  const std::string path = FACET_TEST_DATA_DIR "/photos/baboon.png";
+  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  ASSERT_FALSE(photo.empty()) << "missing " << path;
+  for (const cv::Rect region : {cv::Rect(0, 0, 160, 128), cv::Rect(5, 3, 160, 128),
+                                cv::Rect(photo.cols - 160, photo.rows - 128, 160, 128),
+                                cv::Rect(37, photo.rows - 131, 150, 131)}) {
+    SCOPED_TRACE(::testing::Message() << "region " << region);
+    const cv::Point reference(region.x + 64, region.y + 64);
+    ShapeModelParams inPlace;
+    inPlace.roi = region;
+    inPlace.referencePoint = cv::Point2d(reference);
+    const ShapeModel model = createShapeModel(photo, inPlace);
+    EXPECT_GE(model.numLevels(), 3);
+    const LevelAgreement trained = agreementWithImagePyramid(photo, model, region, reference);
+    EXPECT_GT(trained.leastDot.front(), 0.9999);
+  }
+}
+
 }  // namespace
 }  // namespace facet
