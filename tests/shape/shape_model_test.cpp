@@ -268,21 +268,32 @@ LevelAgreement agreementWithImagePyramid(const cv::Mat& image, const ShapeModel&
   return agreement;
 }
 
+// tests/data/photos/baboon.png, grey: texture up to any region's border.
+cv::Mat baboonPhoto() {
+  const std::string path = FACET_TEST_DATA_DIR "/photos/baboon.png";
+  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
+  if (photo.empty()) ADD_FAILURE() << "missing " << path;
+  return photo;
+}
+
+ShapeModel trainedInPlace(const cv::Mat& image, cv::Rect region, cv::Point reference) {
+  ShapeModelParams inPlace;
+  inPlace.roi = region;
+  inPlace.referencePoint = cv::Point2d(reference);
+  return createShapeModel(image, inPlace);
+}
+
 // A region of a textured photograph trained in place: near the region's border a level's
 // gradients come from the photograph around it, as in the pyramid of a scene that shows the part,
 // so each point's direction is the one a search of that image finds there, on every level.
 // Trained from the region cut out, the points near its border read a reflected copy instead.
 TEST(ShapeModel, ARegionIsTrainedOnThePyramidOfItsImage) {
-  const std::string path = FACET_TEST_DATA_DIR "/photos/baboon.png";
-  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  ASSERT_FALSE(photo.empty()) << "missing " << path;
+  const cv::Mat photo = baboonPhoto();
+  ASSERT_FALSE(photo.empty());
   // Corners and reference point on multiples of 32: whole pixels on every level.
   const cv::Rect region(192, 160, 160, 128);
   const cv::Point reference(192 + 96, 160 + 64);
-  ShapeModelParams inPlace;
-  inPlace.roi = region;
-  inPlace.referencePoint = cv::Point2d(reference);
-  const ShapeModel model = createShapeModel(photo, inPlace);
+  const ShapeModel model = trainedInPlace(photo, region, reference);
   ASSERT_GE(model.numLevels(), 3);
   const LevelAgreement trained = agreementWithImagePyramid(photo, model, region, reference);
   EXPECT_EQ(trained.outside, 0);
@@ -300,18 +311,14 @@ TEST(ShapeModel, ARegionIsTrainedOnThePyramidOfItsImage) {
 // Regions on or near the image's edges, where the image is reflected as the search image's pyramid
 // reflects it: trained without error, level 0 exactly as the image's own gradients.
 TEST(ShapeModel, ARegionAtTheImagesEdgeIsTrainedInPlace) {
-  const std::string path = FACET_TEST_DATA_DIR "/photos/baboon.png";
-  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  ASSERT_FALSE(photo.empty()) << "missing " << path;
+  const cv::Mat photo = baboonPhoto();
+  ASSERT_FALSE(photo.empty());
   for (const cv::Rect region : {cv::Rect(0, 0, 160, 128), cv::Rect(5, 3, 160, 128),
                                 cv::Rect(photo.cols - 160, photo.rows - 128, 160, 128),
                                 cv::Rect(37, photo.rows - 131, 150, 131)}) {
     SCOPED_TRACE(::testing::Message() << "region " << region);
     const cv::Point reference(region.x + 64, region.y + 64);
-    ShapeModelParams inPlace;
-    inPlace.roi = region;
-    inPlace.referencePoint = cv::Point2d(reference);
-    const ShapeModel model = createShapeModel(photo, inPlace);
+    const ShapeModel model = trainedInPlace(photo, region, reference);
     EXPECT_GE(model.numLevels(), 3);
     const LevelAgreement trained = agreementWithImagePyramid(photo, model, region, reference);
     EXPECT_GT(trained.leastDot.front(), 0.9999);
