@@ -344,7 +344,9 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     const int minComponentSize = level == 0
                                      ? params.minComponentSize.value_or(kAutoMinComponentSize)
                                      : static_cast<int>(model.minComponentSize * f);
-    // The region on this level within the surroundings' pyramid; only its pixels give points.
+    // The region on this level within the surroundings' pyramid; only its pixels give points,
+    // its outermost ones too where the image goes on around them (their gradients are then the
+    // image's; a template without surroundings loses them to its replicated border).
     const cv::Point offset(surroundings.offset.x >> level, surroundings.offset.y >> level);
     const cv::Rect regionOnLevel(offset, regionSize);
     cv::Mat levelMask(grey.size(), CV_8U, cv::Scalar(0));
