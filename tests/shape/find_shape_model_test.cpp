@@ -16,12 +16,14 @@
 #include "tests/shape/bracket_scenes.hpp"
 #include "tests/shape/nested_part_scenes.hpp"
 #include "tests/shape/photo_occlusion.hpp"
+#include "tests/shape/test_photos.hpp"
 
 namespace facet {
 namespace {
 
 using testing::bracketScene;
 using testing::bracketTemplate;
+using testing::testPhoto;
 
 const ShapeModel& bracketModel() {
   static const ShapeModel model = createShapeModel(bracketTemplate());
@@ -613,14 +615,6 @@ void expectTheRegion(const ShapeModel& model, const TurnedPhoto& turned, double 
   EXPECT_NEAR(found[0].angle, radians(angleDeg), radians(0.1));
   EXPECT_NEAR(found[0].scale, scale, 0.002);
   EXPECT_GT(found[0].score, minScore);
-}
-
-// tests/data/photos/<file>, grey (empty, with a failure, when it is missing).
-cv::Mat testPhoto(const std::string& file) {
-  const std::string path = FACET_TEST_DATA_DIR "/photos/" + file;
-  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (photo.empty()) ADD_FAILURE() << "missing " << path;
-  return photo;
 }
 
 // expectTheRegion on copies of `photo` turned by `angleDeg` at `scale`, one per noise seed.

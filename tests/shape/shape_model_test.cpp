@@ -5,7 +5,6 @@
 #include <vector>
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "algorithms/shape/find_shape_model.hpp"
@@ -13,6 +12,7 @@
 #include "algorithms/shape/shape_model.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
 #include "tests/shape/bracket_scenes.hpp"
+#include "tests/shape/test_photos.hpp"
 
 namespace facet {
 namespace {
@@ -268,14 +268,6 @@ LevelAgreement agreementWithImagePyramid(const cv::Mat& image, const ShapeModel&
   return agreement;
 }
 
-// tests/data/photos/baboon.png, grey: texture up to any region's border.
-cv::Mat baboonPhoto() {
-  const std::string path = FACET_TEST_DATA_DIR "/photos/baboon.png";
-  const cv::Mat photo = cv::imread(path, cv::IMREAD_GRAYSCALE);
-  if (photo.empty()) ADD_FAILURE() << "missing " << path;
-  return photo;
-}
-
 ShapeModel trainedInPlace(const cv::Mat& image, cv::Rect region, cv::Point reference) {
   ShapeModelParams inPlace;
   inPlace.roi = region;
@@ -288,7 +280,7 @@ ShapeModel trainedInPlace(const cv::Mat& image, cv::Rect region, cv::Point refer
 // so each point's direction is the one a search of that image finds there, on every level.
 // Trained from the region cut out, the points near its border read a reflected copy instead.
 TEST(ShapeModel, ARegionIsTrainedOnThePyramidOfItsImage) {
-  const cv::Mat photo = baboonPhoto();
+  const cv::Mat photo = testing::testPhoto("baboon.png");  // fur: texture everywhere
   ASSERT_FALSE(photo.empty());
   // Corners and reference point on multiples of 32: whole pixels on every level.
   const cv::Rect region(192, 160, 160, 128);
@@ -311,7 +303,7 @@ TEST(ShapeModel, ARegionIsTrainedOnThePyramidOfItsImage) {
 // Regions on or near the image's edges, where the image is reflected as the search image's pyramid
 // reflects it: trained without error, level 0 exactly as the image's own gradients.
 TEST(ShapeModel, ARegionAtTheImagesEdgeIsTrainedInPlace) {
-  const cv::Mat photo = baboonPhoto();
+  const cv::Mat photo = testing::testPhoto("baboon.png");  // fur: texture everywhere
   ASSERT_FALSE(photo.empty());
   for (const cv::Rect region : {cv::Rect(0, 0, 160, 128), cv::Rect(5, 3, 160, 128),
                                 cv::Rect(photo.cols - 160, photo.rows - 128, 160, 128),
