@@ -28,11 +28,6 @@ constexpr Turn kTurns[] = {{-5.5, 0.31, -0.17}, {-4.0, -0.12, 0.27}, {-2.5, 0.46
                            {4.0, -0.37, -0.29}, {5.5, 0.08, -0.44}};
 constexpr double kSearchHalfRange = 2.0 * std::numbers::pi / 180.0;  // around the known angle
 
-// The zero crossing replaces the profile fit only when the copies show it better beyond their
-// own scatter: its mean error lower by more than twice the standard error of the paired
-// differences (a one-sided test at about 2.5%, whatever the part).
-constexpr double kSignificance = 2.0;
-
 double poseError(const ShapeModel& model, const Pose2D& found, const Pose2D& truth) {
   const Pose2D::Map f = found.map(), t = truth.map();
   double sum = 0.0;
@@ -43,24 +38,23 @@ double poseError(const ShapeModel& model, const Pose2D& found, const Pose2D& tru
   return std::sqrt(sum / static_cast<double>(model.finePoints.size()));
 }
 
-// True when `better`'s errors are lower than `than`'s, copy by copy, beyond their scatter. A copy
-// that one of them did not find counts for the other.
-bool clearlyBetter(const std::vector<double>& better, const std::vector<double>& than) {
-  std::vector<double> gain;
-  for (std::size_t i = 0; i < better.size(); ++i) {
-    if (std::isinf(better[i]) && std::isinf(than[i])) continue;
-    if (std::isinf(better[i])) return false;
+// True when `errors` are lower than `than` on average, copy by copy. A copy that one of them did
+// not find counts for the other. No margin favours either estimator: where the profile fit is
+// the better (rendered blurred steps) it wins the trial by a factor of 3, while a margin for it
+// (twice the copies' standard error, the earlier rule) kept it on parts cut from photographs
+// where the zero crossing is the better: on bench_turned_photos' 1200 cases the 90% quantile of
+// the pose error was 0.085-0.139 px per seed with the margin, 0.065-0.126 px without.
+bool findsCopiesBetter(const std::vector<double>& errors, const std::vector<double>& than) {
+  double gain = 0.0;
+  int compared = 0;
+  for (std::size_t i = 0; i < errors.size(); ++i) {
+    if (std::isinf(errors[i]) && std::isinf(than[i])) continue;
+    if (std::isinf(errors[i])) return false;
     if (std::isinf(than[i])) return true;
-    gain.push_back(than[i] - better[i]);
+    gain += than[i] - errors[i];
+    ++compared;
   }
-  if (gain.size() < 2) return false;
-  const double n = static_cast<double>(gain.size());
-  double mean = 0.0, var = 0.0;
-  for (const double g : gain) mean += g;
-  mean /= n;
-  for (const double g : gain) var += (g - mean) * (g - mean);
-  const double standardError = std::sqrt(var / (n - 1.0) / n);
-  return mean > kSignificance * standardError;
+  return compared > 0 && gain > 0.0;
 }
 
 }  // namespace
@@ -73,8 +67,9 @@ EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
   for (const ShapeModel* model : candidates)
     if (model->referencePoint != candidates.front()->referencePoint)
       throw std::invalid_argument("chooseEdgeEstimator: the candidates' reference points differ");
-  // The copies lie on a canvas a quarter larger, the template's border repeated, so that turned
-  // corners of the part stay in view.
+  // The copies lie on a canvas a quarter larger, so that turned corners of the part stay in view:
+  // the image around a region where it has one (copyMakeBorder reads beyond a region of a larger
+  // image), the template's border repeated beyond.
   const int margin = std::max(templateImage.cols, templateImage.rows) / 8 + 4;
   cv::Mat canvas;
   cv::copyMakeBorder(templateImage, canvas, margin, margin, margin, margin, cv::BORDER_REPLICATE);
@@ -120,7 +115,7 @@ EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
     (choice.trials[i].estimator == EdgeEstimator::ProfileFit ? profile : zeroCrossing) = i;
   if (profile < 0) {
     choice.chosen = EdgeEstimator::FacetZeroCrossing;
-  } else if (zeroCrossing >= 0 && clearlyBetter(errors[zeroCrossing], errors[profile])) {
+  } else if (zeroCrossing >= 0 && findsCopiesBetter(errors[zeroCrossing], errors[profile])) {
     choice.chosen = EdgeEstimator::FacetZeroCrossing;
   }
   return choice;

@@ -22,10 +22,10 @@ struct EdgeEstimatorChoice {
 };
 
 // Tries `candidates` (models trained from the same template and parameters, one per estimator;
-// each model's edgeEstimator says which) on turned copies of `templateImage` (the trained region
-// only, the model's reference point in its pixels) and returns the estimator that reproduces the
-// poses best. The profile fit is kept unless the zero crossing is better beyond the copies' own
-// scatter (a paired test of their errors, copy by copy). Candidates whose reference points differ
+// each model's edgeEstimator says which) on turned copies of `templateImage` (the trained region,
+// the model's reference point in its pixels; where it is a region of a larger image, the copies
+// show that image around it) and returns the estimator that reproduces the poses best: the lower
+// mean error, copy by copy (the profile fit on a tie). Candidates whose reference points differ
 // are refused (std::invalid_argument): each turned copy serves them all.
 EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
                                         const std::vector<const ShapeModel*>& candidates);
