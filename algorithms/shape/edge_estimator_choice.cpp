@@ -28,16 +28,6 @@ constexpr Turn kTurns[] = {{-5.5, 0.31, -0.17}, {-4.0, -0.12, 0.27}, {-2.5, 0.46
                            {4.0, -0.37, -0.29}, {5.5, 0.08, -0.44}};
 constexpr double kSearchHalfRange = 2.0 * std::numbers::pi / 180.0;  // around the known angle
 
-double poseError(const ShapeModel& model, const Pose2D& found, const Pose2D& truth) {
-  const Pose2D::Map f = found.map(), t = truth.map();
-  double sum = 0.0;
-  for (const ShapePoint& p : model.finePoints) {
-    const cv::Point2d d = f(cv::Point2d(p.position)) - t(cv::Point2d(p.position));
-    sum += d.dot(d);
-  }
-  return std::sqrt(sum / static_cast<double>(model.finePoints.size()));
-}
-
 // True when `errors` are lower than `than` on average, copy by copy. A copy that one of them did
 // not find counts for the other. No margin favours either estimator: where the profile fit is
 // the better (rendered blurred steps) it wins the trial by a factor of 3, while a margin for it
@@ -100,7 +90,7 @@ EdgeEstimatorChoice chooseEdgeEstimator(const cv::Mat& templateImage,
         const std::vector<ShapeMatch> matches = findShapeModel(copy, *candidates[c], find);
         errors[c][static_cast<std::size_t>(i)] =
             matches.empty() ? std::numeric_limits<double>::infinity()
-                            : poseError(*candidates[c], matches.front().pose(), truth);
+                            : candidates[c]->pointsDistance(matches.front().pose(), truth);
       }
     }
   });

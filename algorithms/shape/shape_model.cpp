@@ -296,6 +296,16 @@ double ShapeModel::radius() const {
   return levels.empty() ? 0.0 : extentOf(levels.front().points, box);
 }
 
+double ShapeModel::pointsDistance(const Pose2D& a, const Pose2D& b) const {
+  const Pose2D::Map mapA = a.map(), mapB = b.map();
+  double sum = 0.0;
+  for (const ShapePoint& p : finePoints) {
+    const cv::Point2d d = mapA(cv::Point2d(p.position)) - mapB(cv::Point2d(p.position));
+    sum += d.dot(d);
+  }
+  return finePoints.empty() ? 0.0 : std::sqrt(sum / static_cast<double>(finePoints.size()));
+}
+
 ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams& params) {
   checkParams(templateImage, params);
   const cv::Rect region =

@@ -14,6 +14,7 @@
 
 #include <opencv2/core.hpp>
 
+#include "algorithms/geometry/pose2d.hpp"
 #include "algorithms/shape/model_symmetry.hpp"
 
 namespace facet {
@@ -141,6 +142,10 @@ struct ShapeModel {
   [[nodiscard]] int numLevels() const { return static_cast<int>(levels.size()); }
   // Largest distance of a level-0 point from the reference point, pixels.
   [[nodiscard]] double radius() const;
+  // How far pose `a` puts the subpixel points from where pose `b` puts them: RMS, pixels. The
+  // error of a found pose over the whole part, which its angle and scale enter as well as its
+  // place.
+  [[nodiscard]] double pointsDistance(const Pose2D& a, const Pose2D& b) const;
 };
 
 // Thrown for templates that give no usable model (no edges, empty image, bad parameters).
