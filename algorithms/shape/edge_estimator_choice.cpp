@@ -32,8 +32,9 @@ constexpr double kSearchHalfRange = 2.0 * std::numbers::pi / 180.0;  // around t
 // not find counts for the other. No margin favours either estimator: where the profile fit is
 // the better (rendered blurred steps) it wins the trial by a factor of 3, while a margin for it
 // (twice the copies' standard error, the earlier rule) kept it on parts cut from photographs
-// where the zero crossing is the better: on bench_turned_photos' 1200 cases the 90% quantile of
-// the pose error was 0.085-0.139 px per seed with the margin, 0.065-0.126 px without.
+// where the zero crossing is the better: in bench_turned_photos (seeds 41-131) the 90% quantile
+// of the pose error over the model's points was 0.091-0.138 px per seed with the margin,
+// 0.065-0.118 px without; with --capture 0.088-0.131 and 0.077-0.098 px.
 bool findsCopiesBetter(const std::vector<double>& errors, const std::vector<double>& than) {
   double gain = 0.0;
   int compared = 0;
