@@ -81,9 +81,9 @@ TEST(EdgeEstimatorChoice, SharpenedContoursAFewPixelsApartTakeTheZeroCrossingAnd
 
 // A chip on a photographed circuit board (tests/data/photos/README.md, board_qfp44), trained on
 // its region of the photograph: the zero crossing finds the turned copies a little better, within
-// their scatter. It is chosen, and it is the better in a scene the trial never saw (the whole
-// photograph turned by -117 degrees at scale 0.99, an exact reference): the profile fit takes in
-// the pins' neighbouring edges.
+// their scatter (where the profile fit was kept while a margin favoured it). It is chosen, and it
+// is the better in a scene the trial never saw: the whole photograph turned by -117 degrees at
+// scale 0.99, an exact reference.
 TEST(EdgeEstimatorChoice, ThePhotographedChipTakesTheEstimatorThatFoundItsCopiesBetter) {
   const cv::Mat photo = testing::testPhoto("board_source.jpg");
   const cv::Mat scene = testing::testPhoto("board_qfp44_scene.png");
