@@ -86,12 +86,11 @@ cv::Mat cameraImage(const cv::Mat& fine) {
   return image;
 }
 
-// Up to `count` cases of one photograph; none where no region has edges enough. With `capture`,
-// `fine` is the scene at twice the camera's resolution (even sizes); otherwise it is the camera's
-// image itself.
-std::vector<Case> casesOf(const std::string& name, const cv::Mat& fine, bool capture, int count,
-                          std::mt19937_64& rng) {
-  const cv::Mat photo = capture ? cameraImage(fine) : fine;
+// Up to `count` cases of one photograph; none where no region has edges enough. `photo` is the
+// camera's image; with `capture` it is cameraImage(fine) of the scene at twice the camera's
+// resolution (even sizes), otherwise `fine` is `photo` itself.
+std::vector<Case> casesOf(const std::string& name, const cv::Mat& fine, const cv::Mat& photo,
+                          bool capture, int count, std::mt19937_64& rng) {
   // Camera pixels <-> pixels of `fine` (pixel centres: camera x covers fine 2x and 2x + 1).
   const double ratio = capture ? 2.0 : 1.0;
   const double shift = capture ? 0.5 : 0.0;
@@ -283,7 +282,7 @@ int main(int argc, char** argv) {
       if (capture) photo = photo(cv::Rect(0, 0, photo.cols & ~1, photo.rows & ~1));
       // The image the model is trained on: the camera's.
       const cv::Mat camera = capture ? cameraImage(photo) : photo;
-      for (const Case& c : casesOf(path.filename().string(), photo, capture, 3, rng)) {
+      for (const Case& c : casesOf(path.filename().string(), photo, camera, capture, 3, rng)) {
         ShapeModel model;
         try {
           ShapeModelParams region;
