@@ -10,6 +10,7 @@
 #include "algorithms/edges/subpixel_edges.hpp"
 #include "algorithms/shape/edge_estimator_choice.hpp"
 #include "algorithms/shape/image_gradients.hpp"
+#include "algorithms/shape/pyramid_depth_check.hpp"
 
 namespace facet {
 namespace {
@@ -415,6 +416,23 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   };
   model.finePoints = finePoints(model.edgeEstimator);
   model.symmetries = findSearchSymmetries(model.levels);
+  if (params.numLevels == 0 && model.numLevels() > 1) {
+    // The automatic pyramid, tested on copies of the template (pyramid_depth_check.hpp): the top
+    // level is given up while the pyramid without it loses fewer copies.
+    int lost = copiesLostBySearch(templateImage(region), model);
+    model.pyramidTrials.push_back({model.numLevels(), lost});
+    while (lost > 0 && model.numLevels() > 1) {
+      ShapeModel shallower = model;
+      shallower.levels.pop_back();
+      shallower.symmetries = findSearchSymmetries(shallower.levels);
+      const int shallowerLost = copiesLostBySearch(templateImage(region), shallower);
+      model.pyramidTrials.push_back({shallower.numLevels(), shallowerLost});
+      if (shallowerLost >= lost) break;
+      shallower.pyramidTrials = model.pyramidTrials;
+      model = std::move(shallower);
+      lost = shallowerLost;
+    }
+  }
   if (!params.edgeEstimator) {
     // Chosen by the test of edge_estimator_choice.hpp; the other candidate differs only in its
     // subpixel points.

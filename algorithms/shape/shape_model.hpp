@@ -41,6 +41,12 @@ struct EdgeEstimatorTrial {
   double poseError = 0.0;
 };
 
+// One depth of the automatic pyramid tried at training.
+struct PyramidTrial {
+  int levels = 0;
+  int copiesLost = 0;  // of the template's turned, shifted copies (pyramid_depth_check.hpp)
+};
+
 struct ShapeModelParams {
   // Region of the template image that holds the part, image pixels; empty = the whole image.
   // The image around the region is read too: every level sees near the region's border what a
@@ -57,7 +63,9 @@ struct ShapeModelParams {
   // on the top level costs about 1/16 of the one below it (a quarter of the positions, half the
   // angles, half the points), so the model takes every level that still holds the part: at
   // least 24 edge pixels and a radius of at least 5 pixels (angle step below 12 degrees) on the
-  // top level, whatever the template's width. At most 6 levels.
+  // top level, whatever the template's width. At most 6 levels. Then fewer where the deepest
+  // pyramid loses turned, shifted copies of the template that a shallower one finds
+  // (pyramid_depth_check.hpp; ShapeModel::pyramidTrials).
   int numLevels = 0;
 
   // Angle range searched, radians: [angleStart, angleStart + angleExtent]. Default: full circle.
@@ -120,6 +128,9 @@ struct ShapeModel {
   EdgeEstimator edgeEstimator = EdgeEstimator::ProfileFit;
   // The training test that chose it (empty when it was given, or the model was loaded).
   std::vector<EdgeEstimatorTrial> edgeEstimatorTrials;
+  // The automatic pyramid's test (pyramid_depth_check.hpp), deepest first: the copies of the
+  // template each depth lost. Empty when the levels were given, or the model was loaded.
+  std::vector<PyramidTrial> pyramidTrials;
 
   cv::Size templateSize;                  // size of the trained region, pixels
   cv::Point2d referencePoint;             // in the trained region's pixels

@@ -98,11 +98,16 @@ void run(const ModelOptions& o) {
     for (const auto& t : model.edgeEstimatorTrials)
       trials[edgeEstimatorName(t.estimator)] =
           std::isfinite(t.poseError) ? nlohmann::json(t.poseError) : nlohmann::json();
+    // The automatic pyramid's test: copies of the template each depth lost, deepest first.
+    nlohmann::json pyramidTrials = nlohmann::json::array();
+    for (const auto& t : model.pyramidTrials)
+      pyramidTrials.push_back({{"levels", t.levels}, {"copies_lost", t.copiesLost}});
     printJson(
         {{"model", o.out},
          {"levels", model.numLevels()},
          {"levels_chosen", o.levels == 0 ? "automatic" : "--levels"},
          {"pyramid", levels},
+         {"pyramid_trials", pyramidTrials},
          {"points", model.levels.front().points.size()},
          {"subpixel_points", model.finePoints.size()},
          {"reference", {model.referencePoint.x, model.referencePoint.y}},

@@ -90,6 +90,10 @@ TEST(ShapeCli, CreateThenMatchPrintsThePoseAsJson) {
   ASSERT_EQ(create.exitCode, 0) << readText(err);
   const auto created = nlohmann::json::parse(create.out);
   EXPECT_GE(created.at("levels").get<int>(), 3);
+  // The automatic pyramid's test: the depth its edges allow finds every copy, and is kept.
+  ASSERT_EQ(created.at("pyramid_trials").size(), 1u);
+  EXPECT_EQ(created.at("pyramid_trials")[0].at("levels"), created.at("levels"));
+  EXPECT_EQ(created.at("pyramid_trials")[0].at("copies_lost").get<int>(), 0);
   EXPECT_DOUBLE_EQ(created.at("reference")[0].get<double>(), 79.5);
   // The automatic edge estimator and the training test behind it: a part of blurred steps.
   EXPECT_EQ(created.at("edge_estimator"), "profile");
