@@ -333,16 +333,16 @@ int spreadOnLevel(int maxDeformation, int l) {
   return maxDeformation >> l;
 }
 
-// The angle steps of the level below the top that a second, wider look covers on either side of
-// a top-level candidate: two of the top level's steps. A part partly hidden can peak on the top
-// level a step or two from its own angle, where the occluder's or clutter's edges line up with
-// the model's; the usual look, one step of the level below (half a top step), left such a part to
+// The angle steps of a level that a second, wider look covers on either side of a candidate from
+// the level above: two steps of the level above. A part partly hidden can peak on the top level a
+// step or two from its own angle, where the occluder's or clutter's edges line up with the
+// model's; the usual look, one step of the level below (half a step above), left such a part to
 // climb from there, and the climb stopped on the wrong side's peak. The wider look's peak is
 // tracked beside the near one where the two differ: either may be the part, and the levels below
 // tell them apart.
-int stepsBelowTop(const ShapeLevel& top, const ShapeLevel& below) {
-  if (!(below.angleStep > 0.0) || !(top.angleStep > 0.0)) return 1;
-  return std::max(1, static_cast<int>(std::ceil(2.0 * top.angleStep / below.angleStep - 1e-9)));
+int wideLookSteps(const ShapeLevel& above, const ShapeLevel& below) {
+  if (!(below.angleStep > 0.0) || !(above.angleStep > 0.0)) return 1;
+  return std::max(1, static_cast<int>(std::ceil(2.0 * above.angleStep / below.angleStep - 1e-9)));
 }
 
 // Two tracked poses on one level that are the same peak: within a pixel and an angle step.
@@ -418,7 +418,6 @@ struct Tracker {
   // The candidates that hold on every level (threshold()). Called with FindParams::minScore, or
   // with a higher score a candidate has to reach to be returned at all.
   std::vector<Candidate> toLevelZero(std::vector<Candidate> candidates, double minScore) const {
-    const ShapeLevel& topLevel = model.levels[top];
     LevelSearch search = base;
     for (int l = top - 1; l >= 0; --l) {
       search.field = &fields[l].directions();
@@ -432,9 +431,10 @@ struct Tracker {
       search.minScore = threshold(minScore, l);
       // Each candidate is tracked on its own (the field is read-only here), in parallel when
       // threads > 1; kept in their order, so the result is the same for any number of threads.
-      // Below the top, a candidate may also leave a second peak (see stepsBelowTop).
+      // A candidate may also leave a second peak (see wideLookSteps).
       std::vector<std::array<Candidate, 2>> tracked(candidates.size());
-      const int wideSteps = l == top - 1 ? stepsBelowTop(topLevel, model.levels[l]) : 1;
+      const bool belowTop = l == top - 1;
+      const int wideSteps = wideLookSteps(model.levels[l + 1], model.levels[l]);
       auto track = [&](const cv::Range& r) {
         for (int i = r.start; i < r.end; ++i) {
           Candidate c = candidates[static_cast<std::size_t>(i)];
@@ -444,14 +444,19 @@ struct Tracker {
           out[0] = refineOnLevel(search, c, 2);
           out[1].score = -1.0;
           // Also around a candidate whose near look fails but which scored this level's bar on
-          // the top level: it has lost its angle rather than its part (on a texture the top
+          // the level above: it has lost its angle rather than its part. On a texture the top
           // level's best angle at the part's pixel lay 2.3 of its steps from the part's; the near
           // look from there scored 0.47, the wider one climbed to 0.95, and a part scoring 0.99
-          // was missed). There a look of 3x3 positions is enough, the angle is what it seeks.
-          // Beside a candidate that holds, only a peak that could still be chosen over it (as
-          // the finish does: within kClusterMargin).
+          // was missed. Further down the same happens where the level above sees only the
+          // part's outline and this one its texture too (a patch of orange peel: 30 points on
+          // level 1, 449 on level 0; level 1 left the angle 2.6 degrees off, three steps of
+          // level 0, where the texture no longer scores). There a look of 3x3 positions is
+          // enough, the angle is what it seeks. Below the top, also beside a candidate that
+          // holds: only a peak that could still be chosen over it (as the finish does: within
+          // kClusterMargin).
           const bool holds = out[0].score >= search.minScore;
-          if (wideSteps > 1 && (holds || c.score >= search.minScore)) {  // c.score: the top's
+          // c.score: the level above's
+          if (wideSteps > 1 && ((holds && belowTop) || (!holds && c.score >= search.minScore))) {
             LevelSearch wideSearch = search;
             if (holds)
               wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);
