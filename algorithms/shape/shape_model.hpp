@@ -129,7 +129,8 @@ struct ShapeModel {
   // The training test that chose it (empty when it was given, or the model was loaded).
   std::vector<EdgeEstimatorTrial> edgeEstimatorTrials;
   // The automatic pyramid's test (pyramid_depth_check.hpp), deepest first: the copies of the
-  // template each depth lost. Empty when the levels were given, or the model was loaded.
+  // template each depth lost. Empty when the levels were given, the edges allow one level only,
+  // or the model was loaded.
   std::vector<PyramidTrial> pyramidTrials;
 
   cv::Size templateSize;                  // size of the trained region, pixels

@@ -28,6 +28,14 @@ cv::Mat cameraImage(const cv::Mat& fine) {
   return image;
 }
 
+// The patch's training parameters: `levels` pyramid levels, 0 = automatic.
+ShapeModelParams patchParams(int levels) {
+  ShapeModelParams params;
+  params.roi = kPatch;
+  params.numLevels = levels;
+  return params;
+}
+
 struct Shot {
   cv::Mat image;
   Pose2D truth;  // of the patch's centre
@@ -64,15 +72,10 @@ TEST(PyramidDepthCheck, TheAliasedTopLevelOfAChessboardIsGivenUp) {
   const cv::Mat fine = testPhoto("right04.png");
   ASSERT_FALSE(fine.empty());
   const cv::Mat photo = cameraImage(fine);
-  ShapeModelParams params;
-  params.roi = kPatch;
-  params.numLevels = 4;
-  EXPECT_GT(copiesLostBySearch(photo(kPatch), createShapeModel(photo, params)), 0);
-  params.numLevels = 3;
-  EXPECT_EQ(copiesLostBySearch(photo(kPatch), createShapeModel(photo, params)), 0);
+  EXPECT_GT(copiesLostBySearch(photo(kPatch), createShapeModel(photo, patchParams(4))), 0);
+  EXPECT_EQ(copiesLostBySearch(photo(kPatch), createShapeModel(photo, patchParams(3))), 0);
 
-  params.numLevels = 0;
-  const ShapeModel automatic = createShapeModel(photo, params);
+  const ShapeModel automatic = createShapeModel(photo, patchParams(0));
   EXPECT_EQ(automatic.numLevels(), 3);
   ASSERT_EQ(automatic.pyramidTrials.size(), 2u);
   EXPECT_EQ(automatic.pyramidTrials[0].levels, 4);
@@ -89,16 +92,14 @@ TEST(PyramidDepthCheck, TheAutomaticModelFindsTheChessboardPatchInASecondShot) {
   ASSERT_FALSE(fine.empty());
   const cv::Mat photo = cameraImage(fine);
   const Shot shot = turnedShot(fine, -165.71, 1.01);
-  ShapeModelParams params;
-  params.roi = kPatch;
-  const auto found = findShapeModel(shot.image, createShapeModel(photo, params));
+  const auto found = findShapeModel(shot.image, createShapeModel(photo, patchParams(0)));
   ASSERT_EQ(found.size(), 1u);
   EXPECT_LT(std::hypot(found[0].x - shot.truth.x, found[0].y - shot.truth.y), 0.2);
   EXPECT_NEAR(found[0].angle, shot.truth.angle, 0.2 * std::numbers::pi / 180.0);
   EXPECT_GT(found[0].score, 0.99);
 
-  params.numLevels = 4;  // the pyramid the edges allow, untested
-  const auto deep = findShapeModel(shot.image, createShapeModel(photo, params));
+  // The pyramid the edges allow, untested.
+  const auto deep = findShapeModel(shot.image, createShapeModel(photo, patchParams(4)));
   ASSERT_FALSE(deep.empty());
   EXPECT_GT(std::hypot(deep[0].x - shot.truth.x, deep[0].y - shot.truth.y), 10.0)
       << "the 4-level pyramid finds the part: the test no longer shows what the check is for";
@@ -119,11 +120,7 @@ TEST(PyramidDepthCheck, APartThatFindsItsCopiesKeepsItsLevels) {
 TEST(PyramidDepthCheck, GivenLevelsAreNotTested) {
   const cv::Mat fine = testPhoto("right04.png");
   ASSERT_FALSE(fine.empty());
-  const cv::Mat photo = cameraImage(fine);
-  ShapeModelParams params;
-  params.roi = kPatch;
-  params.numLevels = 4;
-  const ShapeModel model = createShapeModel(photo, params);
+  const ShapeModel model = createShapeModel(cameraImage(fine), patchParams(4));
   EXPECT_EQ(model.numLevels(), 4);
   EXPECT_TRUE(model.pyramidTrials.empty());
 }
