@@ -419,19 +419,21 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   if (params.numLevels == 0 && model.numLevels() > 1) {
     // The automatic pyramid, tested on copies of the template (pyramid_depth_check.hpp): the top
     // level is given up while the pyramid without it loses fewer copies.
-    int lost = copiesLostBySearch(templateImage(region), model);
-    model.pyramidTrials.push_back({model.numLevels(), lost});
-    while (lost > 0 && model.numLevels() > 1) {
+    // Within the loop the last trial is the kept depth's: a shallower depth is kept only where it
+    // loses fewer copies, and the loop ends with the first that does not.
+    std::vector<PyramidTrial> trials{
+        {model.numLevels(), copiesLostBySearch(templateImage(region), model)}};
+    while (trials.back().copiesLost > 0 && model.numLevels() > 1) {
       ShapeModel shallower = model;
       shallower.levels.pop_back();
       shallower.symmetries = findSearchSymmetries(shallower.levels);
-      const int shallowerLost = copiesLostBySearch(templateImage(region), shallower);
-      model.pyramidTrials.push_back({shallower.numLevels(), shallowerLost});
-      if (shallowerLost >= lost) break;
-      shallower.pyramidTrials = model.pyramidTrials;
+      const int lost = copiesLostBySearch(templateImage(region), shallower);
+      const bool better = lost < trials.back().copiesLost;
+      trials.push_back({shallower.numLevels(), lost});
+      if (!better) break;
       model = std::move(shallower);
-      lost = shallowerLost;
     }
+    model.pyramidTrials = std::move(trials);
   }
   if (!params.edgeEstimator) {
     // Chosen by the test of edge_estimator_choice.hpp; the other candidate differs only in its
