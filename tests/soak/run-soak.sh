@@ -16,8 +16,9 @@
 #
 # The results database is not trimmed (ResultsStore has a RetentionPolicy, but the station file
 # has no setting for it and facetd never applies it): it grows by one row per part (about
-# 0.8 MiB per 1,000 parts of this recipe) on disk, but SQLite's page cache is bounded (default
-# cache_size, 2 MiB per connection; no mmap_size), so a growing file does not grow facetd's RSS.
+# 0.8 MiB per 1,000 parts of this recipe) on disk, but SQLite's page cache is bounded (the store
+# sets cache_size to 512 KiB; no mmap_size), so a growing file does not grow facetd's RSS. With
+# SQLite's default 2 MiB the cache was still filling ~2,500 parts in, past the CI soak's baseline.
 # Failed parts' images are archived with a 50 MB quota, so archive eviction runs all along.
 #
 # To see the judgement fail, preload the leak shim into facetd (facet_soak passes its environment
