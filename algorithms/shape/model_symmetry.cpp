@@ -193,6 +193,103 @@ std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& l
   return out;
 }
 
+namespace {
+
+// The points' bounding box, half a pixel wider on every side.
+cv::Rect2d extentOf(const std::vector<ShapePoint>& points) {
+  float x0 = points[0].position.x, x1 = x0, y0 = points[0].position.y, y1 = y0;
+  for (const auto& p : points) {
+    x0 = std::min(x0, p.position.x), x1 = std::max(x1, p.position.x);
+    y0 = std::min(y0, p.position.y), y1 = std::max(y1, p.position.y);
+  }
+  return {x0 - 0.5, y0 - 0.5, x1 - x0 + 1.0, y1 - y0 + 1.0};
+}
+
+// Mean over every `stride`-th point whose shifted place lies within `extent` of the best direction
+// agreement within one pixel there; 0 where fewer than a third of the points stay within it (the
+// shift is then no period of the model's own pattern).
+double shiftedSimilarity(const std::vector<ShapePoint>& points, const PointRaster& raster,
+                         const cv::Rect2d& extent, cv::Point2d shift, std::size_t stride) {
+  const cv::Rect inside(1, 1, raster.directions.cols - 2, raster.directions.rows - 2);
+  double sum = 0.0;
+  std::size_t within = 0, all = 0;
+  for (std::size_t i = 0; i < points.size(); i += stride, ++all) {
+    const ShapePoint& p = points[i];
+    const cv::Point2d q(p.position.x + shift.x, p.position.y + shift.y);
+    if (!extent.contains(q)) continue;
+    ++within;
+    const cv::Point at(cvRound(q.x - raster.origin.x), cvRound(q.y - raster.origin.y));
+    if (!inside.contains(at)) continue;
+    double best = 0.0;
+    for (int v = -1; v <= 1; ++v)
+      for (int u = -1; u <= 1; ++u) {
+        const cv::Vec2f d = raster.directions.at<cv::Vec2f>(at + cv::Point(u, v));
+        best = std::max(best, double(d[0] * p.direction.x + d[1] * p.direction.y));
+      }
+    sum += best;
+  }
+  return 3 * within < all || within == 0 ? 0.0 : sum / static_cast<double>(within);
+}
+
+}  // namespace
+
+std::vector<ModelPeriod> findSearchPeriods(const std::vector<ShapeLevel>& levels, int topReach,
+                                           double minScore, int maxCount) {
+  if (levels.size() < 2 || levels.front().points.size() < 8 || levels.back().points.size() < 8)
+    return {};
+  const std::vector<ShapePoint>& points = levels.front().points;
+  const double topPixel = std::ldexp(1.0, static_cast<int>(levels.size()) - 1);
+  // A shift whose pose may land within topReach of the candidate's in x and y at some angle,
+  // once both are rounded to the top level's pixels.
+  const double longest = (topReach + 1) * std::numbers::sqrt2 * topPixel;
+  const double shortest = topPixel;
+  const Cloud cloud = cloudOf(points);
+  const cv::Rect2d extent = extentOf(points);
+  // The top level's own points, where the pattern may have been smoothed away.
+  const std::vector<ShapePoint>& topPoints = levels.back().points;
+  const Cloud topCloud = cloudOf(topPoints);
+  const cv::Rect2d topExtent = extentOf(topPoints);
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / kSampledPoints);
+  const int r = static_cast<int>(std::ceil(longest));
+  const int side = 2 * r + 3;
+  // Every shift scored with a sample first; with all points near the threshold (as the turns).
+  cv::Mat full(side, side, CV_64F, cv::Scalar(-1.0));
+  const auto fullAt = [&](int dx, int dy) {
+    double& v = full.at<double>(dy + r + 1, dx + r + 1);
+    if (v < 0.0) v = shiftedSimilarity(points, cloud.raster, extent, cv::Point2d(dx, dy), 1);
+    return v;
+  };
+  std::vector<ModelPeriod> out;
+  for (int dy = -r; dy <= r; ++dy)
+    for (int dx = -r; dx <= r; ++dx) {
+      const double length = std::hypot(dx, dy);
+      if (length < shortest || length > longest) continue;
+      if (shiftedSimilarity(points, cloud.raster, extent, cv::Point2d(dx, dy), stride) <
+          minScore - kSampleMargin)
+        continue;
+      const double v = fullAt(dx, dy);
+      if (v < minScore) continue;
+      bool peak = true;
+      for (int ey = -1; ey <= 1 && peak; ++ey)
+        for (int ex = -1; ex <= 1 && peak; ++ex)
+          if ((ex || ey) && fullAt(dx + ex, dy + ey) > v) peak = false;
+      // A period: halfway to it the pattern does not repeat. Along a straight edge it does.
+      if (!peak || fullAt(static_cast<int>(std::lround(dx / 2.0)),
+                          static_cast<int>(std::lround(dy / 2.0))) >= 0.5 * v)
+        continue;
+      // Only a pattern the top level still sees makes its peaks compete there (a cloth's fine
+      // weave, 2-3 px apart, is gone a level up; a dark stripe across it is not).
+      if (shiftedSimilarity(topPoints, topCloud.raster, topExtent, cv::Point2d(dx, dy) / topPixel,
+                            1) < minScore)
+        continue;
+      out.push_back({cv::Point2d(dx, dy), v});
+    }
+  std::sort(out.begin(), out.end(),
+            [](const ModelPeriod& a, const ModelPeriod& b) { return a.score > b.score; });
+  if (static_cast<int>(out.size()) > maxCount) out.resize(static_cast<std::size_t>(maxCount));
+  return out;
+}
+
 Pose2D turnedBy(const Pose2D& pose, const ModelSymmetry& symmetry) {
   const double c = std::cos(symmetry.angle), s = std::sin(symmetry.angle);
   const cv::Point2d& m = symmetry.centre;

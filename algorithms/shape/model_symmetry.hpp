@@ -3,6 +3,8 @@
 // model (almost) onto itself, such as the quarter turns of a cross whose arms differ slightly.
 // The search turns each match by them and keeps the pose that scores best, so that a part is not
 // returned in a near-symmetric pose that the coarse levels could not tell from the right one.
+// And the periods of a repeating pattern: shifts that map the model almost onto itself, which the
+// automatic pyramid keeps beyond the reach of its top level.
 
 #include <vector>
 
@@ -39,6 +41,24 @@ bool mapsOntoItselfAtEveryTurn(const std::vector<ShapePoint>& points, double ang
 // scores 0.7) but may be one on the top level, which then keeps the turned pose and loses the
 // right one; such turns are located on level 0's points (the best turn within a top-level step).
 std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& levels);
+
+// A translation that maps the model almost onto itself: a period of a repeating pattern (a patch
+// of a chessboard, a row of pins). Beyond the template the pattern often goes on, so a shifted
+// pose is judged by the points that stay within the model's extent.
+struct ModelPeriod {
+  cv::Point2d shift;   // model coordinates, level-0 pixels
+  double score = 0.0;  // 0..1: share of those points that land on a point of like direction
+};
+
+// The periods of a model with these pyramid levels (level 0 first) that its top level cannot
+// tell apart: those that may put a shifted pose within `topReach` pixels of the top level, where
+// the search keeps one maximum of the score over position among several that close
+// (response_map_search.hpp) and a neighbouring period's pose may outscore the part's. Shifts
+// under a pixel of the top level are not periods (the levels below look that far around each
+// candidate), nor are slides along a straight edge (the shift's half must score less than half
+// as much). Self-similarity as findModelSymmetries'. Best first, at most `maxCount`.
+std::vector<ModelPeriod> findSearchPeriods(const std::vector<ShapeLevel>& levels, int topReach,
+                                           double minScore = 0.6, int maxCount = 4);
 
 // The pose that shows the model turned by `symmetry` where `pose` shows it: pose o S with
 // S(p) = c + R(a) (p - c).

@@ -136,9 +136,6 @@ class MapPlanes {
   std::int8_t* data_ = nullptr;
 };
 
-// Pixels: a kept maximum over position suppresses the weaker ones this close.
-constexpr int kPeakReach = 2;
-
 // Two peaks in angle at a pixel are separate beyond the reach of the wider look below the top
 // (find_shape_model.cpp), and only one within kClusterMargin (find_shape_model.cpp) of the best
 // nearby could still be the part's.

@@ -11,6 +11,7 @@
 #include "algorithms/shape/edge_estimator_choice.hpp"
 #include "algorithms/shape/image_gradients.hpp"
 #include "algorithms/shape/pyramid_depth_check.hpp"
+#include "algorithms/shape/response_map_search.hpp"
 
 namespace facet {
 namespace {
@@ -409,6 +410,19 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     model.levels.push_back(std::move(shapeLevel));
   }
 
+  // Automatic levels: none whose top level sees the part's pattern repeat within the reach where
+  // the search keeps one maximum of the score among several (a chessboard patch whose diagonal
+  // period is 3 px on the top level, 1/8: the part's pose scored 0.79 there and the next period's
+  // 0.84, which suppressed it, and the part, 0.996 at level 0, was missed).
+  std::vector<PyramidTrial> trials;
+  while (params.numLevels == 0 && model.numLevels() > 1) {
+    const std::vector<ModelPeriod> periods =
+        findSearchPeriods(model.levels, shape_detail::kPeakReach);
+    if (periods.empty()) break;
+    trials.push_back({model.numLevels(), 0, periods.front()});
+    model.levels.pop_back();
+  }
+
   // `mask` now has the top level's size; the fine points take the caller's.
   const auto finePoints = [&](EdgeEstimator estimator) {
     return finePointsOf(templateImage, region, mask.empty() ? cv::Mat() : params.mask, model,
@@ -421,8 +435,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
     // level is given up while the pyramid without it loses fewer copies.
     // Within the loop the last trial is the kept depth's: a shallower depth is kept only where it
     // loses fewer copies, and the loop ends with the first that does not.
-    std::vector<PyramidTrial> trials{
-        {model.numLevels(), copiesLostBySearch(templateImage(region), model)}};
+    trials.push_back({model.numLevels(), copiesLostBySearch(templateImage(region), model)});
     while (trials.back().copiesLost > 0 && model.numLevels() > 1) {
       ShapeModel shallower = model;
       shallower.levels.pop_back();
@@ -433,8 +446,8 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
       if (!better) break;
       model = std::move(shallower);
     }
-    model.pyramidTrials = std::move(trials);
   }
+  model.pyramidTrials = std::move(trials);
   if (!params.edgeEstimator) {
     // Chosen by the test of edge_estimator_choice.hpp; the other candidate differs only in its
     // subpixel points.

@@ -45,6 +45,10 @@ struct EdgeEstimatorTrial {
 struct PyramidTrial {
   int levels = 0;
   int copiesLost = 0;  // of the template's turned, shifted copies (pyramid_depth_check.hpp)
+  // Set where the depth was refused because the part's pattern repeats too closely for its top
+  // level (findSearchPeriods, model_symmetry.hpp): the shortest such period. No copies were
+  // searched then.
+  std::optional<ModelPeriod> period;
 };
 
 struct ShapeModelParams {
@@ -63,8 +67,10 @@ struct ShapeModelParams {
   // on the top level costs about 1/16 of the one below it (a quarter of the positions, half the
   // angles, half the points), so the model takes every level that still holds the part: at
   // least 24 edge pixels and a radius of at least 5 pixels (angle step below 12 degrees) on the
-  // top level, whatever the template's width. At most 6 levels. Then fewer where the deepest
-  // pyramid loses turned, shifted copies of the template that a shallower one finds
+  // top level, whatever the template's width. At most 6 levels. Then fewer while the part's
+  // pattern repeats within a few pixels of the top level (a chessboard, a row of pins: the top
+  // level cannot keep the part's pose beside a period's; findSearchPeriods), and while the
+  // deepest pyramid loses turned, shifted copies of the template that a shallower one finds
   // (pyramid_depth_check.hpp; ShapeModel::pyramidTrials).
   int numLevels = 0;
 
@@ -128,9 +134,9 @@ struct ShapeModel {
   EdgeEstimator edgeEstimator = EdgeEstimator::ProfileFit;
   // The training test that chose it (empty when it was given, or the model was loaded).
   std::vector<EdgeEstimatorTrial> edgeEstimatorTrials;
-  // The automatic pyramid's test (pyramid_depth_check.hpp), deepest first: the copies of the
-  // template each depth lost. Empty when the levels were given, the edges allow one level only,
-  // or the model was loaded.
+  // The automatic pyramid's tests, deepest first: the depths refused for a period of the part's
+  // pattern, then the copies of the template each depth searched lost (pyramid_depth_check.hpp).
+  // Empty when the levels were given, the edges allow one level only, or the model was loaded.
   std::vector<PyramidTrial> pyramidTrials;
 
   cv::Size templateSize;                  // size of the trained region, pixels

@@ -98,10 +98,15 @@ void run(const ModelOptions& o) {
     for (const auto& t : model.edgeEstimatorTrials)
       trials[edgeEstimatorName(t.estimator)] =
           std::isfinite(t.poseError) ? nlohmann::json(t.poseError) : nlohmann::json();
-    // The automatic pyramid's test: copies of the template each depth lost, deepest first.
+    // The automatic pyramid's tests, deepest first: a depth refused for the period of the part's
+    // pattern (its shift in template pixels; no copies searched), or the copies it lost.
     nlohmann::json pyramidTrials = nlohmann::json::array();
     for (const auto& t : model.pyramidTrials)
-      pyramidTrials.push_back({{"levels", t.levels}, {"copies_lost", t.copiesLost}});
+      pyramidTrials.push_back(
+          t.period ? nlohmann::json{{"levels", t.levels},
+                                    {"period", {t.period->shift.x, t.period->shift.y}},
+                                    {"period_score", t.period->score}}
+                   : nlohmann::json{{"levels", t.levels}, {"copies_lost", t.copiesLost}});
     printJson(
         {{"model", o.out},
          {"levels", model.numLevels()},

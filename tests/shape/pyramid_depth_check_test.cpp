@@ -1,6 +1,7 @@
-// The automatic pyramid's test on copies of the template
-// (algorithms/shape/pyramid_depth_check.hpp), checked on a scene the test never saw: a second
-// camera image of the photographed part, turned.
+// The automatic pyramid's depth: refused where the part's pattern repeats within the top level's
+// reach (findSearchPeriods), and tested on copies of the template
+// (algorithms/shape/pyramid_depth_check.hpp); checked on a scene neither saw: a second camera
+// image of the photographed part, turned.
 #include <cmath>
 #include <numbers>
 
@@ -66,8 +67,9 @@ Shot turnedShot(const cv::Mat& fine, double degrees, double scale) {
   return shot;
 }
 
-// The pyramid its edges allow (4 levels) loses copies of the chessboard patch that 3 levels find;
-// the automatic model takes 3 and says what it tried.
+// The pyramid its edges allow (4 levels) sees the chessboard's period within its top level's reach
+// and loses copies of the patch that 3 levels find; the automatic model refuses 4 levels for the
+// period, takes 3 and says what it tried.
 TEST(PyramidDepthCheck, TheAliasedTopLevelOfAChessboardIsGivenUp) {
   const cv::Mat fine = testPhoto("right04.png");
   ASSERT_FALSE(fine.empty());
@@ -79,9 +81,33 @@ TEST(PyramidDepthCheck, TheAliasedTopLevelOfAChessboardIsGivenUp) {
   EXPECT_EQ(automatic.numLevels(), 3);
   ASSERT_EQ(automatic.pyramidTrials.size(), 2u);
   EXPECT_EQ(automatic.pyramidTrials[0].levels, 4);
-  EXPECT_GT(automatic.pyramidTrials[0].copiesLost, 0);
+  EXPECT_TRUE(automatic.pyramidTrials[0].period.has_value());
   EXPECT_EQ(automatic.pyramidTrials[1].levels, 3);
+  EXPECT_FALSE(automatic.pyramidTrials[1].period.has_value());
   EXPECT_EQ(automatic.pyramidTrials[1].copiesLost, 0);
+}
+
+// An apple (tests/data/photos/apple.png) whose upper levels see an outline that is nearly round:
+// they leave the angle and the place off by more than the levels below look around, and copies of
+// the template are lost with 3 and 2 levels. No period refuses them; the copies' test gives them
+// up, and one level finds every copy.
+TEST(PyramidDepthCheck, ADepthThatLosesCopiesIsGivenUp) {
+  const cv::Mat photo = testPhoto("apple.png");
+  ASSERT_FALSE(photo.empty());
+  ShapeModelParams params;
+  params.roi = cv::Rect(251, 133, 149, 110);
+  const ShapeModel automatic = createShapeModel(photo, params);
+  ASSERT_EQ(automatic.pyramidTrials.size(), 3u);
+  for (int k = 0; k < 3; ++k) {
+    const PyramidTrial& trial = automatic.pyramidTrials[static_cast<std::size_t>(k)];
+    EXPECT_EQ(trial.levels, 3 - k);
+    EXPECT_FALSE(trial.period.has_value());
+    if (k < 2) {
+      EXPECT_GT(trial.copiesLost, 0) << trial.levels << " levels";
+    }
+  }
+  EXPECT_EQ(automatic.pyramidTrials[2].copiesLost, 0);
+  EXPECT_EQ(automatic.numLevels(), 1);
 }
 
 // The camera's second shot, turned by -165.71 degrees at scale 1.01: with 4 levels the search

@@ -1,5 +1,6 @@
 // `facet model create` and `facet match`: the real binary on generated images.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <filesystem>
@@ -245,6 +246,35 @@ TEST(ShapeCli, MaxDeformationKeepsTheRigidPoseOfAnExactPart) {
   EXPECT_NEAR(b[0].at("y").get<double>(), a[0].at("y").get<double>(), 1e-6);
   EXPECT_GE(b[0].at("score").get<double>(), a[0].at("score").get<double>());
   fs::remove_all(scene.dir);
+}
+
+// A depth the automatic pyramid refused because the part's pattern repeats within its top level's
+// reach is printed with the period (template pixels) instead of copies lost.
+TEST(ShapeCli, CreatePrintsThePeriodThatRefusedADepth) {
+  const fs::path dir = fs::temp_directory_path() / "facet_shape_cli_period_test";
+  fs::create_directories(dir);
+  const fs::path err = dir / "stderr.txt";
+  cv::Mat board(240, 240, CV_8U);
+  for (int y = 0; y < board.rows; ++y)
+    for (int x = 0; x < board.cols; ++x)
+      board.at<std::uint8_t>(y, x) = ((x / 8 + y / 8) % 2) ? 200 : 50;
+  ASSERT_TRUE(cv::imwrite((dir / "board.png").string(), board));
+  const CliRun create =
+      run(std::string(FACET_CLI) + " model create --image " + (dir / "board.png").string() +
+              " --roi 53,59,70,60 --out " + (dir / "board.model").string() + " --json",
+          err);
+  ASSERT_EQ(create.exitCode, 0) << readText(err);
+  const auto trials = nlohmann::json::parse(create.out).at("pyramid_trials");
+  ASSERT_GE(trials.size(), 2u) << create.out;
+  EXPECT_GT(trials[0].at("levels").get<int>(), nlohmann::json::parse(create.out).at("levels"));
+  ASSERT_EQ(trials[0].at("period").size(), 2u);
+  const double length =
+      std::hypot(trials[0].at("period")[0].get<double>(), trials[0].at("period")[1].get<double>());
+  EXPECT_GT(length, 10.0);  // a square's diagonal, 11.3 px, or longer
+  EXPECT_GT(trials[0].at("period_score").get<double>(), 0.6);
+  EXPECT_FALSE(trials[0].contains("copies_lost"));
+  EXPECT_TRUE(trials.back().contains("copies_lost"));
+  fs::remove_all(dir);
 }
 
 }  // namespace
