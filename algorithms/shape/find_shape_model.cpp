@@ -450,19 +450,23 @@ struct Tracker {
           // was missed. Further down the same happens where the level above sees only the
           // part's outline and this one its texture too (a patch of orange peel: 30 points on
           // level 1, 449 on level 0; level 1 left the angle 2.6 degrees off, three steps of
-          // level 0, where the texture no longer scores). The wider look covers the near look's
-          // positions: where the level above has the angle wrong its best pixel may be wrong
-          // too (on a textured disc, turned -121.5 degrees, level 1's peak lay a pixel of its
-          // own and 1.4 degrees from the part's, and a look of 3x3 positions missed the part,
-          // 0.92, two pixels away). Below the top, also beside a candidate that holds: only a
-          // peak that could still be chosen over it (as the finish does: within kClusterMargin).
+          // level 0, where the texture no longer scores). There a look of 3x3 positions is
+          // enough, the angle is what it seeks; from a candidate that reached the minimum score
+          // itself on the level above, 5x5 as the near look: its best pixel there may be off
+          // with its angle (on a textured disc turned -121.5 degrees level 1's peak, 0.88, lay
+          // a pixel of its own and 1.4 degrees from the part's, and the part, 0.92, two pixels
+          // away below, was missed). Most candidates that fail are clutter below the minimum,
+          // for which the wider positions cost a busy photograph a quarter more time. Below the
+          // top, also beside a candidate that holds: only a peak that could still be chosen
+          // over it (as the finish does: within kClusterMargin).
           const bool holds = out[0].score >= search.minScore;
           // c.score: the level above's
           if (wideSteps > 1 && ((holds && belowTop) || (!holds && c.score >= search.minScore))) {
             LevelSearch wideSearch = search;
             if (holds)
               wideSearch.minScore = std::max(search.minScore, out[0].score - kClusterMargin);
-            const Candidate wide = refineOnLevel(wideSearch, c, 2, wideSteps);
+            const int radius = holds || c.score >= params.minScore ? 2 : 1;
+            const Candidate wide = refineOnLevel(wideSearch, c, radius, wideSteps);
             if (wide.score >= wideSearch.minScore &&
                 !sameLevelPose(wide, out[0], search.level->angleStep))
               out[1] = wide;

@@ -57,8 +57,11 @@ struct ModelPeriod {
 // under a pixel of the top level are not periods (the levels below look that far around each
 // candidate), nor are slides along a straight edge (the shift's half must score less than half
 // as much). Self-similarity as findModelSymmetries'. Best first, at most `maxCount`.
+// `minScore`: the search trusts the top level's scores to within a factor of 0.7 (it keeps
+// candidates from 0.7 x the minimum score there); a shifted pose that keeps less of the pattern
+// than that does not rival the part's (a row of pins, 0.63: the body does not repeat).
 std::vector<ModelPeriod> findSearchPeriods(const std::vector<ShapeLevel>& levels, int topReach,
-                                           double minScore = 0.6, int maxCount = 4);
+                                           double minScore = 0.7, int maxCount = 4);
 
 // The pose that shows the model turned by `symmetry` where `pose` shows it: pose o S with
 // S(p) = c + R(a) (p - c).
