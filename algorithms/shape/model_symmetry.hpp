@@ -43,7 +43,7 @@ bool mapsOntoItselfAtEveryTurn(const std::vector<ShapePoint>& points, double ang
 std::vector<ModelSymmetry> findSearchSymmetries(const std::vector<ShapeLevel>& levels);
 
 // A translation that maps the model almost onto itself: a period of a repeating pattern (a patch
-// of a chessboard, a row of pins). Beyond the template the pattern often goes on, so a shifted
+// of a chessboard, a grid). Beyond the template the pattern often goes on, so a shifted
 // pose is judged by the points that stay within the model's extent.
 struct ModelPeriod {
   cv::Point2d shift;   // model coordinates, level-0 pixels

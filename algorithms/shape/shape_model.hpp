@@ -46,7 +46,7 @@ struct PyramidTrial {
   int levels = 0;
   int copiesLost = 0;  // of the template's turned, shifted copies (pyramid_depth_check.hpp)
   // Set where the depth was refused because the part's pattern repeats too closely for its top
-  // level (findSearchPeriods, model_symmetry.hpp): the shortest such period. No copies were
+  // level (findSearchPeriods, model_symmetry.hpp): the best-scoring such period. No copies were
   // searched then.
   std::optional<ModelPeriod> period;
 };
@@ -68,8 +68,8 @@ struct ShapeModelParams {
   // angles, half the points), so the model takes every level that still holds the part: at
   // least 24 edge pixels and a radius of at least 5 pixels (angle step below 12 degrees) on the
   // top level, whatever the template's width. At most 6 levels. Then fewer while the part's
-  // pattern repeats within a few pixels of the top level (a chessboard, a row of pins: the top
-  // level cannot keep the part's pose beside a period's; findSearchPeriods), and while the
+  // pattern repeats within a few pixels of the top level (a chessboard, a grid: the top level
+  // cannot keep the part's pose beside a period's; findSearchPeriods), and while the
   // deepest pyramid loses turned, shifted copies of the template that a shallower one finds
   // (pyramid_depth_check.hpp; ShapeModel::pyramidTrials).
   int numLevels = 0;

@@ -640,6 +640,27 @@ TEST(FindShapeModel, ATexturedPartWhoseTopLevelAngleIsOffIsFound) {
   expectTheRegionInTurnedCopies(photo, region, model, -96.88, 1.0, {3, 4, 5}, 0.95);
 }
 
+// A region of a photograph with `margin` pixels of its border repeated around it, turned about
+// the region's centre by `degrees` and shifted by `shift` (cubic): the copy and where the
+// region's centre lies in it.
+struct RegionCopy {
+  cv::Mat image;
+  cv::Point2d centre;
+};
+RegionCopy turnedRegion(const cv::Mat& photo, cv::Rect region, int margin, double degrees,
+                        cv::Point2d shift) {
+  cv::Mat canvas;
+  cv::copyMakeBorder(photo(region), canvas, margin, margin, margin, margin, cv::BORDER_REPLICATE);
+  const cv::Point2d centre(margin + (region.width - 1) / 2.0, margin + (region.height - 1) / 2.0);
+  cv::Mat warp = cv::getRotationMatrix2D(centre, degrees, 1.0);
+  warp.at<double>(0, 2) += shift.x;
+  warp.at<double>(1, 2) += shift.y;
+  RegionCopy copy;
+  cv::warpAffine(canvas, copy.image, warp, canvas.size(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  copy.centre = centre + shift;
+  return copy;
+}
+
 // A patch of orange peel (tests/data/photos/orange.png) turned by 58.5 degrees and shifted by
 // 1.5 px, searched with 3 levels: levels 1 and 2 keep only the orange's outline (30 points against
 // level 0's 449), level 1 left the angle 2.6 degrees off, three steps of level 0, where the peel's
@@ -654,26 +675,20 @@ TEST(FindShapeModel, ATexturedPartWhoseOutlineAloneSetsTheAngleAboveIsFound) {
   params.numLevels = 3;
   const ShapeModel model = createShapeModel(photo, params);
   ASSERT_LT(model.levels[1].points.size() * 4, model.levels[0].points.size());
-  // The region with the photograph around it, turned about its centre and shifted.
-  const int margin = 36;
-  cv::Mat canvas, copy;
-  cv::copyMakeBorder(photo(region), canvas, margin, margin, margin, margin, cv::BORDER_REPLICATE);
-  const cv::Point2d centre(margin + (region.width - 1) / 2.0, margin + (region.height - 1) / 2.0);
-  cv::Mat warp = cv::getRotationMatrix2D(centre, 58.5, 1.0);
-  warp.at<double>(1, 2) += 1.5;
-  cv::warpAffine(canvas, copy, warp, canvas.size(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
-  const auto found = findShapeModel(copy, model);
+  const RegionCopy copy = turnedRegion(photo, region, 36, 58.5, {0.0, 1.5});
+  const auto found = findShapeModel(copy.image, model);
   ASSERT_EQ(found.size(), 1u);
-  EXPECT_LT(std::hypot(found[0].x - centre.x, found[0].y - (centre.y + 1.5)), 0.2);
+  EXPECT_LT(std::hypot(found[0].x - copy.centre.x, found[0].y - copy.centre.y), 0.2);
   EXPECT_NEAR(found[0].angle, radians(58.5), radians(0.2));
   EXPECT_GT(found[0].score, 0.85);
 }
 
 // A larger patch of the orange, turned by -121.5 degrees and shifted by (1, 1.75) px, searched with
-// 2 levels: level 1 peaks 1.4 degrees and a pixel of its own from the part, the near look below
-// fails, and the wider look, over 3x3 positions, missed the part (0.92) two pixels away. The
-// wider look covers the near look's positions. The automatic pyramid, which searches such copies,
-// had given this part one level (its search 10-70 times slower).
+// 2 levels: level 1 peaks (0.88) 1.4 degrees and a pixel of its own from the part, the near look
+// below fails, and the wider look, over 3x3 positions, missed the part (0.92) two pixels away.
+// From a candidate that reached the minimum score above, the wider look covers the near look's
+// 5x5 positions. The automatic pyramid, which searches such copies, had given this part one level
+// (its search 10-70 times slower).
 TEST(FindShapeModel, ATexturedDiscWhoseTopLevelPeakIsAPixelOffIsFound) {
   const cv::Mat photo = testPhoto("orange.png");
   ASSERT_FALSE(photo.empty());
@@ -682,22 +697,14 @@ TEST(FindShapeModel, ATexturedDiscWhoseTopLevelPeakIsAPixelOffIsFound) {
   params.roi = region;
   params.numLevels = 2;
   const ShapeModel model = createShapeModel(photo, params);
-  // The region, its border repeated around it, turned about its centre and shifted.
-  const int margin = 48;
-  cv::Mat canvas, copy;
-  cv::copyMakeBorder(photo(region), canvas, margin, margin, margin, margin, cv::BORDER_REPLICATE);
-  const cv::Point2d centre(margin + (region.width - 1) / 2.0, margin + (region.height - 1) / 2.0);
-  cv::Mat warp = cv::getRotationMatrix2D(centre, -121.5, 1.0);
-  warp.at<double>(0, 2) += 1.0;
-  warp.at<double>(1, 2) += 1.75;
-  cv::warpAffine(canvas, copy, warp, canvas.size(), cv::INTER_CUBIC, cv::BORDER_REPLICATE);
+  const RegionCopy copy = turnedRegion(photo, region, 48, -121.5, {1.0, 1.75});
   // The search's pose, not the least-squares fit's: on this texture the fit moves it by 0.4-0.75
   // px (from the known pose too), which is the refinement's matter, not the search's.
   FindParams find;
   find.subpixel = SubpixelMode::Interpolation;
-  const auto found = findShapeModel(copy, model, find);
+  const auto found = findShapeModel(copy.image, model, find);
   ASSERT_EQ(found.size(), 1u);
-  EXPECT_LT(std::hypot(found[0].x - (centre.x + 1.0), found[0].y - (centre.y + 1.75)), 0.3);
+  EXPECT_LT(std::hypot(found[0].x - copy.centre.x, found[0].y - copy.centre.y), 0.3);
   EXPECT_NEAR(found[0].angle, radians(-121.5), radians(0.3));
   EXPECT_GT(found[0].score, 0.85);
 
