@@ -640,6 +640,14 @@ TEST(FindShapeModel, ATexturedPartWhoseTopLevelAngleIsOffIsFound) {
   expectTheRegionInTurnedCopies(photo, region, model, -96.88, 1.0, {3, 4, 5}, 0.95);
 }
 
+// A model trained on a region of a photograph with `levels` pyramid levels (0 = automatic).
+ShapeModel regionModel(const cv::Mat& photo, cv::Rect region, int levels) {
+  ShapeModelParams params;
+  params.roi = region;
+  params.numLevels = levels;
+  return createShapeModel(photo, params);
+}
+
 // A region of a photograph with `margin` pixels of its border repeated around it, turned about
 // the region's centre by `degrees` and shifted by `shift` (cubic): the copy and where the
 // region's centre lies in it.
@@ -670,10 +678,7 @@ TEST(FindShapeModel, ATexturedPartWhoseOutlineAloneSetsTheAngleAboveIsFound) {
   const cv::Mat photo = testPhoto("orange.png");
   ASSERT_FALSE(photo.empty());
   const cv::Rect region(55, 109, 111, 77);
-  ShapeModelParams params;
-  params.roi = region;
-  params.numLevels = 3;
-  const ShapeModel model = createShapeModel(photo, params);
+  const ShapeModel model = regionModel(photo, region, 3);
   ASSERT_LT(model.levels[1].points.size() * 4, model.levels[0].points.size());
   const RegionCopy copy = turnedRegion(photo, region, 36, 58.5, {0.0, 1.5});
   const auto found = findShapeModel(copy.image, model);
@@ -693,10 +698,7 @@ TEST(FindShapeModel, ATexturedDiscWhoseTopLevelPeakIsAPixelOffIsFound) {
   const cv::Mat photo = testPhoto("orange.png");
   ASSERT_FALSE(photo.empty());
   const cv::Rect region(144, 279, 159, 103);
-  ShapeModelParams params;
-  params.roi = region;
-  params.numLevels = 2;
-  const ShapeModel model = createShapeModel(photo, params);
+  const ShapeModel model = regionModel(photo, region, 2);
   const RegionCopy copy = turnedRegion(photo, region, 48, -121.5, {1.0, 1.75});
   // The search's pose, not the least-squares fit's: on this texture the fit moves it by 0.4-0.75
   // px (from the known pose too), which is the refinement's matter, not the search's.
@@ -708,8 +710,7 @@ TEST(FindShapeModel, ATexturedDiscWhoseTopLevelPeakIsAPixelOffIsFound) {
   EXPECT_NEAR(found[0].angle, radians(-121.5), radians(0.3));
   EXPECT_GT(found[0].score, 0.85);
 
-  params.numLevels = 0;
-  EXPECT_EQ(createShapeModel(photo, params).numLevels(), 2);
+  EXPECT_EQ(regionModel(photo, region, 0).numLevels(), 2);
 }
 
 // A calibration chessboard photographed at an angle (tests/data/photos/left12.png), turned by
