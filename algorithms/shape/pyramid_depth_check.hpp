@@ -1,12 +1,12 @@
 #pragma once
 // Whether a shape model's search, with all of its pyramid levels, finds the model's own part
-// wherever the part lands on the camera's grid. A coarse level sees a periodic pattern (a
-// chessboard's squares, a connector's pins) aliased: at some turns and sub-pixel phases the
-// part's own pose scores lower there than a neighbouring period's, is suppressed, and the search
-// returns the neighbour though the part scores higher at level 0 (a chessboard patch: the top
-// level 1/8 of the part's size, a square 1.6 px there; 0.954 returned, the part 0.999). The
-// automatic pyramid (ShapeModelParams::numLevels = 0) is built from the edges each level keeps;
-// this test, whose answer is known, then turns levels down while that loses fewer copies.
+// wherever the part lands on the camera's grid. The automatic pyramid (ShapeModelParams::numLevels
+// = 0) is built from the edges each level keeps, less the top levels on which the part's pattern
+// repeats within the search's reach (findSearchPeriods, model_symmetry.hpp: a chessboard's
+// squares, aliased at 1/8). This test, whose answer is known, then turns levels down while that
+// loses fewer copies: it catches what neither rule sees (an apple, whose upper levels see a
+// nearly round outline and leave the part's angle and place further off than the levels below
+// look).
 
 #include <opencv2/core.hpp>
 
