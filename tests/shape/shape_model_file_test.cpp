@@ -289,6 +289,10 @@ TEST_F(ShapeModelFile, UnusableValuesBehindAValidChecksumAreRefused) {
   refusal("far_reference", [](ShapeModel& m) { m.referencePoint.x = 1e9; });
   refusal("angle_start", [](ShapeModel& m) { m.angleStart = 1e43; });
   refusal("huge_angle_step", [](ShapeModel& m) { m.levels.front().angleStep = 2.7e154; });
+  // Level 0's step 1/2,750 of level 1's: the search's wider look on level 0 spans two steps of
+  // level 1 in level 0's steps, and one search of a 48x40 image took six minutes (fuzz target).
+  refusal("fine_level_below_a_coarse_one",
+          [](ShapeModel& m) { m.levels.front().angleStep = m.levels[1].angleStep / 2750.0; });
   // The trained model itself is fine.
   saveShapeModel(trained, dir_ / "trained.model");
   EXPECT_NO_THROW(loadShapeModel(dir_ / "trained.model"));
