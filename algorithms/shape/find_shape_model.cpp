@@ -27,10 +27,11 @@ using shape_detail::Interval;
 using shape_detail::LevelSearch;
 using shape_detail::refineOnLevel;
 
+using shape_detail::kFinalFactor;
+using shape_detail::kMiddleFactor;
+using shape_detail::kTopFactor;
+
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
-constexpr double kTopFactor = 0.7;     // top-level threshold, relative to minScore
-constexpr double kMiddleFactor = 0.8;  // threshold on levels between top and 0
-constexpr double kFinalFactor = 0.8;   // level 0 before refinement (the refined score decides)
 
 // ---------------------------------------------------------------------------------------------
 // Search space

@@ -12,6 +12,14 @@
 
 namespace facet::shape_detail {
 
+// The score a part must keep on each level to be tracked, relative to FindParams::minScore: a part
+// scoring the minimum at the end is assumed to score at least this share of it there. The
+// automatic pyramid holds a model's top level to it (pyramid_depth_check.hpp).
+inline constexpr double kTopFactor = 0.7;     // the top level
+inline constexpr double kMiddleFactor = 0.8;  // the levels between the top and 0
+inline constexpr double kFinalFactor =
+    0.8;  // level 0 before refinement (the refined score decides)
+
 struct Interval {
   double start = 0.0;
   double extent = 0.0;

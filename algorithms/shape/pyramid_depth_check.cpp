@@ -10,6 +10,7 @@
 
 #include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/image_gradients.hpp"
+#include "algorithms/shape/level_search.hpp"
 #include "algorithms/shape/shape_similarity.hpp"
 
 namespace facet {
@@ -39,6 +40,38 @@ Placement placement(const ShapeModel& model, int k) {
   return {
       angle,
       {topPixel * ((3 * k + 1) % kCopies) / kCopies, topPixel * ((5 * k + 2) % kCopies) / kCopies}};
+}
+
+// Whether the top level scores the copy's known pose at least the share of level 0's score
+// (`level0Score`) that the search assumes of a part there (kTopFactor: it keeps top-level
+// candidates from that share of the minimum score); one that keeps less would drop the part were
+// it to score only the minimum at the end. The level's best over the 3x3 pixels around the pose,
+// at the pose's angle: the loss asked about is that of the level's features under a turn, not of
+// the angle grid's phase, which the search's looks absorb. The levels between are not held to
+// their share (kMiddleFactor): a large template of a circuit board keeps less than 0.8 of it on
+// levels that the search, looking around every candidate there, tracks the part through, and it
+// would lose two of its six levels and run 7 times longer.
+bool topLevelKeepsItsShare(const cv::Mat& copy, const ShapeModel& model, const Pose2D& truth,
+                           double level0Score) {
+  const int top = model.numLevels() - 1;
+  if (top == 0) return true;
+  cv::Mat grey = copy;
+  for (int l = 1; l <= top; ++l) cv::pyrDown(grey, grey);
+  const double f = std::ldexp(1.0, -top);
+  const cv::Point at(cvRound(truth.x * f), cvRound(truth.y * f));
+  const int reach = static_cast<int>(std::ceil(model.radius() * f)) + 4;
+  shape_detail::DirectionField field(grey.depth() == CV_8U ? grey : shape_detail::toGreyFloat(grey),
+                                     model.minContrast);
+  field.ensure(cv::Rect(at.x - reach, at.y - reach, 2 * reach + 1, 2 * reach + 1));
+  const shape_detail::PosedPoints posed = shape_detail::posePoints(
+      model.levels[static_cast<std::size_t>(top)].points, truth.angle, 1.0);
+  double best = 0.0;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      best =
+          std::max(best, shape_detail::scorePose(field.directions(), posed, at + cv::Point(dx, dy),
+                                                 Polarity::Use, 0.0, 0.0, 0));
+  return best >= shape_detail::kTopFactor * level0Score;
 }
 
 }  // namespace
@@ -72,18 +105,18 @@ int copiesLostBySearch(const cv::Mat& templateImage, const ShapeModel& model) {
       find.subpixel = SubpixelMode::Interpolation;
       find.threads = 1;
       const std::vector<ShapeMatch> matches = findShapeModel(copy, model, find);
-      if (!matches.empty() &&
-          std::hypot(matches.front().x - truth.x, matches.front().y - truth.y) <= kSamePlace)
-        continue;
       // The known pose's score, as the search scores an interpolated pose.
       shape_detail::DirectionField field(
           copy.depth() == CV_8U ? copy : shape_detail::toGreyFloat(copy), model.minContrast);
       field.ensureAll();
       const double truthScore =
           shape_detail::refinedScore(field.directions(), model, truth, Polarity::Use, 0);
-      if (matches.empty() ? truthScore >= find.minScore
-                          : truthScore > matches.front().score + kScoreMargin)
-        ++lost;
+      const bool found = !matches.empty() && std::hypot(matches.front().x - truth.x,
+                                                        matches.front().y - truth.y) <= kSamePlace;
+      const bool missed =
+          !found && (matches.empty() ? truthScore >= find.minScore
+                                     : truthScore > matches.front().score + kScoreMargin);
+      if (missed || !topLevelKeepsItsShare(copy, model, truth, truthScore)) ++lost;
     }
   });
   return lost;

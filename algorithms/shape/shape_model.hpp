@@ -70,8 +70,8 @@ struct ShapeModelParams {
   // top level, whatever the template's width. At most 6 levels. Then fewer while the part's
   // pattern repeats within a few pixels of the top level (a chessboard, a grid: the top level
   // cannot keep the part's pose beside a period's; findSearchPeriods), and while the
-  // deepest pyramid loses turned, shifted copies of the template that a shallower one finds
-  // (pyramid_depth_check.hpp; ShapeModel::pyramidTrials).
+  // deepest pyramid loses turned, shifted copies of the template that a shallower one finds,
+  // or would lose them at the minimum score (pyramid_depth_check.hpp; ShapeModel::pyramidTrials).
   int numLevels = 0;
 
   // Angle range searched, radians: [angleStart, angleStart + angleExtent]. Default: full circle.

@@ -10,6 +10,7 @@
 //      deformation tolerance of 1 px.
 //
 //   bench_shape_real [--smoke] [--data DIR] [--speed-only | --photos-only] [--greediness G]
+//                    [--min-score S]  (the photographs searched at another minimum score)
 // Times are medians of the process's CPU time (all threads), ms, on this machine, but for the
 // column that says wall.
 
@@ -443,13 +444,15 @@ void occludedPhotoTable(const std::filesystem::path& data, bool smoke) {
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);  // rows appear as they are measured
   bool smoke = false, photosOnly = false, speedOnly = false;
-  FindParams photoParams;  // the defaults; --greediness G to compare
+  FindParams photoParams;  // the defaults; --greediness G, --min-score S to compare
   std::filesystem::path data = std::filesystem::path(FACET_SOURCE_DIR) / "tests/data/photos";
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--smoke")) smoke = true;
     if (!std::strcmp(argv[i], "--data") && i + 1 < argc) data = argv[++i];
     if (!std::strcmp(argv[i], "--greediness") && i + 1 < argc)
       photoParams.greediness = std::atof(argv[++i]);
+    if (!std::strcmp(argv[i], "--min-score") && i + 1 < argc)
+      photoParams.minScore = std::atof(argv[++i]);
     if (!std::strcmp(argv[i], "--photos-only")) photosOnly = true;
     if (!std::strcmp(argv[i], "--speed-only")) speedOnly = true;
   }

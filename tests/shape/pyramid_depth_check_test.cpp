@@ -131,6 +131,42 @@ TEST(PyramidDepthCheck, TheAutomaticModelFindsTheChessboardPatchInASecondShot) {
       << "the 4-level pyramid finds the part: the test no longer shows what the check is for";
 }
 
+// Lines of small print (tests/data/photos/text_lines_*.png): on the third level, 1/4, the letters
+// blur into rows, which score the part on turned copies of the template at 0.57-0.75 of what
+// level 0 scores it, where the search assumes 0.7 (it keeps top-level candidates from 0.7 x the
+// minimum score). The search with 3 levels finds every copy, each scoring 0.97 at level 0; in a
+// second shot turned -167.4 degrees the part scores 0.488 on the top level and 0.958 in the end,
+// and 3 levels miss it. The check counts the copies whose levels keep less than the search's
+// share, and the automatic model takes 2 levels.
+TEST(PyramidDepthCheck, ADepthWhoseTopLevelKeepsTooLittleOfThePartIsGivenUp) {
+  const cv::Mat templ = testPhoto("text_lines_template.png");
+  const cv::Mat scene = testPhoto("text_lines_scene.png");
+  ASSERT_FALSE(templ.empty());
+  ASSERT_FALSE(scene.empty());
+  ShapeModelParams three;
+  three.numLevels = 3;
+  const ShapeModel deep = createShapeModel(templ, three);
+  EXPECT_TRUE(findShapeModel(scene, deep).empty())
+      << "3 levels find the part: the test no longer shows what the check is for";
+  EXPECT_GT(copiesLostBySearch(templ, deep), 0);
+
+  const ShapeModel automatic = createShapeModel(templ);
+  EXPECT_EQ(automatic.numLevels(), 2);
+  ASSERT_EQ(automatic.pyramidTrials.size(), 2u);
+  EXPECT_EQ(automatic.pyramidTrials[0].levels, 3);
+  EXPECT_GT(automatic.pyramidTrials[0].copiesLost, 0);
+  EXPECT_EQ(automatic.pyramidTrials[1].copiesLost, 0);
+  const auto found = findShapeModel(scene, automatic);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_GT(found[0].score, 0.9);
+  // Where the exhaustive search of level 0 alone finds it.
+  ShapeModelParams one;
+  one.numLevels = 1;
+  const auto exhaustive = findShapeModel(scene, createShapeModel(templ, one));
+  ASSERT_EQ(exhaustive.size(), 1u);
+  EXPECT_LT(std::hypot(found[0].x - exhaustive[0].x, found[0].y - exhaustive[0].y), 0.05);
+}
+
 // A part without a periodic pattern keeps the pyramid its edges allow: the test finds every copy.
 TEST(PyramidDepthCheck, APartThatFindsItsCopiesKeepsItsLevels) {
   const cv::Mat photo = testPhoto("board_qfp44_template.png");
