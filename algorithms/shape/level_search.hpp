@@ -17,8 +17,7 @@ namespace facet::shape_detail {
 // automatic pyramid holds a model's top level to it (pyramid_depth_check.hpp).
 inline constexpr double kTopFactor = 0.7;     // the top level
 inline constexpr double kMiddleFactor = 0.8;  // the levels between the top and 0
-inline constexpr double kFinalFactor =
-    0.8;  // level 0 before refinement (the refined score decides)
+inline constexpr double kFinalFactor = 0.8;   // level 0 before refinement (the fit's score decides)
 
 struct Interval {
   double start = 0.0;

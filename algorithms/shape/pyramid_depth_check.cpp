@@ -51,17 +51,17 @@ Placement placement(const ShapeModel& model, int k) {
 // their share (kMiddleFactor): a large template of a circuit board keeps less than 0.8 of it on
 // levels that the search, looking around every candidate there, tracks the part through, and it
 // would lose two of its six levels and run 7 times longer.
-bool topLevelKeepsItsShare(const cv::Mat& copy, const ShapeModel& model, const Pose2D& truth,
+// `grey`: the copy as the search reads it (8-bit or float).
+bool topLevelKeepsItsShare(const cv::Mat& grey, const ShapeModel& model, const Pose2D& truth,
                            double level0Score) {
   const int top = model.numLevels() - 1;
   if (top == 0) return true;
-  cv::Mat grey = copy;
-  for (int l = 1; l <= top; ++l) cv::pyrDown(grey, grey);
+  cv::Mat level = grey;
+  for (int l = 1; l <= top; ++l) cv::pyrDown(level, level);
   const double f = std::ldexp(1.0, -top);
   const cv::Point at(cvRound(truth.x * f), cvRound(truth.y * f));
   const int reach = static_cast<int>(std::ceil(model.radius() * f)) + 4;
-  shape_detail::DirectionField field(grey.depth() == CV_8U ? grey : shape_detail::toGreyFloat(grey),
-                                     model.minContrast);
+  shape_detail::DirectionField field(level, model.minContrast);
   field.ensure(cv::Rect(at.x - reach, at.y - reach, 2 * reach + 1, 2 * reach + 1));
   const shape_detail::PosedPoints posed = shape_detail::posePoints(
       model.levels[static_cast<std::size_t>(top)].points, truth.angle, 1.0);
@@ -105,9 +105,11 @@ int copiesLostBySearch(const cv::Mat& templateImage, const ShapeModel& model) {
       find.subpixel = SubpixelMode::Interpolation;
       find.threads = 1;
       const std::vector<ShapeMatch> matches = findShapeModel(copy, model, find);
-      // The known pose's score, as the search scores an interpolated pose.
-      shape_detail::DirectionField field(
-          copy.depth() == CV_8U ? copy : shape_detail::toGreyFloat(copy), model.minContrast);
+      // The copy's grey as the search reads it (8-bit as it is, else on the 8-bit float scale),
+      // from which its pyramid is built. The known pose's score, as the search scores an
+      // interpolated pose.
+      const cv::Mat grey = copy.depth() == CV_8U ? copy : shape_detail::toGreyFloat(copy);
+      shape_detail::DirectionField field(grey, model.minContrast);
       field.ensureAll();
       const double truthScore =
           shape_detail::refinedScore(field.directions(), model, truth, Polarity::Use, 0);
@@ -116,7 +118,7 @@ int copiesLostBySearch(const cv::Mat& templateImage, const ShapeModel& model) {
       const bool missed =
           !found && (matches.empty() ? truthScore >= find.minScore
                                      : truthScore > matches.front().score + kScoreMargin);
-      if (missed || !topLevelKeepsItsShare(copy, model, truth, truthScore)) ++lost;
+      if (missed || !topLevelKeepsItsShare(grey, model, truth, truthScore)) ++lost;
     }
   });
   return lost;
