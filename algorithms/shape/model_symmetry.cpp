@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "algorithms/shape/level_search.hpp"
+#include "algorithms/shape/response_map_search.hpp"
 #include "algorithms/shape/shape_model.hpp"
 
 namespace facet {
@@ -234,7 +236,7 @@ double shiftedSimilarity(const std::vector<ShapePoint>& points, const PointRaste
 }  // namespace
 
 std::vector<ModelPeriod> findSearchPeriods(const std::vector<ShapeLevel>& levels, int topReach,
-                                           double minScore, int maxCount) {
+                                           double minScore, int maxCount, double levelZeroShare) {
   if (levels.size() < 2 || levels.front().points.size() < 8 || levels.back().points.size() < 8)
     return {};
   const std::vector<ShapePoint>& points = levels.front().points;
@@ -259,16 +261,17 @@ std::vector<ModelPeriod> findSearchPeriods(const std::vector<ShapeLevel>& levels
     if (v < 0.0) v = shiftedSimilarity(points, cloud.raster, extent, cv::Point2d(dx, dy), 1);
     return v;
   };
+  const double levelZeroScore = levelZeroShare * minScore;
   std::vector<ModelPeriod> out;
   for (int dy = -r; dy <= r; ++dy)
     for (int dx = -r; dx <= r; ++dx) {
       const double length = std::hypot(dx, dy);
       if (length < shortest || length > longest) continue;
       if (shiftedSimilarity(points, cloud.raster, extent, cv::Point2d(dx, dy), stride) <
-          minScore - kSampleMargin)
+          levelZeroScore - kSampleMargin)
         continue;
       const double v = fullAt(dx, dy);
-      if (v < minScore) continue;
+      if (v < levelZeroScore) continue;
       bool peak = true;
       for (int ey = -1; ey <= 1 && peak; ++ey)
         for (int ex = -1; ex <= 1 && peak; ++ex)
@@ -288,6 +291,23 @@ std::vector<ModelPeriod> findSearchPeriods(const std::vector<ShapeLevel>& levels
             [](const ModelPeriod& a, const ModelPeriod& b) { return a.score > b.score; });
   if (static_cast<int>(out.size()) > maxCount) out.resize(static_cast<std::size_t>(maxCount));
   return out;
+}
+
+std::vector<ModelPeriod> findTrackedPeriods(const std::vector<ShapeLevel>& levels) {
+  std::vector<ModelPeriod> periods =
+      findSearchPeriods(levels, shape_detail::kPeakReach, 0.7, 4, shape_detail::kTopFactor);
+  // A shift's opposite is a period as well; only the points that stay within the model's extent
+  // score it, and they are others (a slanted board's period scored 0.72 one way, 0.58 the other,
+  // and the part lay the other way from its neighbour).
+  const std::size_t found = periods.size();
+  for (std::size_t i = 0; i < found; ++i) {
+    const ModelPeriod opposite{-periods[i].shift, periods[i].score};
+    const bool listed = std::any_of(periods.begin(), periods.end(), [&](const ModelPeriod& p) {
+      return std::hypot(p.shift.x - opposite.shift.x, p.shift.y - opposite.shift.y) <= 1.5;
+    });
+    if (!listed) periods.push_back(opposite);
+  }
+  return periods;
 }
 
 Pose2D turnedBy(const Pose2D& pose, const ModelSymmetry& symmetry) {

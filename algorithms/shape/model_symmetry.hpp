@@ -4,7 +4,8 @@
 // The search turns each match by them and keeps the pose that scores best, so that a part is not
 // returned in a near-symmetric pose that the coarse levels could not tell from the right one.
 // And the periods of a repeating pattern: shifts that map the model almost onto itself, which the
-// automatic pyramid keeps beyond the reach of its top level.
+// automatic pyramid keeps beyond the reach of its top level, or, where level 0 repeats less well
+// than its top level, the search tracks.
 
 #include <vector>
 
@@ -60,8 +61,23 @@ struct ModelPeriod {
 // `minScore`: the search trusts the top level's scores to within a factor of 0.7 (it keeps
 // candidates from 0.7 x the minimum score there); a shifted pose that keeps less of the pattern
 // than that does not rival the part's (a row of pins, 0.63: the body does not repeat).
+// `levelZeroShare`: level 0's points need only this share of `minScore` (the top level's bar is
+// `minScore` as it stands); see findTrackedPeriods.
 std::vector<ModelPeriod> findSearchPeriods(const std::vector<ShapeLevel>& levels, int topReach,
-                                           double minScore = 0.7, int maxCount = 4);
+                                           double minScore = 0.7, int maxCount = 4,
+                                           double levelZeroShare = 1.0);
+
+// The periods the search tracks beside each top-level candidate (find_shape_model.cpp): those the
+// top level may not tell from the part's pose, though level 0 does not repeat well enough for the
+// automatic pyramid to refuse the depth. A chessboard photographed at a slant keeps 0.63-0.68 of
+// level 0's points under one period (the squares' spacing changes across the patch), while its
+// top level, where the slant is gone, repeats at 0.72-0.86; a neighbouring square's pose two
+// pixels away outscored the part's there (0.937 against 0.927) and the part (0.998) was missed.
+// Refusing such depths cost a package with rows of pins (which repeat; its body does not) two of
+// four levels and 22 times its search time. Level 0 is held to the share of the bar the search
+// trusts a top-level score to (kTopFactor): enough to show the shift is a period of the pattern.
+// Each period's opposite is among them.
+std::vector<ModelPeriod> findTrackedPeriods(const std::vector<ShapeLevel>& levels);
 
 // The pose that shows the model turned by `symmetry` where `pose` shows it: pose o S with
 // S(p) = c + R(a) (p - c).

@@ -430,6 +430,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
   };
   model.finePoints = finePoints(model.edgeEstimator);
   model.symmetries = findSearchSymmetries(model.levels);
+  model.trackedPeriods = findTrackedPeriods(model.levels);
   if (params.numLevels == 0 && model.numLevels() > 1) {
     // The automatic pyramid, tested on copies of the template (pyramid_depth_check.hpp): the top
     // level is given up while the pyramid without it loses fewer copies.
@@ -440,6 +441,7 @@ ShapeModel createShapeModel(const cv::Mat& templateImage, const ShapeModelParams
       ShapeModel shallower = model;
       shallower.levels.pop_back();
       shallower.symmetries = findSearchSymmetries(shallower.levels);
+      shallower.trackedPeriods = findTrackedPeriods(shallower.levels);
       const int lost = copiesLostBySearch(templateImage(region), shallower);
       const bool better = lost < trials.back().copiesLost;
       trials.push_back({shallower.numLevels(), lost});

@@ -155,6 +155,10 @@ struct ShapeModel {
   // (findSearchSymmetries, model_symmetry.hpp; derived from the points when the model is
   // created, and kept in its file).
   std::vector<ModelSymmetry> symmetries;
+  // Shifts that map the model almost onto itself within its top level's reach, which the search
+  // tracks beside each top-level candidate (findTrackedPeriods, model_symmetry.hpp). Derived from
+  // the points when the model is created, and kept in its file.
+  std::vector<ModelPeriod> trackedPeriods;
 
   [[nodiscard]] bool empty() const { return levels.empty(); }
   [[nodiscard]] int numLevels() const { return static_cast<int>(levels.size()); }

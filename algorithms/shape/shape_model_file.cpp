@@ -24,6 +24,7 @@ constexpr double kMaxStepRatio = 4.0;      // a level's angle step over the one 
 // findSearchSymmetries gives at most 3 of level 0 and 3 of the top level; each costs every search
 // a turned pose to score.
 constexpr std::uint32_t kMaxSymmetries = 16;
+constexpr std::uint32_t kMaxTrackedPeriods = 16;
 
 std::uint64_t fnv1a(const char* data, std::size_t size) {
   std::uint64_t h = 14695981039346656037ull;
@@ -145,6 +146,11 @@ std::string implausibility(const ShapeModel& m) {
         !(std::abs(sym.centre.y) <= 4.0 * kMaxTemplateSide) ||
         !(sym.score >= 0.0 && sym.score <= 1.0 + 1e-6))
       return "symmetry";
+  for (const ModelPeriod& period : m.trackedPeriods)
+    if (!(std::abs(period.shift.x) <= 4.0 * kMaxTemplateSide) ||
+        !(std::abs(period.shift.y) <= 4.0 * kMaxTemplateSide) ||
+        !(period.score >= 0.0 && period.score <= 1.0 + 1e-6))
+      return "period";
   return "";
 }
 
@@ -170,6 +176,9 @@ void saveShapeModel(const ShapeModel& model, const std::filesystem::path& path) 
   w.put(static_cast<std::uint32_t>(model.symmetries.size()));
   for (const ModelSymmetry& sym : model.symmetries)
     w.put(sym.angle), w.put(sym.centre.x), w.put(sym.centre.y), w.put(sym.score);
+  w.put(static_cast<std::uint32_t>(model.trackedPeriods.size()));
+  for (const ModelPeriod& period : model.trackedPeriods)
+    w.put(period.shift.x), w.put(period.shift.y), w.put(period.score);
 
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   if (!out) throw ShapeModelFileError(path.string() + ": cannot open for writing");
@@ -250,12 +259,22 @@ ShapeModel loadShapeModel(const std::filesystem::path& path) {
       sym.score = r.get<double>();
     }
   }
+  if (version >= 4) {
+    const auto count = r.get<std::uint32_t>();
+    if (count > kMaxTrackedPeriods) r.fail("corrupt period count");
+    model.trackedPeriods.resize(count);
+    for (ModelPeriod& period : model.trackedPeriods) {
+      period.shift.x = r.get<double>(), period.shift.y = r.get<double>();
+      period.score = r.get<double>();
+    }
+  }
   if (!r.atEnd()) r.fail("corrupt shape model file (unexpected data after the model)");
   if (model.levels.front().points.empty() || model.finePoints.empty())
     r.fail("corrupt shape model file (invalid values)");
   if (const std::string why = implausibility(model); !why.empty())
     r.fail("corrupt shape model file (invalid values: " + why + ")");
   if (version < 3) model.symmetries = findSearchSymmetries(model.levels);
+  if (version < 4) model.trackedPeriods = findTrackedPeriods(model.levels);
   return model;
 }
 

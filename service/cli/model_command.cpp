@@ -93,6 +93,10 @@ void run(const ModelOptions& o) {
     nlohmann::json symmetries = nlohmann::json::array();
     for (const auto& s : model.symmetries)
       symmetries.push_back({{"angle", degrees(s.angle)}, {"score", s.score}});
+    // Shifts (template pixels) whose neighbours the search tracks beside each top-level candidate.
+    nlohmann::json periods = nlohmann::json::array();
+    for (const auto& p : model.trackedPeriods)
+      periods.push_back({{"shift", {p.shift.x, p.shift.y}}, {"score", p.score}});
     // The training test's pose errors (null for a copy not found: JSON has no infinity).
     nlohmann::json trials = nlohmann::json::object();
     for (const auto& t : model.edgeEstimatorTrials)
@@ -123,6 +127,7 @@ void run(const ModelOptions& o) {
          {"min_component", model.minComponentSize},
          {"min_component_chosen", o.minComponent ? "--min-component" : "automatic"},
          {"near_symmetries", symmetries},
+         {"tracked_periods", periods},
          {"edge_estimator", edgeEstimatorName(model.edgeEstimator)},
          {"edge_estimator_chosen", o.edgeEstimator == "auto" ? "automatic" : "--edge-estimator"},
          {"edge_estimator_trials", trials}});

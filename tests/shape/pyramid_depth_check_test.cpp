@@ -112,7 +112,9 @@ TEST(PyramidDepthCheck, ADepthThatLosesCopiesIsGivenUp) {
 
 // The camera's second shot, turned by -165.71 degrees at scale 1.01: with 4 levels the search
 // returned a neighbouring pair of squares (0.954, 29 px off) while the part scores 0.999; the
-// automatic model finds the part.
+// automatic model finds the part. So does the 4-level one now that the search tracks each
+// top-level candidate's neighbours one period away (ShapeModel::trackedPeriods), and without them
+// it still returns the neighbour.
 TEST(PyramidDepthCheck, TheAutomaticModelFindsTheChessboardPatchInASecondShot) {
   const cv::Mat fine = testPhoto("right04.png");
   ASSERT_FALSE(fine.empty());
@@ -125,7 +127,13 @@ TEST(PyramidDepthCheck, TheAutomaticModelFindsTheChessboardPatchInASecondShot) {
   EXPECT_GT(found[0].score, 0.99);
 
   // The pyramid the edges allow, untested.
-  const auto deep = findShapeModel(shot.image, createShapeModel(photo, patchParams(4)));
+  ShapeModel deepModel = createShapeModel(photo, patchParams(4));
+  ASSERT_FALSE(deepModel.trackedPeriods.empty());
+  const auto tracked = findShapeModel(shot.image, deepModel);
+  ASSERT_FALSE(tracked.empty());
+  EXPECT_LT(std::hypot(tracked[0].x - shot.truth.x, tracked[0].y - shot.truth.y), 0.2);
+  deepModel.trackedPeriods.clear();
+  const auto deep = findShapeModel(shot.image, deepModel);
   ASSERT_FALSE(deep.empty());
   EXPECT_GT(std::hypot(deep[0].x - shot.truth.x, deep[0].y - shot.truth.y), 10.0)
       << "the 4-level pyramid finds the part: the test no longer shows what the check is for";

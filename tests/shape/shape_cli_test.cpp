@@ -1,4 +1,5 @@
 // `facet model create` and `facet match`: the real binary on generated images.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -274,6 +275,34 @@ TEST(ShapeCli, CreatePrintsThePeriodThatRefusedADepth) {
   EXPECT_GT(trials[0].at("period_score").get<double>(), 0.6);
   EXPECT_FALSE(trials[0].contains("copies_lost"));
   EXPECT_TRUE(trials.back().contains("copies_lost"));
+  // A board patch whose period the depth keeps: none is tracked beside it.
+  EXPECT_TRUE(nlohmann::json::parse(create.out).at("tracked_periods").empty()) << create.out;
+  fs::remove_all(dir);
+}
+
+// A chessboard photographed at a slant keeps its depth; the periods its top level cannot tell
+// apart are tracked by the search, each with its opposite, and printed.
+TEST(ShapeCli, CreatePrintsTheTrackedPeriods) {
+  const fs::path dir = fs::temp_directory_path() / "facet_shape_cli_tracked_test";
+  fs::create_directories(dir);
+  const fs::path err = dir / "stderr.txt";
+  const CliRun create = run(std::string(FACET_CLI) + " model create --image " +
+                                FACET_TEST_DATA_DIR + "/photos/slanted_board_template.png --out " +
+                                (dir / "board.model").string() + " --json",
+                            err);
+  ASSERT_EQ(create.exitCode, 0) << readText(err);
+  const auto periods = nlohmann::json::parse(create.out).at("tracked_periods");
+  ASSERT_FALSE(periods.empty()) << create.out;
+  for (const auto& p : periods) {
+    const double x = p.at("shift")[0].get<double>(), y = p.at("shift")[1].get<double>();
+    EXPECT_GT(std::hypot(x, y), 8.0);  // a pixel of the top level (1/8) or more
+    EXPECT_GE(p.at("score").get<double>(), 0.49);
+    const bool opposite = std::any_of(periods.begin(), periods.end(), [&](const nlohmann::json& q) {
+      return std::hypot(q.at("shift")[0].get<double>() + x, q.at("shift")[1].get<double>() + y) <=
+             1.5;
+    });
+    EXPECT_TRUE(opposite) << p;
+  }
   fs::remove_all(dir);
 }
 

@@ -14,6 +14,7 @@
 #include "algorithms/shape/find_shape_model.hpp"
 #include "algorithms/shape/shape_model_file.hpp"
 #include "tests/shape/bracket_scenes.hpp"
+#include "tests/shape/test_photos.hpp"
 
 namespace facet {
 namespace {
@@ -118,7 +119,12 @@ std::vector<char> rewritten(const std::vector<char>& file, std::uint32_t version
   return out;
 }
 
-// The bytes a model's near-symmetries take at the end of a version 3 payload.
+// The bytes a model's tracked periods take at the end of a version 4 payload.
+std::size_t periodBlockSize(const ShapeModel& model) {
+  return sizeof(std::uint32_t) + model.trackedPeriods.size() * 3 * sizeof(double);
+}
+
+// The bytes a model's near-symmetries take before them (at the end of a version 3 payload).
 std::size_t symmetryBlockSize(const ShapeModel& model) {
   return sizeof(std::uint32_t) + model.symmetries.size() * 4 * sizeof(double);
 }
@@ -147,11 +153,12 @@ TEST_F(ShapeModelFile, SymmetriesAreKeptAndFilesWithoutThemFindThemAtLoad) {
       EXPECT_EQ(loaded.symmetries[i].score, model.symmetries[i].score) << what;
     }
   };
-  same(loadShapeModel(file), "version 3");
+  same(loadShapeModel(file), "version 4");
   // Version 2 ended after the estimator byte: the same symmetries, found at load.
+  const std::size_t periodBytes = periodBlockSize(model);
   const fs::path v2 = dir_ / "version2.model";
   write(v2, rewritten(bytesOf(file), 2, [&](std::vector<char>& p) {
-          p.resize(p.size() - symmetryBlockSize(model));
+          p.resize(p.size() - periodBytes - symmetryBlockSize(model));
         }));
   same(loadShapeModel(v2), "version 2");
 
@@ -160,18 +167,62 @@ TEST_F(ShapeModelFile, SymmetriesAreKeptAndFilesWithoutThemFindThemAtLoad) {
   const fs::path nan = dir_ / "nan_symmetry.model";
   write(nan, rewritten(bytesOf(file), kShapeModelFileVersion, [&](std::vector<char>& p) {
           const double bad = std::numeric_limits<double>::quiet_NaN();
-          std::memcpy(p.data() + p.size() - symmetryBlockSize(model) + sizeof(std::uint32_t), &bad,
-                      sizeof bad);
+          std::memcpy(
+              p.data() + p.size() - periodBytes - symmetryBlockSize(model) + sizeof(std::uint32_t),
+              &bad, sizeof bad);
         }));
   std::string e = loadError(nan);
   EXPECT_NE(e.find("symmetry"), std::string::npos) << e;
   const fs::path many = dir_ / "many_symmetries.model";
   write(many, rewritten(bytesOf(file), kShapeModelFileVersion, [&](std::vector<char>& p) {
           const std::uint32_t count = 1000;
-          std::memcpy(p.data() + p.size() - symmetryBlockSize(model), &count, sizeof count);
+          std::memcpy(p.data() + p.size() - periodBytes - symmetryBlockSize(model), &count,
+                      sizeof count);
         }));
   e = loadError(many);
   EXPECT_NE(e.find("symmetry count"), std::string::npos) << e;
+}
+
+// A patch of a chessboard photographed at a slant (tests/data/photos/slanted_board_template.png)
+// has periods its top level cannot tell apart (model_symmetry.hpp, findTrackedPeriods).
+TEST_F(ShapeModelFile, TrackedPeriodsAreKeptAndFilesWithoutThemFindThemAtLoad) {
+  const cv::Mat templ = testing::testPhoto("slanted_board_template.png");
+  ASSERT_FALSE(templ.empty());
+  const ShapeModel model = createShapeModel(templ);
+  ASSERT_FALSE(model.trackedPeriods.empty());
+  const fs::path file = dir_ / "board.model";
+  saveShapeModel(model, file);
+  const auto same = [&](const ShapeModel& loaded, const char* what) {
+    ASSERT_EQ(loaded.trackedPeriods.size(), model.trackedPeriods.size()) << what;
+    for (std::size_t i = 0; i < model.trackedPeriods.size(); ++i) {
+      EXPECT_EQ(loaded.trackedPeriods[i].shift, model.trackedPeriods[i].shift) << what;
+      EXPECT_EQ(loaded.trackedPeriods[i].score, model.trackedPeriods[i].score) << what;
+    }
+  };
+  same(loadShapeModel(file), "version 4");
+  // Version 3 ended after the symmetries: the same periods, found at load.
+  const std::size_t periodBytes = periodBlockSize(model);
+  const fs::path v3 = dir_ / "version3.model";
+  write(v3, rewritten(bytesOf(file), 3,
+                      [&](std::vector<char>& p) { p.resize(p.size() - periodBytes); }));
+  same(loadShapeModel(v3), "version 3");
+
+  // Values no search can use behind a valid checksum: a shift that is not a number, more periods
+  // than any model has.
+  const fs::path nan = dir_ / "nan_period.model";
+  write(nan, rewritten(bytesOf(file), kShapeModelFileVersion, [&](std::vector<char>& p) {
+          const double bad = std::numeric_limits<double>::quiet_NaN();
+          std::memcpy(p.data() + p.size() - periodBytes + sizeof(std::uint32_t), &bad, sizeof bad);
+        }));
+  std::string e = loadError(nan);
+  EXPECT_NE(e.find("period"), std::string::npos) << e;
+  const fs::path many = dir_ / "many_periods.model";
+  write(many, rewritten(bytesOf(file), kShapeModelFileVersion, [&](std::vector<char>& p) {
+          const std::uint32_t count = 1000;
+          std::memcpy(p.data() + p.size() - periodBytes, &count, sizeof count);
+        }));
+  e = loadError(many);
+  EXPECT_NE(e.find("period count"), std::string::npos) << e;
 }
 
 TEST_F(ShapeModelFile, TheEdgeEstimatorIsKeptAndVersionOneFilesLoadAsTheProfileFit) {
@@ -182,9 +233,9 @@ TEST_F(ShapeModelFile, TheEdgeEstimatorIsKeptAndVersionOneFilesLoadAsTheProfileF
   saveShapeModel(model, file);
   EXPECT_EQ(loadShapeModel(file).edgeEstimator, EdgeEstimator::FacetZeroCrossing);
 
-  // Version 1 had no estimator byte after the subpixel points (nor the symmetries that follow
-  // it since version 3): its models used the profile fit.
-  const std::size_t symmetryBytes = symmetryBlockSize(model);
+  // Version 1 had no estimator byte after the subpixel points (nor the symmetries and periods
+  // that follow it since versions 3 and 4): its models used the profile fit.
+  const std::size_t symmetryBytes = symmetryBlockSize(model) + periodBlockSize(model);
   const fs::path old = dir_ / "version1.model";
   write(old, rewritten(bytesOf(file), 1,
                        [&](std::vector<char>& p) { p.resize(p.size() - symmetryBytes - 1); }));
