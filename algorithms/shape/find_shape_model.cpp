@@ -405,12 +405,8 @@ void addPeriodNeighbours(std::vector<Candidate>& candidates, const ShapeModel& m
     for (const ModelPeriod& period : model.trackedPeriods) {
       const cv::Point2d shift = pose.applyToVector(period.shift * f);
       const cv::Point at(cvRound(c.x + shift.x), cvRound(c.y + shift.y));
-      double best = -1.0;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-          best = std::max(best, shape_detail::scorePose(topField, posed, at + cv::Point(dx, dy),
-                                                        polarity, 0.0, 0.0, spread));
-      if (best >= c.score - kClusterMargin)
+      if (shape_detail::bestScoreAround(topField, posed, at, polarity, spread) >=
+          c.score - kClusterMargin)
         candidates.push_back({double(at.x), double(at.y), c.angle, c.scale, c.score});
     }
   }

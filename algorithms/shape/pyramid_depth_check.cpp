@@ -65,12 +65,8 @@ bool topLevelKeepsItsShare(const cv::Mat& grey, const ShapeModel& model, const P
   field.ensure(cv::Rect(at.x - reach, at.y - reach, 2 * reach + 1, 2 * reach + 1));
   const shape_detail::PosedPoints posed = shape_detail::posePoints(
       model.levels[static_cast<std::size_t>(top)].points, truth.angle, 1.0);
-  double best = 0.0;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx)
-      best =
-          std::max(best, shape_detail::scorePose(field.directions(), posed, at + cv::Point(dx, dy),
-                                                 Polarity::Use, 0.0, 0.0, 0));
+  const double best =
+      std::max(0.0, shape_detail::bestScoreAround(field.directions(), posed, at, Polarity::Use, 0));
   return best >= shape_detail::kTopFactor * level0Score;
 }
 

@@ -150,6 +150,17 @@ double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, P
   return (polarity == Polarity::IgnoreGlobal ? std::abs(sum) : sum) * invN;
 }
 
+double bestScoreAround(const cv::Mat& field, const PosedPoints& posed, cv::Point at,
+                       Polarity polarity, int spread) {
+  double best = scorePose(field, posed, at, polarity, 0.0, 0.0, spread);
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx)
+      if (dx || dy)
+        best = std::max(
+            best, scorePose(field, posed, at + cv::Point(dx, dy), polarity, 0.0, 0.0, spread));
+  return best;
+}
+
 double refinedScore(const cv::Mat& field, const ShapeModel& model, const Pose2D& pose,
                     Polarity polarity, int spread) {
   const double c = std::cos(pose.angle), s = std::sin(pose.angle);

@@ -31,6 +31,11 @@ PosedPoints posePoints(const std::vector<ShapePoint>& points, double angle, doub
 double scorePose(const cv::Mat& field, const PosedPoints& posed, cv::Point at, Polarity polarity,
                  double minScore, double greediness, int spread);
 
+// The best scorePose (no early termination) over the 3x3 pixels around `at`: how well a level
+// sees a pose whatever the phase of its pixel grid.
+double bestScoreAround(const cv::Mat& field, const PosedPoints& posed, cv::Point at,
+                       Polarity polarity, int spread);
+
 // The similarity of the model's subpixel points at a subpixel pose, with the image's directions
 // interpolated bilinearly: the score of a refined match. With `spread` > 0 each point takes the
 // best of the directions at whole-pixel shifts of up to `spread` in x and y.
