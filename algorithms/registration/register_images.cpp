@@ -11,6 +11,7 @@
 #include "algorithms/registration/correlation_peak.hpp"
 #include "algorithms/registration/harris_affine.hpp"
 #include "algorithms/registration/patch_correlation.hpp"
+#include "algorithms/registration/relative_defocus.hpp"
 #include "algorithms/registration/rotation_scale_vote.hpp"
 
 namespace facet {
@@ -109,9 +110,11 @@ cv::Point2d centreOf(const cv::Mat& image) {
 
 // Warp-and-re-match: the reference warped by H is compared, patch by patch around each reference
 // corner's predicted position, with the image; the NCC peak (subpixel) gives the match.
+// `defocus`: the views' relative defocus, estimated here when empty and kept for the next call.
 std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
                                   const std::vector<HarrisCorner>& corners, const cv::Matx33d& H,
-                                  int R, const RegistrationParams& params) {
+                                  int R, const RegistrationParams& params,
+                                  std::optional<double>& defocus) {
   const double s = magnificationAt(H, centreOf(refGrey));
   // Match resolutions: blur whichever image is seen at the finer scale, into a buffer of its own
   // (a blur into `ref` or `img` while they share the caller's pixels would blur those in place,
@@ -132,6 +135,22 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
   cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
   cv::Mat ones(refGrey.size(), CV_8U, cv::Scalar(255));
   cv::warpPerspective(ones, valid, H, imgGrey.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  // The views may also differ in focus (a refocused lens, a blurred shot): the sharper one is
+  // blurred to the other's detail, estimated on the first re-matching (relative_defocus.hpp).
+  if (!defocus) defocus = params.matchDefocus ? relativeDefocus(warped, img, valid) : 0.0;
+  if (*defocus > 0) {
+    cv::Mat blurred;
+    cv::GaussianBlur(warped, blurred, cv::Size(), *defocus, *defocus, cv::BORDER_REFLECT);
+    warped = blurred;
+    // The blur has spread the unmapped border into the pixels within 3 sigma of it.
+    const int reach = static_cast<int>(std::ceil(3 * *defocus));
+    cv::erode(valid, valid,
+              cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
+  } else if (*defocus < 0) {
+    cv::Mat blurred;
+    cv::GaussianBlur(img, blurred, cv::Size(), -*defocus, -*defocus, cv::BORDER_REFLECT);
+    img = blurred;
+  }
   const int r = params.refinePatchRadius;
   const cv::Rect bounds(0, 0, imgGrey.cols, imgGrey.rows);
   std::vector<FeatureMatch> out;
@@ -380,11 +399,13 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
     }
     const std::vector<HarrisCorner>& dense = *s.grid;
     std::size_t rematched = 0;  // pairs the last accepted re-matching found
+    std::optional<double> defocus;
     for (int it = 0; it < params.refineIterations; ++it) {
       // Once H rests on the dense pairs, the prediction is within a pixel or two.
       const int radius =
           it == 0 ? params.refineSearchRadius : std::min(params.refineSearchRadius, 3);
-      std::vector<FeatureMatch> rm = rematch(s.ref, s.img, dense, result.H, radius, params);
+      std::vector<FeatureMatch> rm =
+          rematch(s.ref, s.img, dense, result.H, radius, params, defocus);
       std::vector<cv::Point2d> s2, d2;
       for (const auto& m : rm) {
         s2.push_back(m.ref);

@@ -60,6 +60,9 @@ struct RegistrationParams {
   int refinePatchRadius = 7;    // pixels; patches are (2r+1)^2
   double finalThreshold = 1.0;  // pixels; RANSAC threshold of the fit to the re-matched pairs
   double refineMinScore = 0.8;  // minimum NCC of a re-matched patch
+  // The re-matching blurs the sharper of the two views to the other's detail first (a blurred
+  // or refocused shot; relative_defocus.hpp). false: they are compared as they are.
+  bool matchDefocus = true;
   // Escalation to Harris-Affine regions (registerImages only, when affineRegions is off): when
   // the plain Harris stage fails, or its global fit rests on fewer than `affineBelowInliers`
   // inliers (a large viewpoint change leaves plain windows few true matches, and a transform on
