@@ -1,10 +1,10 @@
 #pragma once
 // How much more blurred one of two registered views is than the other. Two photographs of a
 // scene differ by more than their sampling when focus or depth of field differ between them (a
-// refocused lens, a part nearer or farther than the focus plane). Correlating a sharp patch with a blurred one
-// locates the pair worse than correlating two equally blurred ones (the matched filter for a
-// blurred patch is the blurred patch): on Oxford bikes 1-6 the re-matched pairs lay a median 1.5 px
-// from the best homography, and their fit 1.7 px from the dense reference.
+// refocused lens, a part nearer or farther than the focus plane). Correlating a sharp patch with a
+// blurred one locates the pair worse than correlating two equally blurred ones (the matched filter
+// for a blurred patch is the blurred patch): on Oxford bikes 1-6 the re-matched pairs lay a
+// median 1.5 px from the best homography, and their fit 1.7 px from the dense reference.
 
 #include <opencv2/core.hpp>
 
