@@ -114,7 +114,7 @@ TEST(RegisterImages, ABlurredViewIsReMatchedAtItsOwnFocus) {
     cv::Mat image = warp(ref, truth, {400, 400});
     cv::GaussianBlur(image, image, cv::Size(), 3.0, 3.0);
     cv::Mat noise(image.size(), CV_16S);
-    cv::randn(noise, 0, 2);
+    cv::RNG(seed).fill(noise, cv::RNG::NORMAL, 0, 2);
     cv::Mat noisy;
     image.convertTo(noisy, CV_16S);
     noisy += noise;
