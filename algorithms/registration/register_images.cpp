@@ -425,6 +425,7 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
       result.matches = std::move(rm);
       result.inliers = std::move(inliers);
     }
+    result.defocus = defocus.value_or(0.0);
     // A transform resting on very few global matches must be confirmed by the re-matching: at
     // least confirmInliers pairs, and most of those it found. Around the right transform nearly
     // every re-matched pair agrees with it; around a wrong one the pairs are chance hits of

@@ -48,6 +48,7 @@ void run(const RegisterOptions& o) {
                        {"global_inliers", r.globalInliers},
                        {"stage", r.stage},
                        {"escalated", r.escalated},
+                       {"defocus_px", r.defocus},
                        {"time_ms", ms}};
     // Thousands of pairs (over 100 KB) only when asked for: the summary is what a line needs.
     if (o.pairs) {
@@ -63,6 +64,13 @@ void run(const RegisterOptions& o) {
     std::cout << r.matches.size() << " matches, " << r.inliers.size() << " inliers, " << ms
               << " ms, stage " << r.stage << (r.escalated ? " (after the plain Harris stage)" : "")
               << "\n";
+    // A camera out of focus shows here first: the re-matching blurred one view to the other.
+    if (r.defocus > 0)
+      std::cout << "the image is more blurred than the reference (Gaussian sigma " << r.defocus
+                << " px)\n";
+    else if (r.defocus < 0)
+      std::cout << "the reference is more blurred than the image (Gaussian sigma " << -r.defocus
+                << " px)\n";
   }
 }
 

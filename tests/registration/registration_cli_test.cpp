@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "tests/registration/textured_scene.hpp"
 #include "tests/support/cli/facet_cli.hpp"
@@ -81,6 +82,26 @@ TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairsOnRequest) {
   EXPECT_EQ(j.at("stage").get<std::string>(), "harris");
   EXPECT_FALSE(j.at("escalated").get<bool>());
   EXPECT_GE(j.at("global_inliers").get<int>(), 20);
+}
+
+// A view out of focus: the command says by how much, in the JSON and in words.
+TEST_F(RegisterCli, SaysHowMuchMoreBlurredTheImageIs) {
+  const CliRun sharp =
+      facet("register --ref " + ref_ + " --image " + image_ + " --model similarity --json");
+  ASSERT_EQ(sharp.exitCode, 0) << sharp.err << sharp.out;
+  EXPECT_EQ(nlohmann::json::parse(sharp.out).at("defocus_px").get<double>(), 0.0);
+  cv::Mat blurred = cv::imread(image_, cv::IMREAD_GRAYSCALE);
+  cv::GaussianBlur(blurred, blurred, cv::Size(), 2.5, 2.5);
+  const std::string path = (dir_ / "blurred.png").string();
+  cv::imwrite(path, blurred);
+  const CliRun json =
+      facet("register --ref " + ref_ + " --image " + path + " --model similarity --json");
+  ASSERT_EQ(json.exitCode, 0) << json.err << json.out;
+  EXPECT_NEAR(nlohmann::json::parse(json.out).at("defocus_px").get<double>(), 2.5, 0.4);
+  const CliRun words = facet("register --ref " + path + " --image " + ref_);
+  ASSERT_EQ(words.exitCode, 0) << words.err << words.out;
+  EXPECT_NE(words.out.find("the reference is more blurred than the image"), std::string::npos)
+      << words.out;
 }
 
 TEST_F(RegisterCli, BlankImageIsAMeasurementFailureWithItsCause) {
