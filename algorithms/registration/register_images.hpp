@@ -100,9 +100,9 @@ struct RegistrationResult {
   // "harris-affine" (Harris-Affine regions); `escalated` when both ran (the plain one first).
   std::string stage;
   bool escalated = false;
-  // How much more blurred the image is than the reference, as the re-matching found it (Gaussian
-  // sigma, image pixels; relative_defocus.hpp): negative where the reference is the blurrier, 0
-  // where the two hold the same detail or no re-matching ran.
+  // How much more blurred the image is than the reference beyond what their scales explain, as
+  // the re-matching found it (Gaussian sigma, image pixels; relative_defocus.hpp): negative where
+  // the reference is the blurrier, 0 where the two hold the same detail or no re-matching ran.
   double defocus = 0.0;
   // Inlier correspondences as (x_ref, y_ref, x_img, y_img).
   [[nodiscard]] std::vector<cv::Vec4d> pairs() const;
