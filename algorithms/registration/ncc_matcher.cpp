@@ -355,28 +355,34 @@ std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
   CompareScratch scratch;
   const NccAccelerations& acc = params.accelerations;
   const bool pruneAcrossWindows = acc.projections || acc.jensen;
+  const auto kept = static_cast<std::size_t>(std::max(1, params.candidates));
   for (std::size_t i = 0; i < ref.size(); ++i) {
     if (!ref[i].valid) continue;
     const Placement pa = place(ref[i], ringShifts, R);
-    WindowMatch best;
+    std::vector<WindowMatch> best;  // the best `kept` so far, best first
     for (std::size_t j = 0; j < image.size(); ++j) {
       if (!image[j].valid || image[j].rows != rows || image[j].angles != A) continue;
       const Pair q{ref[i],     image[j], pa, imagePlacements[j],
                    ringShifts, R,        A,  static_cast<std::int64_t>(R) * A};
-      // Once a match is known, only a better one matters: it becomes the threshold (ties keep
-      // the earlier image window, as the plain loop does).
+      // Once `kept` matches are known, only a better one matters: the worst of them becomes the
+      // threshold (ties keep the earlier image window, as the plain loop does).
       const double thr =
-          (pruneAcrossWindows && best.image >= 0) ? best.best.score : params.minScore;
+          (pruneAcrossWindows && best.size() == kept) ? best.back().best.score : params.minScore;
       const WindowScore s = comparePlaced(q, thr, acc, scratch);
       if (s.score < params.minScore) continue;
-      if (best.image < 0 || s.score > best.best.score) {
-        best.ref = static_cast<int>(i);
-        best.image = static_cast<int>(j);
-        best.best = s;
-      }
+      if (best.size() == kept && s.score <= best.back().best.score) continue;
+      WindowMatch m;
+      m.ref = static_cast<int>(i);
+      m.image = static_cast<int>(j);
+      m.best = s;
+      auto at = std::find_if(best.begin(), best.end(),
+                             [&](const WindowMatch& b) { return s.score > b.best.score; });
+      best.insert(at, m);
+      if (best.size() > kept) best.pop_back();
     }
-    if (best.image >= 0) perRef.push_back(best);
+    perRef.insert(perRef.end(), best.begin(), best.end());
   }
+  if (kept > 1) return perRef;
   // One-to-one: an image window claimed twice keeps its best reference window.
   std::vector<int> owner(image.size(), -1);
   for (std::size_t k = 0; k < perRef.size(); ++k) {

@@ -29,6 +29,11 @@ struct NccAccelerations {
 
 struct NccMatchParams {
   double minScore = 0.75;  // NCC below this is not a match
+  // Image windows kept per reference window, best first. 1: the best one, and an image window
+  // claimed by several reference windows keeps only its best (one-to-one). More: on a repeated
+  // pattern the true partner is often not the best scoring of its look-alikes, so the best
+  // `candidates` are all kept and the geometric consensus chooses; no one-to-one then.
+  int candidates = 1;
   NccAccelerations accelerations;
 };
 
@@ -50,7 +55,8 @@ struct WindowMatch {
 };
 
 // For every reference window the best image window (score >= minScore), then one-to-one: an
-// image window claimed by several reference windows keeps the best-scoring one.
+// image window claimed by several reference windows keeps the best-scoring one. With
+// params.candidates > 1 the best that many per reference window, and no one-to-one.
 std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
                                       const std::vector<LogPolarWindow>& image, int ringShifts,
                                       const NccMatchParams& params);

@@ -194,7 +194,7 @@ struct GlobalStage {
 // All-pairs window matching of the first `count` corners of each image, pruning by the matches'
 // own rotation/scale, robust fit seeded by their local maps.
 GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, double minScore,
-                          const RegistrationParams& params) {
+                          const RegistrationParams& params, cv::Point2d refCentre) {
   GlobalStage g;
   auto subset = [count](const Features& f) {
     Features s;
@@ -263,9 +263,34 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
                        std::to_string(params.minInliers) + " needed";
     return g;
   }
+  // The detector sees structures over params.corners.octaves octaves: a fit that magnifies the
+  // view beyond that was made of chance matches (and its re-matching would blur the image by
+  // hundreds of pixels to match resolutions).
+  const double magnification = magnificationAt(fit->H, refCentre);
+  const double reach = std::ldexp(1.0, params.corners.octaves);
+  if (!(magnification <= reach && magnification >= 1.0 / reach)) {
+    g.status.cause = RegistrationFailure::DegenerateTransform;
+    g.status.message = "the fit magnifies the view " + std::to_string(magnification) +
+                       " times, beyond the detector's " + std::to_string(params.corners.octaves) +
+                       " octaves";
+    return g;
+  }
   g.H = fit->H;
   for (int i : fit->inliers) g.inliers.push_back(kept[i]);
   return g;
+}
+
+void takeGlobalStage(const GlobalStage& stage, RegistrationResult& result) {
+  result.refCorners = stage.refCorners;
+  result.imageCorners = stage.imageCorners;
+  result.matches = stage.matches;
+  if (!stage.status.ok()) {
+    result.status = stage.status;
+    return;
+  }
+  result.H = stage.H;
+  result.inliers = stage.inliers;
+  result.globalInliers = static_cast<int>(result.inliers.size());
 }
 
 }  // namespace
@@ -350,8 +375,8 @@ RegistrationResult matchStage(StageCache& cache, const RegistrationParams& param
   if (!d.first) {
     describeUpTo(d.ref, s.refCorners, s.refPyramid, params, params.corners.maxCorners);
     describeUpTo(d.img, s.imgCorners, s.imgPyramid, params, params.corners.maxCorners);
-    d.first =
-        matchGlobally(d.ref, d.img, params.corners.maxCorners, params.matching.minScore, params);
+    d.first = matchGlobally(d.ref, d.img, params.corners.maxCorners, params.matching.minScore,
+                            params, centreOf(s.ref));
   }
   // The first stage stays in the cache (the other detector's run or a later call reuses it); the
   // result copies from whichever stage is kept.
@@ -361,21 +386,33 @@ RegistrationResult matchStage(StageCache& cache, const RegistrationParams& param
       static_cast<int>(stage->inliers.size()) < params.escalateBelowInliers) {
     describeUpTo(d.ref, s.refCorners, s.refPyramid, params, params.escalateCorners);
     describeUpTo(d.img, s.imgCorners, s.imgPyramid, params, params.escalateCorners);
-    wider = matchGlobally(d.ref, d.img, params.escalateCorners, params.escalateMinScore, params);
+    wider = matchGlobally(d.ref, d.img, params.escalateCorners, params.escalateMinScore, params,
+                          centreOf(s.ref));
     if (wider.inliers.size() > stage->inliers.size() || (!stage->status.ok() && wider.status.ok()))
       stage = &wider;
   }
-  result.refCorners = stage->refCorners;
-  result.imageCorners = stage->imageCorners;
-  result.matches = stage->matches;
-  if (!stage->status.ok()) {
-    result.status = stage->status;
+  takeGlobalStage(*stage, result);
+  return result;
+}
+
+RegistrationResult matchLookalikes(StageCache& cache, const RegistrationParams& params) {
+  RegistrationResult result;
+  result.stage = "harris-lookalikes";
+  StageCache::State& s = *cache.state;
+  if (!s.status.ok()) {
+    result.status = s.status;
     return result;
   }
-  result.H = stage->H;
-  result.inliers = stage->inliers;
-
-  result.globalInliers = static_cast<int>(result.inliers.size());
+  RegistrationParams lookalikes = params;
+  lookalikes.affineRegions = false;
+  lookalikes.matching.candidates = std::max(1, params.lookalikeCandidates);
+  const int count = std::max(params.corners.maxCorners, params.escalateCorners);
+  StageCache::State::Detector& d = s.plain;
+  describeUpTo(d.ref, s.refCorners, s.refPyramid, lookalikes, count);
+  describeUpTo(d.img, s.imgCorners, s.imgPyramid, lookalikes, count);
+  takeGlobalStage(
+      matchGlobally(d.ref, d.img, count, params.escalateMinScore, lookalikes, centreOf(s.ref)),
+      result);
   return result;
 }
 
@@ -431,7 +468,9 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
     // every re-matched pair agrees with it; around a wrong one the pairs are chance hits of
     // the correlation (a fine repetitive texture gives many), of which one homography explains
     // a few dozen among a hundred and more.
-    const std::size_t confirmed = result.inliers.size();
+    // Only pairs the re-matching found confirm: where it found none, the inliers are still the
+    // global ones it was to confirm.
+    const std::size_t confirmed = rematched > 0 ? result.inliers.size() : 0;
     if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
         (static_cast<int>(confirmed) < params.confirmInliers || 2 * confirmed < rematched))
       result.status = Status<RegistrationFailure>::failed(

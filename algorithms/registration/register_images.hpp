@@ -70,6 +70,13 @@ struct RegistrationParams {
   // more global inliers is kept. false = plain Harris only.
   bool escalateToAffine = true;
   int affineBelowInliers = 20;
+  // The last resort of registerImages when no stage found a transform: the plain windows (the
+  // escalation's budget and minimum NCC) matched again keeping the best `lookalikeCandidates`
+  // image windows of every reference window, not just the best one (on a repeated pattern the
+  // true partner is often not the best scoring of its look-alikes), the consensus choosing among
+  // them; the result must then be confirmed by the re-matching however many global inliers it
+  // has. <= 1: no such stage.
+  int lookalikeCandidates = 3;
   // Last step of registerImages for a homography after the re-matching: the re-matched pairs
   // within inlierThreshold fitted by the Cauchy loss of their transfer errors at their own noise
   // scale (robust_homography.hpp, registration_stages.cpp).
@@ -96,8 +103,9 @@ struct RegistrationResult {
   int refCorners = 0;                  // points detected in the reference / image
   int imageCorners = 0;
   int globalInliers = 0;  // inliers of the global (feature) fit, before the re-matching
-  // The stage whose result this is: "harris" (plain multi-scale Harris windows) or
-  // "harris-affine" (Harris-Affine regions); `escalated` when both ran (the plain one first).
+  // The stage whose result this is: "harris" (plain multi-scale Harris windows),
+  // "harris-affine" (Harris-Affine regions) or "harris-lookalikes" (the plain windows' best few
+  // partners each, the last resort); `escalated` when more than one ran (the plain one first).
   std::string stage;
   bool escalated = false;
   // How much more blurred the image is than the reference beyond what their scales explain, as
@@ -137,6 +145,9 @@ RegistrationResult registerStage(StageCache& cache, const RegistrationParams& pa
 // The global part of a stage: windows, all-pairs matching, robust fit (status, H, the window
 // matches and their inliers, globalInliers).
 RegistrationResult matchStage(StageCache& cache, const RegistrationParams& params, bool widen);
+// The global part of the look-alike stage (lookalikeCandidates): plain windows up to
+// escalateCorners, each reference window's best lookalikeCandidates image windows.
+RegistrationResult matchLookalikes(StageCache& cache, const RegistrationParams& params);
 // The warp-and-re-match of a global result (refineIterations), then the confirmation of a fit on
 // fewer than confirmBelowInliers inliers, which may turn the result into a failure.
 void refineStage(StageCache& cache, const RegistrationParams& params, RegistrationResult& result);

@@ -6,6 +6,7 @@
 // on a wrong transform.
 #include "algorithms/registration/register_images.hpp"
 
+#include <limits>
 #include <optional>
 #include <vector>
 
@@ -84,6 +85,16 @@ RegistrationResult registerStages(const cv::Mat& ref, const cv::Mat& image,
     RegistrationResult wider = registerStage(cache, params, true);
     wider.escalated = true;
     if (wider.status.ok()) return wider;
+  }
+  // Nor that: a repeated pattern, where a window's true partner need not be its best match. A fit
+  // chosen among look-alikes is kept only when the re-matching confirms it, however many global
+  // inliers it has.
+  if (params.lookalikeCandidates > 1) {
+    RegistrationParams lookalikes = params;
+    lookalikes.confirmBelowInliers = std::numeric_limits<int>::max();
+    RegistrationResult repeated = matchLookalikes(cache, lookalikes);
+    repeated.escalated = true;
+    if (refined(cache, lookalikes, repeated)) return repeated;
   }
   return adapted;
 }

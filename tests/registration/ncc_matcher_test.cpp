@@ -1,4 +1,5 @@
 // Log-polar windows and their NCC: shifts mean rotation/scale, accelerations change nothing.
+#include <algorithm>
 #include <cmath>
 
 #include <thread>
@@ -119,6 +120,38 @@ TEST(NccMatcher, AcceleratedMatchingGivesTheSameMatches) {
       EXPECT_EQ(fast[k].image, plain[k].image);
       EXPECT_EQ(fast[k].best.score, plain[k].best.score);
     }
+  }
+}
+
+TEST(NccMatcher, CandidatesAreTheBestFewOfEveryReferenceWindowBestFirst) {
+  const auto [a, b] = windowSets(80);
+  NccMatchParams p;
+  p.candidates = 3;
+  for (int flags : {0, 7}) {
+    p.accelerations = {(flags & 1) != 0, (flags & 2) != 0, (flags & 4) != 0};
+    const auto got = matchWindows(a, b, 2, p);
+    std::size_t next = 0, withSeveral = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      // Every image window's score, as the one-pair comparison gives it.
+      std::vector<std::pair<double, int>> all;
+      for (std::size_t j = 0; j < b.size(); ++j) {
+        const WindowScore s = compareWindows(a[i], b[j], 2, p.minScore, p.accelerations);
+        if (s.score >= p.minScore) all.emplace_back(s.score, static_cast<int>(j));
+      }
+      // Best first; ties keep the earlier image window.
+      std::stable_sort(all.begin(), all.end(),
+                       [](const auto& x, const auto& y) { return x.first > y.first; });
+      const std::size_t expected = std::min<std::size_t>(all.size(), 3);
+      withSeveral += expected > 1;
+      for (std::size_t k = 0; k < expected; ++k, ++next) {
+        ASSERT_LT(next, got.size()) << flags;
+        EXPECT_EQ(got[next].ref, static_cast<int>(i)) << flags;
+        EXPECT_EQ(got[next].image, all[k].second) << flags << " window " << i << " rank " << k;
+        EXPECT_EQ(got[next].best.score, all[k].first) << flags;
+      }
+    }
+    EXPECT_EQ(next, got.size()) << flags;
+    EXPECT_GT(withSeveral, 5u) << flags;  // the test saw windows with more than one candidate
   }
 }
 
