@@ -7,6 +7,7 @@
 // The result H maps reference pixel coordinates to image pixel coordinates (homogeneous,
 // x right, y down, pixel centres at integers): q ~ H * (x, y, 1).
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -112,6 +113,14 @@ struct RegistrationResult {
   // the re-matching found it (Gaussian sigma, image pixels; relative_defocus.hpp): negative where
   // the reference is the blurrier, 0 where the two hold the same detail or no re-matching ran.
   double defocus = 0.0;
+  // How far H may put the points of the reference that the image sees (pixels, 1 sigma, at the
+  // worst corner of the overlap, along its worst direction): the inliers' noise propagated
+  // through the fit (homography_uncertainty.hpp). Small where the inliers spread over the
+  // overlap; large where they lie on a strip or in a corner of it, when H is right only near
+  // them: registerImages then fails with undetermined_transform (when 2.45 times this, the 95 %
+  // ellipse, exceeds inlierThreshold), H and the matches kept for a look. Set by
+  // registerImages; infinity when it found no transform.
+  double overlapUncertainty = std::numeric_limits<double>::infinity();
   // Inlier correspondences as (x_ref, y_ref, x_img, y_img).
   [[nodiscard]] std::vector<cv::Vec4d> pairs() const;
 };

@@ -18,6 +18,8 @@ std::string_view toString(RegistrationFailure failure) {
       return "too_few_inliers";
     case RegistrationFailure::DegenerateTransform:
       return "degenerate_transform";
+    case RegistrationFailure::UndeterminedTransform:
+      return "undetermined_transform";
     case RegistrationFailure::TooFewFiducials:
       return "too_few_fiducials";
   }

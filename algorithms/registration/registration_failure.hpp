@@ -14,7 +14,10 @@ enum class RegistrationFailure {
   TooFewMatches,        // fewer consistent matches than the model and minInliers need
   TooFewInliers,        // the fit (or its confirmation by re-matching) has too few inliers
   DegenerateTransform,  // no non-degenerate transform fits the matches
-  TooFewFiducials,      // fewer than two distinct reference marks
+  // the inliers fix the transform only near them: it may put points of the views' overlap farther
+  // off than inlierThreshold (RegistrationResult::overlapUncertainty)
+  UndeterminedTransform,
+  TooFewFiducials,  // fewer than two distinct reference marks
 };
 
 // snake_case name for JSON and logs ("empty_image", "too_few_inliers", ...); "" for None.

@@ -6,21 +6,52 @@
 // on a wrong transform.
 #include "algorithms/registration/register_images.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <vector>
 
+#include <opencv2/imgproc.hpp>
+
+#include "algorithms/registration/homography_uncertainty.hpp"
 #include "algorithms/registration/robust_homography.hpp"
+#include "algorithms/registration/transform_fit.hpp"
 
 namespace facet {
 namespace {
+
+// The corners of the part of the reference that the image sees: the reference's rectangle cut
+// by the image's, carried back through H. The reference's corners where that is no convex
+// quadrilateral (a horizon crosses the image).
+std::vector<cv::Point2d> overlapCorners(const cv::Matx33d& H, cv::Size ref, cv::Size image) {
+  const auto corners = [](cv::Size s) {
+    const float w = static_cast<float>(s.width - 1), h = static_cast<float>(s.height - 1);
+    return std::vector<cv::Point2f>{{0, 0}, {w, 0}, {w, h}, {0, h}};
+  };
+  const std::vector<cv::Point2f> refCorners = corners(ref);
+  std::vector<cv::Point2d> fallback(refCorners.begin(), refCorners.end());
+  std::vector<cv::Point2f> seen;
+  for (const cv::Point2f& q : corners(image)) {
+    const cv::Point2d p = mapPoint(H.inv(), cv::Point2d(q));
+    if (!std::isfinite(p.x) || !std::isfinite(p.y)) return fallback;
+    seen.emplace_back(static_cast<float>(p.x), static_cast<float>(p.y));
+  }
+  if (!cv::isContourConvex(seen)) return fallback;
+  std::vector<cv::Point2f> overlap;
+  if (cv::intersectConvexConvex(refCorners, seen, overlap) <= 0) return fallback;
+  return {overlap.begin(), overlap.end()};
+}
 
 // The last step for a homography: the re-matched pairs within inlierThreshold of H, fitted by
 // the Cauchy loss of their transfer errors at their own noise scale (robust_homography.cpp says
 // why not least squares within a fixed distance). The RANSAC before it minimises an algebraic
 // error over the pairs within finalThreshold, which weights them unevenly across the image
 // and, on a real lens, keeps only the part of the view that fits best.
-void polishHomography(RegistrationResult& r, const RegistrationParams& params) {
+// Its result's overlapUncertainty is propagated from each pair's error as the fit modelled it.
+void polishHomography(RegistrationResult& r, const RegistrationParams& params, cv::Size ref,
+                      cv::Size image) {
   // Each pair counts by how sharply its correlation peak locates it in each direction, as far
   // as that and not an error all pairs share limits it (robust_homography.cpp); a pair whose
   // surface is no peak (a ridge, a plateau) is left out.
@@ -44,6 +75,27 @@ void polishHomography(RegistrationResult& r, const RegistrationParams& params) {
   if (inliers.size() + r.inliers.size() / 100 < r.inliers.size()) return;
   r.H = fit->H;
   r.inliers = std::move(inliers);
+  r.overlapUncertainty =
+      mappedPointUncertainty(TransformModel::Homography, r.H, src, dst, fit->errorCovariance,
+                             overlapCorners(r.H, ref, image));
+}
+
+// How far the result's H may put the overlap's points, from its inliers' spread and noise, for a
+// result the Cauchy fit did not polish. The noise is the inliers' own: the median transfer error
+// of a 2D Gaussian is its sigma times sqrt(2 ln 2).
+double overlapUncertaintyOf(const RegistrationResult& r, TransformModel model, cv::Size ref,
+                            cv::Size image) {
+  std::vector<cv::Point2d> src, dst;
+  std::vector<double> errors;
+  for (int i : r.inliers) {
+    src.push_back(r.matches[i].ref);
+    dst.push_back(r.matches[i].image);
+    errors.push_back(transferError(r.H, r.matches[i].ref, r.matches[i].image));
+  }
+  if (errors.empty()) return std::numeric_limits<double>::infinity();
+  std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+  const double noise = errors[errors.size() / 2] / std::sqrt(2 * std::log(2.0));
+  return mappedPointUncertainty(model, r.H, src, dst, noise, overlapCorners(r.H, ref, image));
 }
 
 // Re-matches a global result; true when it is then a registration (confirmed when it must be).
@@ -106,7 +158,24 @@ RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
   RegistrationResult r = registerStages(ref, image, params);
   if (r.status.ok() && params.model == TransformModel::Homography && params.refineIterations > 0 &&
       params.polishHomography)
-    polishHomography(r, params);
+    polishHomography(r, params, ref.size(), image.size());
+  if (!r.status.ok()) return r;
+  // A result is claimed within inlierThreshold wherever the two views overlap: the 95 % ellipse
+  // of each of the overlap's corners (2.45 sigma in 2D) must lie within it.
+  if (std::isinf(r.overlapUncertainty))
+    r.overlapUncertainty = overlapUncertaintyOf(r, params.model, ref.size(), image.size());
+  constexpr double k95 = 2.4477;  // sqrt of the chi-square quantile 0.95 with 2 degrees of freedom
+  if (!(k95 * r.overlapUncertainty <= params.inlierThreshold)) {
+    std::ostringstream why;
+    why << "the " << r.inliers.size()
+        << " inliers fix the transform only near them: the corners of the views' overlap are "
+           "uncertain by "
+        << r.overlapUncertainty << " px (1 sigma; at most " << params.inlierThreshold / k95
+        << " px for their 95 % ellipse within the inlier threshold of " << params.inlierThreshold
+        << " px)";
+    r.status =
+        Status<RegistrationFailure>::failed(RegistrationFailure::UndeterminedTransform, why.str());
+  }
   return r;
 }
 

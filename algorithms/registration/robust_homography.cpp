@@ -202,6 +202,10 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
   H *= 1.0 / H(2, 2);
   RobustHomography out;
   out.H = H;
+  reweight(h);
+  const double sigma = std::max(noiseScale(h, a, b, metric, errors), floor);
+  for (std::size_t i = 0; i < a.size(); ++i)
+    out.errorCovariance.push_back(metric[i].inv() * (sigma * sigma / (w[i] * pixel * pixel)));
   const std::vector<cv::Matx22d> plain(a.size(), cv::Matx22d::eye());
   out.noise = noiseScale(h, a, b, plain, errors) / pixel;
   return out;

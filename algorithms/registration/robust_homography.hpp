@@ -11,6 +11,10 @@ namespace facet {
 struct RobustHomography {
   cv::Matx33d H = cv::Matx33d::eye();  // src -> dst, H(2,2) == 1
   double noise = 0;  // pixels: the transfer errors' scale about H (a 2D Gaussian's sigma)
+  // Per pair (pixels^2): the covariance of its transfer error as the fit modelled it, its
+  // metric's inverse at the noise scale over its Cauchy weight; what each pair told the fit is
+  // the inverse (homography_uncertainty.hpp propagates it).
+  std::vector<cv::Matx22d> errorCovariance;
 };
 
 // Minimises the Cauchy loss of the transfer errors H src - dst by iteratively re-weighted

@@ -132,6 +132,7 @@ std::optional<DenseReference> denseReference(const cv::Mat& img1, const cv::Mat&
 struct Outcome {
   int matches = 0, correct = 0, inliers = 0;
   double cornerError = 1e9, ms = 0;
+  double uncertainty = 0;  // facet: how far it says the overlap may be off (1 sigma, px)
   bool ok = false;
   cv::Matx33d H;        // the estimate, when ok
   std::string stage;    // facet: the stage whose result counts ("+" = after the plain one)
@@ -156,6 +157,7 @@ Outcome runOurs(const cv::Mat& a, const cv::Mat& b, const cv::Matx33d& truth,
   if (r.status.ok()) {
     o.inliers = static_cast<int>(r.inliers.size());
     o.cornerError = cornerError(r.H, truth, a.size());
+    o.uncertainty = r.overlapUncertainty;
     o.H = r.H;
   }
   return o;
@@ -301,7 +303,12 @@ void sequenceTable(const std::string& dir, const std::string& name, const char* 
     facet::RegistrationParams p = grafParams();
     p.refineIterations = 0;
     const Outcome g = runOurs(img1, imgN, truth, p);
-    std::printf("1-%d   | %7d %7d %7d %10.2f\n", n, g.matches, g.correct, g.inliers, g.cornerError);
+    if (g.ok)
+      std::printf("1-%d   | %7d %7d %7d %10.2f\n", n, g.matches, g.correct, g.inliers,
+                  g.cornerError);
+    else
+      std::printf("1-%d   | %7d %7d       - no transform: %s\n", n, g.matches, g.correct,
+                  g.failure.c_str());
   }
 }
 
@@ -392,9 +399,9 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
       "\n== %s: photographs of Debian's opencv-doc (examples/data) under SYNTHETIC "
       "homographies (noise sigma 2); defaults ==\n",
       title);
-  std::printf("%-20s %-21s | %7s %7s %8s %8s %-15s | %7s %7s %8s %8s | %s\n", "photo", "warp",
-              "correct", "inliers", "corner", "ms", "stage", "correct", "inliers", "corner", "ms",
-              "targets");
+  std::printf("%-20s %-21s | %7s %7s %8s %6s %8s %-15s | %7s %7s %8s %8s | %s\n", "photo", "warp",
+              "correct", "inliers", "corner", "unc", "ms", "stage", "correct", "inliers", "corner",
+              "ms", "targets");
   int pairs = 0, met = 0;
   double oursMs = 0, siftMs = 0;
   for (const std::string& name : photos) {
@@ -441,10 +448,10 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
       met += good;
       oursMs += ours.ms;
       siftMs += sift.ms;
-      std::printf("%-20s %-21s | %7d %7d %8.2f %8.1f %-15s | %7d %7d %8.2f %8.1f | %s\n",
+      std::printf("%-20s %-21s | %7d %7d %8.2f %6.3f %8.1f %-15s | %7d %7d %8.2f %8.1f | %s\n",
                   name.c_str(), w.name, ours.correct, ours.inliers, ours.ok ? ours.cornerError : -1,
-                  ours.ms, ours.stage.c_str(), sift.correct, sift.inliers,
-                  sift.ok ? sift.cornerError : -1, sift.ms, good ? "met" : "MISSED");
+                  ours.ok ? ours.uncertainty : -1, ours.ms, ours.stage.c_str(), sift.correct,
+                  sift.inliers, sift.ok ? sift.cornerError : -1, sift.ms, good ? "met" : "MISSED");
       if (!ours.ok) std::printf("  facet found no transform: %s\n", ours.failure.c_str());
     }
   }

@@ -78,6 +78,9 @@ TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairsOnRequest) {
     EXPECT_LT(std::hypot(t[0] - pair[2].get<double>(), t[1] - pair[3].get<double>()), 3.0);
   }
   EXPECT_GT(j.at("time_ms").get<double>(), 0.0);
+  // Pairs over the whole view: the overlap is placed to a few hundredths of a pixel.
+  EXPECT_GT(j.at("overlap_uncertainty_px").get<double>(), 0.0);
+  EXPECT_LT(j.at("overlap_uncertainty_px").get<double>(), 0.1);
   // An easy pair: the fast stage stands on its own.
   EXPECT_EQ(j.at("stage").get<std::string>(), "harris");
   EXPECT_FALSE(j.at("escalated").get<bool>());
@@ -101,6 +104,9 @@ TEST_F(RegisterCli, SaysHowMuchMoreBlurredTheImageIs) {
   const CliRun words = facet("register --ref " + path + " --image " + ref_);
   ASSERT_EQ(words.exitCode, 0) << words.err << words.out;
   EXPECT_NE(words.out.find("the reference is more blurred than the image"), std::string::npos)
+      << words.out;
+  EXPECT_NE(words.out.find("the part of the reference the image sees is placed within"),
+            std::string::npos)
       << words.out;
 }
 

@@ -283,6 +283,29 @@ TEST(RegisterImages, LookAlikeCardsGiveNoWrongTransform) {
   }
 }
 
+TEST(RegisterImages, PairsOnAStripOfTheViewLeaveTheTransformUndetermined) {
+  // A part flat but for one textured band: every pair lies on the band, and a homography fitted
+  // to them is right there and may be far off at the view's other end (18 px here; the pairs
+  // along the band's straight borders fix it across them only).
+  const cv::Mat textured = texturedScene({320, 320}, 31);
+  cv::Mat band(textured.size(), CV_8U, cv::Scalar(110));
+  textured.rowRange(150, 162).copyTo(band.rowRange(150, 162));
+  const cv::Matx33d truth(0.95, 0.1, 20, -0.05, 0.9, 30, 2e-4, 1e-4, 1);
+  const RegistrationResult whole = registerImages(textured, warp(textured, truth, {340, 340}), {});
+  ASSERT_TRUE(whole.status.ok()) << whole.status.message;
+  EXPECT_LT(whole.overlapUncertainty, 0.1);
+  EXPECT_LT(cornerError(whole.H, truth, textured.size()), 0.3);
+  const RegistrationResult r = registerImages(band, warp(band, truth, {340, 340}), {});
+  ASSERT_FALSE(r.status.ok()) << "uncertain by " << r.overlapUncertainty << " px, "
+                              << cornerError(r.H, truth, band.size()) << " px off";
+  EXPECT_EQ(toString(r.status.cause), "undetermined_transform") << r.status.message;
+  EXPECT_GT(2.45 * r.overlapUncertainty, RegistrationParams{}.inlierThreshold);
+  // H and its pairs stay for a look: right on the band.
+  const cv::Point2d onBand(160, 167), q = mapPoint(r.H, onBand), t = mapPoint(truth, onBand);
+  EXPECT_LT(std::hypot(q.x - t.x, q.y - t.y), 0.5);
+  EXPECT_GE(r.inliers.size(), 20u);
+}
+
 TEST(RegisterImages, HarrisAffineRegionsHandleAStrongTilt) {
   const cv::Mat ref = texturedScene({320, 320}, 9);
   // Foreshortening by 2 along a 30 degree axis plus a perspective term.
