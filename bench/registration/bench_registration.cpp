@@ -399,7 +399,7 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
       "\n== %s: photographs of Debian's opencv-doc (examples/data) under SYNTHETIC "
       "homographies (noise sigma 2); defaults ==\n",
       title);
-  std::printf("%-20s %-21s | %7s %7s %8s %6s %8s %-15s | %7s %7s %8s %8s | %s\n", "photo", "warp",
+  std::printf("%-20s %-21s | %7s %7s %8s %6s %8s %-18s | %7s %7s %8s %8s | %s\n", "photo", "warp",
               "correct", "inliers", "corner", "unc", "ms", "stage", "correct", "inliers", "corner",
               "ms", "targets");
   int pairs = 0, met = 0;
@@ -448,7 +448,7 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
       met += good;
       oursMs += ours.ms;
       siftMs += sift.ms;
-      std::printf("%-20s %-21s | %7d %7d %8.2f %6.3f %8.1f %-15s | %7d %7d %8.2f %8.1f | %s\n",
+      std::printf("%-20s %-21s | %7d %7d %8.2f %6.3f %8.1f %-18s | %7d %7d %8.2f %8.1f | %s\n",
                   name.c_str(), w.name, ours.correct, ours.inliers, ours.ok ? ours.cornerError : -1,
                   ours.ok ? ours.uncertainty : -1, ours.ms, ours.stage.c_str(), sift.correct,
                   sift.inliers, sift.ok ? sift.cornerError : -1, sift.ms, good ? "met" : "MISSED");
