@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include "algorithms/geometry/point_normaliser.hpp"
 #include "algorithms/geometry/projective_map.hpp"
@@ -79,6 +81,40 @@ double mappedPointUncertainty(TransformModel model, const cv::Matx33d& H,
     worst = std::max(worst, std::sqrt(std::max(0.0, largest)));
   }
   return worst / scale;
+}
+
+double sharedErrorFactor(const std::vector<cv::Point2d>& src,
+                         const std::vector<cv::Point2d>& residual, double radius) {
+  if (src.size() < 2 || residual.size() != src.size() || !(radius > 0)) return 1.0;
+  // Pairs bucketed in cells of `radius`: the neighbours of a pair lie in its cell's 3 x 3 block.
+  double x0 = src[0].x, y0 = src[0].y;
+  for (const cv::Point2d& p : src) x0 = std::min(x0, p.x), y0 = std::min(y0, p.y);
+  std::map<std::pair<long, long>, std::vector<std::size_t>> cells;
+  const auto cellOf = [&](cv::Point2d p) {
+    return std::pair<long, long>(std::lround(std::floor((p.x - x0) / radius)),
+                                 std::lround(std::floor((p.y - y0) / radius)));
+  };
+  for (std::size_t i = 0; i < src.size(); ++i) cells[cellOf(src[i])].push_back(i);
+  double shared = 0, own = 0;
+  std::size_t neighbours = 0;
+  for (std::size_t i = 0; i < src.size(); ++i) {
+    own += residual[i].dot(residual[i]);
+    const auto [cx, cy] = cellOf(src[i]);
+    for (long dx = -1; dx <= 1; ++dx)
+      for (long dy = -1; dy <= 1; ++dy) {
+        const auto cell = cells.find({cx + dx, cy + dy});
+        if (cell == cells.end()) continue;
+        for (std::size_t j : cell->second)
+          if (j != i && cv::norm(src[j] - src[i]) <= radius) {
+            shared += residual[i].dot(residual[j]);
+            ++neighbours;
+          }
+      }
+  }
+  if (neighbours == 0 || !(own > 0)) return 1.0;
+  const double n = static_cast<double>(src.size());
+  const double rho = (shared / static_cast<double>(neighbours)) / (own / n);
+  return std::max(1.0, 1.0 + (static_cast<double>(neighbours) / n) * rho);
 }
 
 double mappedPointUncertainty(TransformModel model, const cv::Matx33d& H,

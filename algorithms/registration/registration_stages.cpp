@@ -44,6 +44,18 @@ std::vector<cv::Point2d> overlapCorners(const cv::Matx33d& H, cv::Size ref, cv::
   return {overlap.begin(), overlap.end()};
 }
 
+std::vector<cv::Point2d> residualsOf(const cv::Matx33d& H, const std::vector<cv::Point2d>& src,
+                                     const std::vector<cv::Point2d>& dst) {
+  std::vector<cv::Point2d> r;
+  for (std::size_t i = 0; i < src.size(); ++i) r.push_back(mapPoint(H, src[i]) - dst[i]);
+  return r;
+}
+
+// Re-matched pairs closer than a patch's width share pixels, and so their errors.
+double patchDiameter(const RegistrationParams& params) {
+  return 2.0 * params.refinePatchRadius + 1.0;
+}
+
 // The last step for a homography: the re-matched pairs within inlierThreshold of H, fitted by
 // the Cauchy loss of their transfer errors at their own noise scale (robust_homography.cpp says
 // why not least squares within a fixed distance). The RANSAC before it minimises an algebraic
@@ -75,16 +87,19 @@ void polishHomography(RegistrationResult& r, const RegistrationParams& params, c
   if (inliers.size() + r.inliers.size() / 100 < r.inliers.size()) return;
   r.H = fit->H;
   r.inliers = std::move(inliers);
-  r.overlapUncertainty =
-      mappedPointUncertainty(TransformModel::Homography, r.H, src, dst, fit->errorCovariance,
-                             overlapCorners(r.H, ref, image));
+  std::vector<cv::Matx22d> covariance = fit->errorCovariance;
+  const double shared = sharedErrorFactor(src, residualsOf(r.H, src, dst), patchDiameter(params));
+  for (cv::Matx22d& c : covariance) c *= shared;
+  r.overlapUncertainty = mappedPointUncertainty(TransformModel::Homography, r.H, src, dst,
+                                                covariance, overlapCorners(r.H, ref, image));
 }
 
 // How far the result's H may put the overlap's points, from its inliers' spread and noise, for a
 // result the Cauchy fit did not polish. The noise is the inliers' own: the median transfer error
 // of a 2D Gaussian is its sigma times sqrt(2 ln 2).
-double overlapUncertaintyOf(const RegistrationResult& r, TransformModel model, cv::Size ref,
-                            cv::Size image) {
+double overlapUncertaintyOf(const RegistrationResult& r, const RegistrationParams& params,
+                            cv::Size ref, cv::Size image) {
+  const TransformModel model = params.model;
   std::vector<cv::Point2d> src, dst;
   std::vector<double> errors;
   for (int i : r.inliers) {
@@ -94,7 +109,8 @@ double overlapUncertaintyOf(const RegistrationResult& r, TransformModel model, c
   }
   if (errors.empty()) return std::numeric_limits<double>::infinity();
   std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  const double noise = errors[errors.size() / 2] / std::sqrt(2 * std::log(2.0));
+  const double shared = sharedErrorFactor(src, residualsOf(r.H, src, dst), patchDiameter(params));
+  const double noise = std::sqrt(shared) * errors[errors.size() / 2] / std::sqrt(2 * std::log(2.0));
   return mappedPointUncertainty(model, r.H, src, dst, noise, overlapCorners(r.H, ref, image));
 }
 
@@ -163,7 +179,7 @@ RegistrationResult registerImages(const cv::Mat& ref, const cv::Mat& image,
   // A result is claimed within inlierThreshold wherever the two views overlap: the 95 % ellipse
   // of each of the overlap's corners (2.45 sigma in 2D) must lie within it.
   if (std::isinf(r.overlapUncertainty))
-    r.overlapUncertainty = overlapUncertaintyOf(r, params.model, ref.size(), image.size());
+    r.overlapUncertainty = overlapUncertaintyOf(r, params, ref.size(), image.size());
   constexpr double k95 = 2.4477;  // sqrt of the chi-square quantile 0.95 with 2 degrees of freedom
   if (!(k95 * r.overlapUncertainty <= params.inlierThreshold)) {
     std::ostringstream why;

@@ -131,5 +131,31 @@ TEST(HomographyUncertainty, PairsThatDoNotFixTheTransformGiveInfinity) {
       mappedPointUncertainty(TransformModel::Homography, truth, three, three, 0.1, kCorners)));
 }
 
+TEST(HomographyUncertainty, NeighboursSharingTheirErrorsWeighAsFewer) {
+  // Pairs 10 px apart; within 15 px each has up to 8 others (fewer on the border).
+  std::vector<cv::Point2d> src;
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j) src.emplace_back(10.0 * i, 10.0 * j);
+  double neighbours = 0;
+  for (const cv::Point2d& p : src)
+    for (const cv::Point2d& q : src) neighbours += (p != q && cv::norm(p - q) <= 15.0);
+  neighbours /= static_cast<double>(src.size());
+  // Errors of their own: no more weight than their number says.
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0, 0.3);
+  std::vector<cv::Point2d> own;
+  for (std::size_t k = 0; k < src.size(); ++k) own.emplace_back(n(rng), n(rng));
+  EXPECT_NEAR(sharedErrorFactor(src, own, 15.0), 1.0, 0.3);
+  // One error shared by all (a field no transform of the family follows): each pair's
+  // neighbourhood counts as one.
+  const std::vector<cv::Point2d> shared(src.size(), cv::Point2d(0.2, -0.1));
+  EXPECT_NEAR(sharedErrorFactor(src, shared, 15.0), 1.0 + neighbours, 1e-9);
+  // Neighbours' errors opposed: never below 1.
+  std::vector<cv::Point2d> alternating;
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j) alternating.emplace_back((i + j) % 2 ? 0.2 : -0.2, 0);
+  EXPECT_GE(sharedErrorFactor(src, alternating, 15.0), 1.0);
+}
+
 }  // namespace
 }  // namespace facet
