@@ -2,7 +2,7 @@
 // How far a fitted transform may be off where it is used, from the pairs it was fitted to. A
 // homography is fixed by its pairs only as far as they spread: fitted to pairs on a strip of the
 // view (the one textured band of a dark part), it is exact along the strip and may put the far
-// corners of the view tens of pixels off, with every pair agreeing within a tenth of a pixel.
+// corners of the view tens of pixels off, its pairs agreeing with it to a fraction of a pixel.
 // First-order propagation of the pairs' noise (Hartley and Zisserman, Multiple View Geometry,
 // 5.2): the covariance of the transform's parameters from the normal matrix of its transfer
 // errors, then that of each mapped point from its Jacobian with respect to them.
