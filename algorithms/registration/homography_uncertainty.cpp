@@ -59,14 +59,16 @@ double mappedPointUncertainty(TransformModel model, const cv::Matx33d& H,
   cv::Matx33d Hn = Td * H * Ts.inv();
   if (std::abs(Hn(2, 2)) < 1e-12) return kUnfixed;
   Hn *= 1.0 / Hn(2, 2);
-  cv::Mat normal = cv::Mat::zeros(n, n, CV_64F);
+  // Accumulated in fixed-size matrices (no allocation per pair); the columns beyond the family's
+  // count stay 0, and only its n x n block is inverted.
+  cv::Matx<double, 8, 8> full = cv::Matx<double, 8, 8>::zeros();
   for (std::size_t i = 0; i < src.size(); ++i) {
     const cv::Matx22d C = errorCovariance[i] * (scale * scale);
     if (!(cv::determinant(C) > 0)) continue;  // a pair that told the fit nothing
-    const cv::Mat J =
-        cv::Mat(jacobianOfMappedPoint(model, Hn, mapPoint(Ts, src[i]))).colRange(0, n);
-    normal += J.t() * cv::Mat(C.inv()) * J;
+    const cv::Matx<double, 2, 8> J = jacobianOfMappedPoint(model, Hn, mapPoint(Ts, src[i]));
+    full += J.t() * C.inv() * J;
   }
+  const cv::Mat normal = cv::Mat(full)(cv::Range(0, n), cv::Range(0, n));
   // The inverse by SVD returns the smallest singular value over the largest: all but 0 where the
   // pairs leave a direction of the transform free.
   cv::Mat inverse;

@@ -356,10 +356,11 @@ std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
   const NccAccelerations& acc = params.accelerations;
   const bool pruneAcrossWindows = acc.projections || acc.jensen;
   const auto kept = static_cast<std::size_t>(std::max(1, params.candidates));
+  std::vector<WindowMatch> best;  // of the current reference window: the best `kept`, best first
   for (std::size_t i = 0; i < ref.size(); ++i) {
     if (!ref[i].valid) continue;
     const Placement pa = place(ref[i], ringShifts, R);
-    std::vector<WindowMatch> best;  // the best `kept` so far, best first
+    best.clear();
     for (std::size_t j = 0; j < image.size(); ++j) {
       if (!image[j].valid || image[j].rows != rows || image[j].angles != A) continue;
       const Pair q{ref[i],     image[j], pa, imagePlacements[j],

@@ -99,19 +99,20 @@ void polishHomography(RegistrationResult& r, const RegistrationParams& params, c
 // of a 2D Gaussian is its sigma times sqrt(2 ln 2).
 double overlapUncertaintyOf(const RegistrationResult& r, const RegistrationParams& params,
                             cv::Size ref, cv::Size image) {
-  const TransformModel model = params.model;
   std::vector<cv::Point2d> src, dst;
-  std::vector<double> errors;
   for (int i : r.inliers) {
     src.push_back(r.matches[i].ref);
     dst.push_back(r.matches[i].image);
-    errors.push_back(transferError(r.H, r.matches[i].ref, r.matches[i].image));
   }
-  if (errors.empty()) return std::numeric_limits<double>::infinity();
+  if (src.empty()) return std::numeric_limits<double>::infinity();
+  const std::vector<cv::Point2d> residuals = residualsOf(r.H, src, dst);
+  std::vector<double> errors;
+  for (const cv::Point2d& e : residuals) errors.push_back(std::hypot(e.x, e.y));
   std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
-  const double shared = sharedErrorFactor(src, residualsOf(r.H, src, dst), patchDiameter(params));
+  const double shared = sharedErrorFactor(src, residuals, patchDiameter(params));
   const double noise = std::sqrt(shared) * errors[errors.size() / 2] / std::sqrt(2 * std::log(2.0));
-  return mappedPointUncertainty(model, r.H, src, dst, noise, overlapCorners(r.H, ref, image));
+  return mappedPointUncertainty(params.model, r.H, src, dst, noise,
+                                overlapCorners(r.H, ref, image));
 }
 
 // Re-matches a global result; true when it is then a registration (confirmed when it must be).

@@ -166,12 +166,13 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
   // A floor on the scale (1e-4 px) keeps exact pairs from giving every weight but one zero.
   const double pixel = Td(0, 0), floor = 1e-4 * pixel;
   std::vector<double> errors, w(a.size());
+  double sigma = floor;  // the noise scale the weights were last set at
   // Iteratively re-weighted: each Levenberg-Marquardt step starts from the metrics and Cauchy
   // weights of the pairs about the current H; the fit stops where no step lowers the cost
   // under the weights of its own H.
   const auto reweight = [&](const Params& x) {
     if (!spread.empty()) metric = pairMetrics(x, a, b, spread);
-    const double sigma = std::max(noiseScale(x, a, b, metric, errors), floor);
+    sigma = std::max(noiseScale(x, a, b, metric, errors), floor);
     for (std::size_t i = 0; i < a.size(); ++i) {
       const double t = errors[i] / (kCauchyScale * sigma);
       w[i] = 1.0 / (1.0 + t * t);
@@ -203,7 +204,6 @@ std::optional<RobustHomography> fitHomographyCauchy(const std::vector<cv::Point2
   RobustHomography out;
   out.H = H;
   reweight(h);
-  const double sigma = std::max(noiseScale(h, a, b, metric, errors), floor);
   for (std::size_t i = 0; i < a.size(); ++i)
     out.errorCovariance.push_back(metric[i].inv() * (sigma * sigma / (w[i] * pixel * pixel)));
   const std::vector<cv::Matx22d> plain(a.size(), cv::Matx22d::eye());
