@@ -425,10 +425,14 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
       cv::Matx33d truth = back * view * rot * toOrigin;
       truth *= 1.0 / truth(2, 2);
       const double shrink = std::min(w.scale * w.tilt, 1.0);
-      cv::Mat source = photo;
+      // A new image for the low-passed copy: a header sharing the photograph's pixels would be
+      // blurred in place, the reference with it, and every later warp's too.
+      cv::Mat source;
       if (shrink < 1) {
         const double sigma = 0.5 * std::sqrt(1.0 / (shrink * shrink) - 1.0);
         cv::GaussianBlur(photo, source, cv::Size(), sigma, sigma);
+      } else {
+        source = photo;
       }
       cv::Mat image;
       cv::warpPerspective(source, image, cv::Mat(truth), photo.size(), cv::INTER_LINEAR,
