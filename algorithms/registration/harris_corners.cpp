@@ -140,6 +140,7 @@ void detectAtLevel(const Neighbour& below, const ScaleLevel& level, const Neighb
   const float threshold =
       static_cast<float>(std::max(p.absoluteThreshold, p.relativeThreshold * maxResponse));
   const int b = std::max(p.border, 2);
+  const auto plateau = static_cast<float>(p.scalePlateau);
   for (int y = b; y < r.rows - b; ++y) {
     const float* r0 = r.ptr<float>(y - 1);
     const float* r1 = r.ptr<float>(y);
@@ -150,9 +151,10 @@ void detectAtLevel(const Neighbour& below, const ScaleLevel& level, const Neighb
       if (v <= r1[x - 1] || v < r1[x + 1] || v <= r0[x - 1] || v <= r0[x] || v <= r0[x + 1] ||
           v < r2[x - 1] || v < r2[x] || v < r2[x + 1])
         continue;
-      // Characteristic scale: |Laplacian| must not be smaller than at the neighbouring scales.
+      // Characteristic scale: |Laplacian| must not be clearly smaller than at the neighbouring
+      // scales (HarrisParams::scalePlateau).
       if (p.selectScale) {
-        const float lap = std::abs(level.laplacian.at<float>(y, x));
+        const float lap = std::abs(level.laplacian.at<float>(y, x)) / plateau;
         if (lap < below.at(x, y) || lap < above.at(x, y)) continue;
       }
       const double dx = parabolaPeak(r1[x - 1], v, r1[x + 1]);
@@ -235,6 +237,7 @@ std::vector<HarrisCorner> detectHarrisGrid(const cv::Mat& grey, int cell,
 
 std::vector<HarrisCorner> detectHarrisCorners(const cv::Mat& grey, const HarrisParams& params) {
   CV_Assert(grey.type() == CV_32F);
+  CV_Assert(params.scalePlateau > 0 && params.scalePlateau <= 1);
   std::vector<HarrisCorner> all;
   const int L = std::max(1, params.levelsPerOctave);
   auto relScale = [L](int j) { return std::pow(2.0, double(j) / L); };
