@@ -212,8 +212,9 @@ TEST(HarrisCorners, VerticesOfASharpDrawingAreFoundAtTheFinestScales) {
   const auto [found, total] = verticesAtFinestLevels(HarrisParams{}.scalePlateau);
   EXPECT_EQ(found, total);
   const auto [strictFound, strictTotal] = verticesAtFinestLevels(1.0);
-  EXPECT_LE(strictFound, strictTotal / 2) << "the strict maximum now keeps the vertices: is the test "
-                                       "still one of scale-free corners?";
+  EXPECT_LE(strictFound, strictTotal / 2)
+      << "the strict maximum now keeps the vertices: is the test "
+         "still one of scale-free corners?";
 }
 
 // A 3000x2000 detection passes through more full-size images than a thread keeps: it keeps up to
