@@ -18,9 +18,8 @@
 namespace facet {
 
 struct CurvatureBiasParams {
-  double coefficient = 0.5;   // pixels^2: blur part of the bias = coefficient / radius
-  bool profileFitted = true;  // add the profile fit's window bias (points from fitEdgeProfile)
-  int halfWindow = 4;         // points either side used for the curvature estimate
+  double coefficient = 0.5;  // pixels^2: blur part of the bias = coefficient / radius
+  int halfWindow = 4;        // points either side used for the curvature estimate
 };
 
 // The coefficient k of the remaining bias k / r for blur `sigma` (pixels), calibrated with

@@ -21,7 +21,6 @@ struct HarrisAffineParams {
       0.95;  // stop when min/max eigenvalue of M in the normalised frame exceeds it
   double maxAnisotropy = 6.0;  // regions more elongated than this are rejected
   int patchRadius = 12;        // pixels of the normalised patch on which M is measured
-  bool selectScale = true;     // re-select the characteristic scale with the Laplacian
 };
 
 struct AffineRegion {
