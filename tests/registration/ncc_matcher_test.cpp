@@ -13,6 +13,7 @@
 #include "algorithms/registration/log_polar_window.hpp"
 #include "algorithms/registration/ncc_matcher.hpp"
 #include "tests/registration/textured_scene.hpp"
+#include "tests/support/scene/plane_scene.hpp"
 
 namespace facet {
 namespace {
@@ -180,18 +181,14 @@ TEST(HarrisCorners, VerticesOfASharpDrawingAreFoundAtTheFinestScales) {
       {{40.3, 50.2}, {150.7, 42.9}, {120.4, 140.6}},
       {{200.2, 40.6}, {330.8, 70.1}, {310.5, 160.3}, {190.9, 130.7}},
       {{80.6, 180.4}, {150.1, 170.2}, {170.7, 240.9}, {110.3, 270.5}, {60.2, 240.8}}};
-  constexpr int kSuper = 8;  // polygons drawn 8x finer, then averaged: pixel coverage
-  cv::Mat fine(300 * kSuper, 400 * kSuper, CV_8U, cv::Scalar(200));
-  int shade = 40;
+  // Exact pixel coverage of each polygon, painted over a light background.
+  cv::Mat f(300, 400, CV_64F, cv::Scalar(200));
+  double shade = 40;
   for (const auto& poly : polygons) {
-    std::vector<cv::Point> pts;
-    for (const auto& v : poly)
-      pts.emplace_back(cvRound((v.x + 0.5) * kSuper - 0.5), cvRound((v.y + 0.5) * kSuper - 0.5));
-    cv::fillPoly(fine, std::vector<std::vector<cv::Point>>{pts}, cv::Scalar(shade));
+    f += scene::polygonCoverage(poly, f.size()) * (shade - 200);
     shade += 50;
   }
-  cv::Mat f;
-  cv::resize(toFloat(fine), f, cv::Size(400, 300), 0, 0, cv::INTER_AREA);
+  f.convertTo(f, CV_32F, 1 / 255.0);
   cv::GaussianBlur(f, f, cv::Size(), 0.7, 0.7);
   auto verticesAtFinestLevels = [&](double plateau) {
     HarrisParams hp;
