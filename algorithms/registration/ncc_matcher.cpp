@@ -325,6 +325,22 @@ WindowScore comparePlaced(const Pair& q, double threshold, const NccAcceleration
   return best;
 }
 
+// An image window claimed by several reference windows keeps the best-scoring one (the first
+// among equals).
+std::vector<WindowMatch> oneToOne(const std::vector<WindowMatch>& perRef) {
+  int images = 0;
+  for (const WindowMatch& m : perRef) images = std::max(images, m.image + 1);
+  std::vector<int> owner(static_cast<std::size_t>(images), -1);
+  for (std::size_t k = 0; k < perRef.size(); ++k) {
+    int& o = owner[perRef[k].image];
+    if (o < 0 || perRef[k].best.score > perRef[o].best.score) o = static_cast<int>(k);
+  }
+  std::vector<WindowMatch> out;
+  for (std::size_t k = 0; k < perRef.size(); ++k)
+    if (owner[perRef[k].image] == static_cast<int>(k)) out.push_back(perRef[k]);
+  return out;
+}
+
 }  // namespace
 
 WindowScore compareWindows(const LogPolarWindow& ref, const LogPolarWindow& image, int ringShifts,
@@ -383,17 +399,18 @@ std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
     }
     perRef.insert(perRef.end(), best.begin(), best.end());
   }
-  if (kept > 1) return perRef;
-  // One-to-one: an image window claimed twice keeps its best reference window.
-  std::vector<int> owner(image.size(), -1);
-  for (std::size_t k = 0; k < perRef.size(); ++k) {
-    int& o = owner[perRef[k].image];
-    if (o < 0 || perRef[k].best.score > perRef[o].best.score) o = static_cast<int>(k);
-  }
-  std::vector<WindowMatch> out;
-  for (std::size_t k = 0; k < perRef.size(); ++k)
-    if (owner[perRef[k].image] == static_cast<int>(k)) out.push_back(perRef[k]);
-  return out;
+  return kept > 1 ? perRef : oneToOne(perRef);
+}
+
+std::vector<WindowMatch> bestOfEach(const std::vector<WindowMatch>& candidates) {
+  // Each reference window's candidates come together, best first, and the first of them is what
+  // a single candidate would have been: the best score, the earliest image window among equals
+  // (comparePlaced's result does not depend on the threshold it was asked to beat, only whether
+  // it is returned at all).
+  std::vector<WindowMatch> best;
+  for (const WindowMatch& m : candidates)
+    if (best.empty() || best.back().ref != m.ref) best.push_back(m);
+  return oneToOne(best);
 }
 
 }  // namespace facet

@@ -61,4 +61,9 @@ std::vector<WindowMatch> matchWindows(const std::vector<LogPolarWindow>& ref,
                                       const std::vector<LogPolarWindow>& image, int ringShifts,
                                       const NccMatchParams& params);
 
+// What matchWindows gives with candidates = 1, from what it gave with more candidates (the same
+// windows and minimum score): each reference window's best, then one-to-one. Where both are
+// needed, one all-pairs pass instead of two.
+std::vector<WindowMatch> bestOfEach(const std::vector<WindowMatch>& candidates);
+
 }  // namespace facet

@@ -191,22 +191,22 @@ struct GlobalStage {
   Status<RegistrationFailure> status;  // ok when a transform was found
 };
 
-// All-pairs window matching of the first `count` corners of each image, pruning by the matches'
-// own rotation/scale, robust fit seeded by their local maps.
-GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, double minScore,
-                          const RegistrationParams& params, cv::Point2d refCentre) {
+// The windows of the corners of rank below `count`.
+Features ranksBelow(const Features& f, int count) {
+  Features s;
+  for (std::size_t i = 0; i < f.windows.size(); ++i)
+    if (f.ranks[i] < count) {
+      s.regions.push_back(f.regions[i]);
+      s.windows.push_back(f.windows[i]);
+      s.ranks.push_back(f.ranks[i]);
+    }
+  return s;
+}
+
+// A global stage on the windows `a` and `b`: failed (too_few_corners) when either has fewer than
+// four.
+GlobalStage startGlobalStage(const Features& a, const Features& b) {
   GlobalStage g;
-  auto subset = [count](const Features& f) {
-    Features s;
-    for (std::size_t i = 0; i < f.windows.size(); ++i)
-      if (f.ranks[i] < count) {
-        s.regions.push_back(f.regions[i]);
-        s.windows.push_back(f.windows[i]);
-        s.ranks.push_back(f.ranks[i]);
-      }
-    return s;
-  };
-  const Features a = subset(fr), b = subset(fi);
   g.refCorners = static_cast<int>(a.windows.size());
   g.imageCorners = static_cast<int>(b.windows.size());
   if (a.windows.size() < 4 || b.windows.size() < 4) {
@@ -214,12 +214,23 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
     g.status.message = "fewer than 4 usable corners (reference " +
                        std::to_string(a.windows.size()) + ", image " +
                        std::to_string(b.windows.size()) + ")";
-    return g;
   }
+  return g;
+}
+
+NccMatchParams windowMatching(const RegistrationParams& params, double minScore) {
   NccMatchParams mp = params.matching;
   mp.minScore = minScore;
-  const std::vector<WindowMatch> wm =
-      matchWindows(a.windows, b.windows, params.window.ringShifts, mp);
+  return mp;
+}
+
+// The global fit of window matches of `a` and `b`: pruning by the matches' own rotation/scale,
+// robust fit seeded by their local maps.
+GlobalStage fitWindowMatches(const Features& a, const Features& b,
+                             const std::vector<WindowMatch>& wm, const RegistrationParams& params,
+                             cv::Point2d refCentre) {
+  GlobalStage g = startGlobalStage(a, b);
+  if (!g.status.ok()) return g;
   std::vector<cv::Matx22d> maps;
   for (const WindowMatch& w : wm) {
     const AffineRegion& ra = a.regions[w.ref];
@@ -280,6 +291,17 @@ GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, dou
   return g;
 }
 
+// All-pairs window matching of the first `count` corners of each image, then the global fit.
+GlobalStage matchGlobally(const Features& fr, const Features& fi, int count, double minScore,
+                          const RegistrationParams& params, cv::Point2d refCentre) {
+  const Features a = ranksBelow(fr, count), b = ranksBelow(fi, count);
+  const GlobalStage start = startGlobalStage(a, b);
+  if (!start.status.ok()) return start;
+  const std::vector<WindowMatch> wm = matchWindows(a.windows, b.windows, params.window.ringShifts,
+                                                   windowMatching(params, minScore));
+  return fitWindowMatches(a, b, wm, params, refCentre);
+}
+
 void takeGlobalStage(const GlobalStage& stage, RegistrationResult& result) {
   result.refCorners = stage.refCorners;
   result.imageCorners = stage.imageCorners;
@@ -313,6 +335,9 @@ struct StageCache::State {
   struct Detector {
     Features ref, img;
     std::optional<GlobalStage> first;
+    // The look-alike stage's window matches (plain windows, each reference window's best few),
+    // kept for the plain escalation, which takes the best of each from them.
+    std::optional<std::vector<WindowMatch>> lookalikes;
   };
   Detector plain, affine;
   std::optional<std::vector<HarrisCorner>> grid;  // reference points for the re-matching
@@ -386,8 +411,15 @@ RegistrationResult matchStage(StageCache& cache, const RegistrationParams& param
       static_cast<int>(stage->inliers.size()) < params.escalateBelowInliers) {
     describeUpTo(d.ref, s.refCorners, s.refPyramid, params, params.escalateCorners);
     describeUpTo(d.img, s.imgCorners, s.imgPyramid, params, params.escalateCorners);
-    wider = matchGlobally(d.ref, d.img, params.escalateCorners, params.escalateMinScore, params,
-                          centreOf(s.ref));
+    // The look-alike stage, where it ran first, has matched the same windows at the same minimum
+    // score (registration_stages.cpp).
+    if (d.lookalikes && params.matching.candidates <= 1)
+      wider = fitWindowMatches(ranksBelow(d.ref, params.escalateCorners),
+                               ranksBelow(d.img, params.escalateCorners), bestOfEach(*d.lookalikes),
+                               params, centreOf(s.ref));
+    else
+      wider = matchGlobally(d.ref, d.img, params.escalateCorners, params.escalateMinScore, params,
+                            centreOf(s.ref));
     if (wider.inliers.size() > stage->inliers.size() || (!stage->status.ok() && wider.status.ok()))
       stage = &wider;
   }
@@ -410,9 +442,15 @@ RegistrationResult matchLookalikes(StageCache& cache, const RegistrationParams& 
   StageCache::State::Detector& d = s.plain;
   describeUpTo(d.ref, s.refCorners, s.refPyramid, lookalikes, count);
   describeUpTo(d.img, s.imgCorners, s.imgPyramid, lookalikes, count);
-  takeGlobalStage(
-      matchGlobally(d.ref, d.img, count, params.escalateMinScore, lookalikes, centreOf(s.ref)),
-      result);
+  const Features a = ranksBelow(d.ref, count), b = ranksBelow(d.img, count);
+  GlobalStage stage = startGlobalStage(a, b);
+  if (stage.status.ok()) {
+    if (!d.lookalikes)
+      d.lookalikes = matchWindows(a.windows, b.windows, params.window.ringShifts,
+                                  windowMatching(lookalikes, params.escalateMinScore));
+    stage = fitWindowMatches(a, b, *d.lookalikes, lookalikes, centreOf(s.ref));
+  }
+  takeGlobalStage(stage, result);
   return result;
 }
 

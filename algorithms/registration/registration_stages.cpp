@@ -147,23 +147,27 @@ RegistrationResult registerStages(const cv::Mat& ref, const cv::Mat& image,
   if (affineFirst && refined(cache, affine, adapted)) return adapted;
   if (fast.status.ok() && (fastRefined || refined(cache, params, fast))) return fast;
   if (!affineFirst && refined(cache, affine, adapted)) return adapted;
-  // Neither stage found a transform: the deferred plain escalation is the last resort (not when
-  // it would repeat the plain stage: no wider budget, or a first match that needs none).
+  // Neither stage found a transform: the deferred plain escalation is the last resort but one
+  // (not when it would repeat the plain stage: no wider budget, or a first match that needs none),
+  // then look-alikes: a repeated pattern, where a window's true partner need not be its best
+  // match. Both match the plain windows within the wider budget at the same minimum score, so the
+  // look-alike matching (each window's best few) runs first and the escalation takes the best of
+  // each from it (ncc_matcher.hpp, bestOfEach): one all-pairs pass instead of two, the same
+  // matches. A fit chosen among look-alikes is kept only when the re-matching confirms it,
+  // however many global inliers it has.
+  RegistrationParams lookalikes = params;
+  lookalikes.confirmBelowInliers = std::numeric_limits<int>::max();
+  std::optional<RegistrationResult> repeated;
+  if (params.lookalikeCandidates > 1) repeated = matchLookalikes(cache, lookalikes);
   if (params.escalateCorners > params.corners.maxCorners &&
       fast.globalInliers < params.escalateBelowInliers) {
     RegistrationResult wider = registerStage(cache, params, true);
     wider.escalated = true;
     if (wider.status.ok()) return wider;
   }
-  // Nor that: a repeated pattern, where a window's true partner need not be its best match. A fit
-  // chosen among look-alikes is kept only when the re-matching confirms it, however many global
-  // inliers it has.
-  if (params.lookalikeCandidates > 1) {
-    RegistrationParams lookalikes = params;
-    lookalikes.confirmBelowInliers = std::numeric_limits<int>::max();
-    RegistrationResult repeated = matchLookalikes(cache, lookalikes);
-    repeated.escalated = true;
-    if (refined(cache, lookalikes, repeated)) return repeated;
+  if (repeated) {
+    repeated->escalated = true;
+    if (refined(cache, lookalikes, *repeated)) return *std::move(repeated);
   }
   return adapted;
 }

@@ -159,6 +159,38 @@ TEST(NccMatcher, CandidatesAreTheBestFewOfEveryReferenceWindowBestFirst) {
   }
 }
 
+// Registration's last two stages share one all-pairs pass: the look-alike stage's candidates,
+// from which the plain escalation takes the best of each.
+TEST(NccMatcher, TheBestOfEachWindowsCandidatesIsTheSingleCandidateMatching) {
+  const auto [a, b] = windowSets(80);
+  for (double minScore : {0.5, 0.7, 0.75}) {
+    NccMatchParams single;
+    single.minScore = minScore;
+    const auto expected = matchWindows(a, b, 2, single);
+    ASSERT_GT(expected.size(), 20u);
+    for (int candidates : {2, 3, 5}) {
+      NccMatchParams several = single;
+      several.candidates = candidates;
+      const auto listed = matchWindows(a, b, 2, several);
+      const auto got = bestOfEach(listed);
+      ASSERT_EQ(got.size(), expected.size()) << minScore << " " << candidates;
+      for (std::size_t k = 0; k < expected.size(); ++k) {
+        EXPECT_EQ(got[k].ref, expected[k].ref);
+        EXPECT_EQ(got[k].image, expected[k].image);
+        EXPECT_EQ(got[k].best.score, expected[k].best.score);
+        EXPECT_EQ(got[k].best.ringShift, expected[k].best.ringShift);
+        EXPECT_EQ(got[k].best.angleShift, expected[k].best.angleShift);
+      }
+      // The one-to-one rule had something to do: some image window was the best of two
+      // reference windows.
+      std::size_t refs = 0;
+      for (std::size_t k = 0; k < listed.size(); ++k)
+        refs += k == 0 || listed[k].ref != listed[k - 1].ref;
+      EXPECT_LT(got.size(), refs) << minScore << " " << candidates;
+    }
+  }
+}
+
 TEST(HarrisCorners, BudgetAndSpreading) {
   const cv::Mat f = toFloat(testing::texturedScene({400, 300}, 2));
   HarrisParams hp;
