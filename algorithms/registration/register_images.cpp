@@ -108,48 +108,64 @@ cv::Point2d centreOf(const cv::Mat& image) {
   return {(image.cols - 1) / 2.0, (image.rows - 1) / 2.0};
 }
 
+// What the re-matching passes of one pair share: the two views brought to the same resolution
+// and focus on the first pass (properties of the pair, not of the pass), and the buffers each
+// pass warps into (a fresh view-sized image per pass costs its page faults every time).
+struct RematchViews {
+  cv::Mat ref, img;               // at matched resolution; img also at matched focus
+  std::optional<double> defocus;  // relative_defocus.hpp; estimated on the first pass
+  cv::Mat ones, warped, valid, focused;
+};
+
 // Warp-and-re-match: the reference warped by H is compared, patch by patch around each reference
 // corner's predicted position, with the image; the NCC peak (subpixel) gives the match.
-// `defocus`: the views' relative defocus, estimated here when empty and kept for the next call.
 std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey,
                                   const std::vector<HarrisCorner>& corners, const cv::Matx33d& H,
-                                  int R, const RegistrationParams& params,
-                                  std::optional<double>& defocus) {
-  const double s = magnificationAt(H, centreOf(refGrey));
-  // Match resolutions: blur whichever image is seen at the finer scale, into a buffer of its own
-  // (a blur into `ref` or `img` while they share the caller's pixels would blur those in place,
-  // and the next iteration would blur them again).
-  cv::Mat ref = refGrey, img = imgGrey;
-  if (s < 0.8) {
-    const double sigma = 0.5 * std::sqrt(1.0 / (s * s) - 1.0);
-    cv::Mat blurred;
-    cv::GaussianBlur(refGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
-    ref = blurred;
-  } else if (s > 1.25) {
-    const double sigma = 0.5 * std::sqrt(s * s - 1.0);
-    cv::Mat blurred;
-    cv::GaussianBlur(imgGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
-    img = blurred;
+                                  int R, const RegistrationParams& params, RematchViews& v) {
+  if (v.ref.empty()) {
+    // Match resolutions: blur whichever image is seen at the finer scale, into a buffer of its
+    // own (a blur into `ref` or `img` while they share the caller's pixels would blur those in
+    // place).
+    const double s = magnificationAt(H, centreOf(refGrey));
+    v.ref = refGrey;
+    v.img = imgGrey;
+    if (s < 0.8) {
+      const double sigma = 0.5 * std::sqrt(1.0 / (s * s) - 1.0);
+      cv::Mat blurred;
+      cv::GaussianBlur(refGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+      v.ref = blurred;
+    } else if (s > 1.25) {
+      const double sigma = 0.5 * std::sqrt(s * s - 1.0);
+      cv::Mat blurred;
+      cv::GaussianBlur(imgGrey, blurred, cv::Size(), sigma, sigma, cv::BORDER_REFLECT);
+      v.img = blurred;
+    }
+    v.ones.create(refGrey.size(), CV_8U);
+    v.ones.setTo(255);
   }
-  cv::Mat warped, valid;
-  cv::warpPerspective(ref, warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT, -1);
-  cv::Mat ones(refGrey.size(), CV_8U, cv::Scalar(255));
-  cv::warpPerspective(ones, valid, H, imgGrey.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT, 0);
+  cv::warpPerspective(v.ref, v.warped, H, imgGrey.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT,
+                      -1);
+  cv::warpPerspective(v.ones, v.valid, H, imgGrey.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                      0);
   // The views may also differ in focus (a refocused lens, a blurred shot): the sharper one is
   // blurred to the other's detail, estimated on the first re-matching (relative_defocus.hpp).
-  if (!defocus) defocus = params.matchDefocus ? relativeDefocus(warped, img, valid) : 0.0;
-  if (*defocus > 0) {
-    cv::Mat blurred;
-    cv::GaussianBlur(warped, blurred, cv::Size(), *defocus, *defocus, cv::BORDER_REFLECT);
-    warped = blurred;
+  if (!v.defocus) {
+    v.defocus = params.matchDefocus ? relativeDefocus(v.warped, v.img, v.valid) : 0.0;
+    if (*v.defocus < 0) {
+      cv::Mat blurred;
+      cv::GaussianBlur(v.img, blurred, cv::Size(), -*v.defocus, -*v.defocus, cv::BORDER_REFLECT);
+      v.img = blurred;
+    }
+  }
+  const cv::Mat& img = v.img;
+  cv::Mat warped = v.warped, valid = v.valid;
+  if (*v.defocus > 0) {
+    cv::GaussianBlur(v.warped, v.focused, cv::Size(), *v.defocus, *v.defocus, cv::BORDER_REFLECT);
+    warped = v.focused;
     // The blur has spread the unmapped border into the pixels within 3 sigma of it.
-    const int reach = static_cast<int>(std::ceil(3 * *defocus));
-    cv::erode(valid, valid,
+    const int reach = static_cast<int>(std::ceil(3 * *v.defocus));
+    cv::erode(v.valid, v.valid,
               cv::getStructuringElement(cv::MORPH_RECT, {2 * reach + 1, 2 * reach + 1}));
-  } else if (*defocus < 0) {
-    cv::Mat blurred;
-    cv::GaussianBlur(img, blurred, cv::Size(), -*defocus, -*defocus, cv::BORDER_REFLECT);
-    img = blurred;
   }
   const int r = params.refinePatchRadius;
   const cv::Rect bounds(0, 0, imgGrey.cols, imgGrey.rows);
@@ -181,6 +197,19 @@ std::vector<FeatureMatch> rematch(const cv::Mat& refGrey, const cv::Mat& imgGrey
     out.push_back(m);
   }
   return out;
+}
+
+// How far `after` puts any of the reference's points from where `before` put them, over those
+// `after` maps into an image of `size` (pixels in the image): the step of one re-matching.
+double largestMove(const cv::Matx33d& before, const cv::Matx33d& after,
+                   const std::vector<HarrisCorner>& points, cv::Size size) {
+  double largest = 0.0;
+  for (const HarrisCorner& c : points) {
+    const cv::Point2d q = mapPoint(after, c.pt);
+    if (!(q.x >= 0 && q.y >= 0 && q.x <= size.width - 1 && q.y <= size.height - 1)) continue;
+    largest = std::max(largest, cv::norm(q - mapPoint(before, c.pt)));
+  }
+  return largest;
 }
 
 struct GlobalStage {
@@ -474,13 +503,12 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
     }
     const std::vector<HarrisCorner>& dense = *s.grid;
     std::size_t rematched = 0;  // pairs the last accepted re-matching found
-    std::optional<double> defocus;
+    RematchViews views;
     for (int it = 0; it < params.refineIterations; ++it) {
       // Once H rests on the dense pairs, the prediction is within a pixel or two.
       const int radius =
           it == 0 ? params.refineSearchRadius : std::min(params.refineSearchRadius, 3);
-      std::vector<FeatureMatch> rm =
-          rematch(s.ref, s.img, dense, result.H, radius, params, defocus);
+      std::vector<FeatureMatch> rm = rematch(s.ref, s.img, dense, result.H, radius, params, views);
       std::vector<cv::Point2d> s2, d2;
       for (const auto& m : rm) {
         s2.push_back(m.ref);
@@ -495,12 +523,14 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
         if (transferError(refit->H, s2[i], d2[i]) <= params.inlierThreshold)
           inliers.push_back(static_cast<int>(i));
       if (inliers.size() < result.inliers.size()) break;
+      const double moved = largestMove(result.H, refit->H, dense, s.img.size());
       result.H = refit->H;
       rematched = rm.size();
       result.matches = std::move(rm);
       result.inliers = std::move(inliers);
+      if (moved <= params.refineConvergence) break;
     }
-    result.defocus = defocus.value_or(0.0);
+    result.defocus = views.defocus.value_or(0.0);
     // A transform resting on very few global matches must be confirmed by the re-matching: at
     // least confirmInliers pairs, and most of those it found. Around the right transform nearly
     // every re-matched pair agrees with it; around a wrong one the pairs are chance hits of
