@@ -528,6 +528,8 @@ void refineStage(StageCache& cache, const RegistrationParams& params, Registrati
       rematched = rm.size();
       result.matches = std::move(rm);
       result.inliers = std::move(inliers);
+      ++result.refinePasses;
+      result.refineLastMove = moved;
       if (moved <= params.refineConvergence) break;
     }
     result.defocus = views.defocus.value_or(0.0);

@@ -120,6 +120,11 @@ struct RegistrationResult {
   // the re-matching found it (Gaussian sigma, image pixels; relative_defocus.hpp): negative where
   // the reference is the blurrier, 0 where the two hold the same detail or no re-matching ran.
   double defocus = 0.0;
+  // The warp-and-re-match passes whose refit was kept, and how far the last of them moved H
+  // (pixels, at the grid points the image sees): at most refineConvergence when the passes
+  // settled, more when they stopped at refineIterations or at a refit with fewer inliers.
+  int refinePasses = 0;
+  double refineLastMove = 0.0;
   // How far H may put the points of the reference that the image sees (pixels, 1 sigma, at the
   // worst corner of the overlap, along its worst direction): the inliers' noise propagated
   // through the fit (homography_uncertainty.hpp). Small where the inliers spread over the

@@ -49,6 +49,8 @@ void run(const RegisterOptions& o) {
                        {"stage", r.stage},
                        {"escalated", r.escalated},
                        {"defocus_px", r.defocus},
+                       {"refine_passes", r.refinePasses},
+                       {"refine_last_move_px", r.refineLastMove},
                        {"overlap_uncertainty_px", r.overlapUncertainty},
                        {"time_ms", ms}};
     // Thousands of pairs (over 100 KB) only when asked for: the summary is what a line needs.
@@ -65,6 +67,8 @@ void run(const RegisterOptions& o) {
     std::cout << r.matches.size() << " matches, " << r.inliers.size() << " inliers, " << ms
               << " ms, stage " << r.stage << (r.escalated ? " (after the plain Harris stage)" : "")
               << "\n";
+    std::cout << "re-matched in " << r.refinePasses << " passes, the last moving H by "
+              << r.refineLastMove << " px\n";
     std::cout << "the part of the reference the image sees is placed within "
               << r.overlapUncertainty << " px (1 sigma)\n";
     // A camera out of focus shows here first: the re-matching blurred one view to the other.

@@ -13,6 +13,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "algorithms/registration/register_images.hpp"
 #include "tests/registration/textured_scene.hpp"
 #include "tests/support/cli/facet_cli.hpp"
 
@@ -85,6 +86,10 @@ TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairsOnRequest) {
   EXPECT_EQ(j.at("stage").get<std::string>(), "harris");
   EXPECT_FALSE(j.at("escalated").get<bool>());
   EXPECT_GE(j.at("global_inliers").get<int>(), 20);
+  // The warp-and-re-match passes kept, and how far the last moved H.
+  EXPECT_GE(j.at("refine_passes").get<int>(), 1);
+  EXPECT_LE(j.at("refine_passes").get<int>(), facet::RegistrationParams{}.refineIterations);
+  EXPECT_GE(j.at("refine_last_move_px").get<double>(), 0.0);
 }
 
 // A view out of focus: the command says by how much, in the JSON and in words.

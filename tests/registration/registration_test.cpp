@@ -360,6 +360,14 @@ TEST(RegisterImages, TheReMatchingIsRepeatedUntilTheTransformStopsMoving) {
     const double two = overlapError(r2.H, v.truth, strip.size(), v.image.size());
     EXPECT_LT(converged, 0.1) << top;
     EXPECT_LT(2 * converged, two) << top;
+    // The result says how the passes ended: more than two, the last moving H less than the
+    // second did (on one strip the passes end at a refit with fewer inliers, the last step
+    // 0.07 px, above the tolerance).
+    EXPECT_GT(r.refinePasses, 2) << top;
+    EXPECT_LE(r.refinePasses, RegistrationParams{}.refineIterations) << top;
+    EXPECT_EQ(r2.refinePasses, 2) << top;
+    EXPECT_GT(r2.refineLastMove, RegistrationParams{}.refineConvergence) << top;
+    EXPECT_LT(r.refineLastMove, r2.refineLastMove) << top;
   }
 }
 
