@@ -39,6 +39,16 @@ struct RegistrationParams {
   // are most of the pairs it re-matched.
   int confirmBelowInliers = 10;
   int confirmInliers = 20;
+  // Such a fit may be one of several the window matches support about as well (a 60 degree
+  // viewpoint change leaves 5-8 true matches among 40-400, and chance ones agree as often): the
+  // distinct consensus sets of at most 64 pruned matches are enumerated (transform_fit.hpp,
+  // up to `consensusSamples` minimal samples), and up to `runnersUp` of them besides the best
+  // are re-matched in turn when the best one is not confirmed. 0 disables it.
+  // A runner-up is confirmed only when its inliers are also `runnerUpSeenShare` of the
+  // re-matching's grid points it puts in the image (refineStage, register_images.cpp, says why).
+  int runnersUp = 8;
+  long consensusSamples = 200000;
+  double runnerUpSeenShare = 0.25;
   // Per-match rotation/scale estimates prune matches that disagree with the dominant pair of
   // rotation (degrees) and log2-scale before RANSAC (rotation_scale_vote.hpp). <= 0 disables
   // the pruning.
@@ -103,6 +113,12 @@ struct FeatureMatch {
   cv::Matx22d peakCurvature = cv::Matx22d::zeros();
 };
 
+// A global fit of the window matches: H and its inliers (indices into the matches).
+struct GlobalFit {
+  cv::Matx33d H = cv::Matx33d::eye();
+  std::vector<int> inliers;
+};
+
 struct RegistrationResult {
   Status<RegistrationFailure> status;
   cv::Matx33d H = cv::Matx33d::eye();  // reference -> image, H(2,2) == 1
@@ -111,6 +127,8 @@ struct RegistrationResult {
   int refCorners = 0;                  // points detected in the reference / image
   int imageCorners = 0;
   int globalInliers = 0;  // inliers of the global (feature) fit, before the re-matching
+  // The global fit's runners-up (RegistrationParams::runnersUp), tried when it is not confirmed.
+  std::vector<GlobalFit> runnersUp;
   // The stage whose result this is: "harris" (plain multi-scale Harris windows),
   // "harris-affine" (Harris-Affine regions) or "harris-lookalikes" (the plain windows' best few
   // partners each, the last resort); `escalated` when more than one ran (the plain one first).

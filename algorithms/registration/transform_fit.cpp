@@ -1,7 +1,9 @@
 #include "algorithms/registration/transform_fit.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numeric>
 
@@ -119,6 +121,44 @@ TransformFit polish(TransformFit fit, const std::vector<cv::Point2d>& src,
   return fit;
 }
 
+// Twice the signed area of the triangle a, b, c.
+double turn(cv::Point2d a, cv::Point2d b, cv::Point2d c) {
+  return (b.x - a.x) * (c.y - a.y) - (b.y - a.y) * (c.x - a.x);
+}
+
+// Whether the sample's triangles turn the same way in both images (always for two points).
+bool keepsOrientation(const std::vector<std::size_t>& sample, const std::vector<cv::Point2d>& src,
+                      const std::vector<cv::Point2d>& dst) {
+  const std::size_t m = sample.size();
+  for (std::size_t i = 0; i + 2 < m; ++i)
+    for (std::size_t j = i + 1; j + 1 < m; ++j)
+      for (std::size_t k = j + 1; k < m; ++k) {
+        const double a = turn(src[sample[i]], src[sample[j]], src[sample[k]]);
+        const double b = turn(dst[sample[i]], dst[sample[j]], dst[sample[k]]);
+        if (!(a * b > 0)) return false;
+      }
+  return true;
+}
+
+// The next combination of sample.size() indices below n, in lexicographic order; false after
+// the last.
+bool nextCombination(std::vector<std::size_t>& sample, std::size_t n) {
+  const std::size_t m = sample.size();
+  for (std::size_t i = m; i-- > 0;)
+    if (sample[i] < n - m + i) {
+      ++sample[i];
+      for (std::size_t j = i + 1; j < m; ++j) sample[j] = sample[j - 1] + 1;
+      return true;
+    }
+  return false;
+}
+
+long combinations(std::size_t n, std::size_t m) {
+  long c = 1;
+  for (std::size_t k = 0; k < m; ++k) c = c * static_cast<long>(n - k) / static_cast<long>(k + 1);
+  return c;
+}
+
 }  // namespace
 
 bool parseTransformModel(const std::string& name, TransformModel& model) {
@@ -223,6 +263,80 @@ std::optional<TransformFit> fitTransformWithLocalMaps(const std::vector<cv::Poin
     if (!best || fit.inliers.size() > best->inliers.size()) best = std::move(fit);
   }
   return best;
+}
+
+std::vector<TransformFit> enumerateConsensusSets(const std::vector<cv::Point2d>& src,
+                                                 const std::vector<cv::Point2d>& dst,
+                                                 const TransformFitParams& params, int count,
+                                                 long maxSamples) {
+  const std::size_t n = src.size();
+  const auto minimal = static_cast<std::size_t>(minimalSample(params.model));
+  if (n != dst.size() || n < minimal + 1 || n > 64 || count <= 0 ||
+      combinations(n, minimal) > maxSamples)
+    return {};
+  // Each sample's inlier set as a bit mask; a set is worth polishing when it holds more than the
+  // sample that made it.
+  std::vector<std::uint64_t> sets;
+  std::vector<cv::Point2d> s(minimal), d(minimal);
+  std::vector<std::size_t> sample(minimal);
+  std::iota(sample.begin(), sample.end(), std::size_t{0});
+  do {
+    if (!keepsOrientation(sample, src, dst)) continue;
+    for (std::size_t k = 0; k < minimal; ++k) {
+      s[k] = src[sample[k]];
+      d[k] = dst[sample[k]];
+    }
+    const auto H = fitNormalised(s, d, params.model);
+    if (!H) continue;
+    std::uint64_t set = 0;
+    for (std::size_t i = 0; i < n; ++i)
+      if (transferError(*H, src[i], dst[i]) <= params.inlierThreshold) set |= std::uint64_t{1} << i;
+    if (static_cast<std::size_t>(std::popcount(set)) > minimal) sets.push_back(set);
+  } while (nextCombination(sample, n));
+  std::sort(sets.begin(), sets.end());
+  sets.erase(std::unique(sets.begin(), sets.end()), sets.end());
+  std::stable_sort(sets.begin(), sets.end(), [](std::uint64_t a, std::uint64_t b) {
+    return std::popcount(a) > std::popcount(b);
+  });
+  // Polished, sets that grow into one another become one; a few times `count` are polished so
+  // that the merged ones leave enough distinct ones.
+  struct Candidate {
+    TransformFit fit;
+    double squaredErrors;
+  };
+  std::vector<Candidate> candidates;
+  const std::size_t polished =
+      std::min<std::size_t>(sets.size(), 4 * static_cast<std::size_t>(count));
+  for (std::size_t c = 0; c < polished; ++c) {
+    TransformFit fit;
+    for (std::size_t i = 0; i < n; ++i)
+      if (sets[c] >> i & 1) fit.inliers.push_back(static_cast<int>(i));
+    std::vector<cv::Point2d> fs, fd;
+    for (int i : fit.inliers) {
+      fs.push_back(src[i]);
+      fd.push_back(dst[i]);
+    }
+    const auto H = fitTransformLeastSquares(fs, fd, params.model);
+    if (!H) continue;
+    fit.H = *H;
+    fit = polish(std::move(fit), src, dst, params);
+    if (fit.inliers.size() <= minimal) continue;
+    double squared = 0;
+    for (int i : fit.inliers) squared += std::pow(transferError(fit.H, src[i], dst[i]), 2);
+    const bool seen = std::any_of(candidates.begin(), candidates.end(),
+                                  [&](const Candidate& o) { return o.fit.inliers == fit.inliers; });
+    if (!seen) candidates.push_back({std::move(fit), squared});
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    if (a.fit.inliers.size() != b.fit.inliers.size())
+      return a.fit.inliers.size() > b.fit.inliers.size();
+    return a.squaredErrors < b.squaredErrors;
+  });
+  std::vector<TransformFit> out;
+  for (std::size_t c = 0; c < candidates.size() && out.size() < static_cast<std::size_t>(count);
+       ++c)
+    out.push_back(std::move(candidates[c].fit));
+  return out;
 }
 
 }  // namespace facet

@@ -49,6 +49,19 @@ std::optional<TransformFit> fitTransformWithLocalMaps(const std::vector<cv::Poin
                                                       const std::vector<cv::Matx22d>& localMaps,
                                                       const TransformFitParams& params);
 
+// The distinct consensus sets of a small match set, most inliers first (fewest squared errors on
+// a tie), at most `count`: every minimal sample whose points keep their orientation (the
+// triangles they span turn the same way in both images, as under any transform that does not
+// fold the plane) is fitted, and each inlier set found is polished by least squares. Where true
+// matches are a few among many (a 60 degree viewpoint change: 6 of 40), a random sample is all
+// true too seldom for RANSAC to draw one, and their set may tie with a chance one: the caller
+// verifies the candidates in turn. Empty when there are more than 64 matches or more than
+// `maxSamples` minimal samples.
+std::vector<TransformFit> enumerateConsensusSets(const std::vector<cv::Point2d>& src,
+                                                 const std::vector<cv::Point2d>& dst,
+                                                 const TransformFitParams& params, int count,
+                                                 long maxSamples);
+
 // |H src - dst| (pixels); infinity when src maps to infinity.
 double transferError(const cv::Matx33d& H, cv::Point2d src, cv::Point2d dst);
 

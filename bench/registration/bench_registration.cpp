@@ -24,12 +24,21 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
+#include "algorithms/image/grey_image.hpp"
 #include "algorithms/registration/harris_corners.hpp"
 #include "algorithms/registration/log_polar_window.hpp"
 #include "algorithms/registration/ncc_matcher.hpp"
 #include "algorithms/registration/register_images.hpp"
 
 namespace {
+
+// An image as `facet register` reads it: decoded as stored, colour turned grey by toGrey
+// (cv::cvtColor's weights). cv::imread's IMREAD_GRAYSCALE converts inside the PNG or JPEG
+// decoder with other rounding, +-1 grey level: enough to turn graf 1-6 from registered to
+// refused before the runners-up (register_images.hpp), so the table reads what users get.
+cv::Mat readGrey(const std::string& path) {
+  return facet::toGrey(cv::imread(path, cv::IMREAD_UNCHANGED));
+}
 
 // Time is the calling thread's CPU time: the machine is shared by many jobs, and wall time
 // there measures the neighbours as much as the code. Everything here runs single-threaded
@@ -207,7 +216,7 @@ facet::RegistrationParams grafParams() {
 // One Oxford sequence: img1 against each later view, facet's defaults beside SIFT.
 void sequenceTable(const std::string& dir, const std::string& name, const char* change, bool smoke,
                    int repeats, bool withGlobalStage, bool withDenseReference) {
-  const cv::Mat img1 = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat img1 = readGrey(dir + "/img1.png");
   if (img1.empty()) {
     std::fprintf(stderr, "bench_registration: cannot read %s/img1.png\n", dir.c_str());
     std::exit(1);
@@ -233,8 +242,7 @@ void sequenceTable(const std::string& dir, const std::string& name, const char* 
   };
   std::vector<PairRun> runs;  // per pair, for the dense reference below
   for (int n = 2; n <= last; ++n) {
-    const cv::Mat imgN =
-        cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
+    const cv::Mat imgN = readGrey(dir + "/img" + std::to_string(n) + ".png");
     const cv::Matx33d truth = readHomography(dir + "/H1to" + std::to_string(n) + "p");
     // Best of `repeats` runs each, alternating, so that both see the same machine.
     Outcome ours = runOurs(img1, imgN, truth, grafParams());
@@ -297,8 +305,7 @@ void sequenceTable(const std::string& dir, const std::string& name, const char* 
   std::printf("\nfacet global stage alone (log-polar NCC + robust fit, refineIterations = 0):\n");
   std::printf("%-5s | %7s %7s %7s %10s\n", "pair", "matches", "correct", "inliers", "corner");
   for (int n = 2; n <= last; ++n) {
-    const cv::Mat imgN =
-        cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
+    const cv::Mat imgN = readGrey(dir + "/img" + std::to_string(n) + ".png");
     const cv::Matx33d truth = readHomography(dir + "/H1to" + std::to_string(n) + "p");
     facet::RegistrationParams p = grafParams();
     p.refineIterations = 0;
@@ -313,7 +320,7 @@ void sequenceTable(const std::string& dir, const std::string& name, const char* 
 }
 
 void syntheticTable(const std::string& dir, int count) {
-  const cv::Mat img1 = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat img1 = readGrey(dir + "/img1.png");
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> angle(-180, 180), logScale(std::log(0.33), std::log(3.0));
   std::uniform_int_distribution<int> ox(0, img1.cols - 256), oy(0, img1.rows - 256);
@@ -405,7 +412,7 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
   int pairs = 0, met = 0;
   double oursMs = 0, siftMs = 0;
   for (const std::string& name : photos) {
-    cv::Mat photo = cv::imread(dir + "/" + name, cv::IMREAD_GRAYSCALE);
+    cv::Mat photo = readGrey(dir + "/" + name);
     if (photo.empty()) {
       std::printf("%-20s cannot read %s/%s (apt-get install opencv-doc): skipped\n", name.c_str(),
                   dir.c_str(), name.c_str());
@@ -466,8 +473,8 @@ void photoWarpTable(const char* title, const std::vector<std::string>& photos) {
 }
 
 void nccTable(const std::string& dir, bool smoke) {
-  const cv::Mat a8 = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
-  const cv::Mat b8 = cv::imread(dir + "/img2.png", cv::IMREAD_GRAYSCALE);
+  const cv::Mat a8 = readGrey(dir + "/img1.png");
+  const cv::Mat b8 = readGrey(dir + "/img2.png");
   cv::Mat a, b;
   a8.convertTo(a, CV_32F, 1 / 255.0);
   b8.convertTo(b, CV_32F, 1 / 255.0);
@@ -539,9 +546,8 @@ void defocusTable() {
     for (int n : {2, 3})
       for (int radius : {2, 4, 6}) {
         const std::string dir = std::string(FACET_TEST_DATA_DIR) + "/oxford-" + name;
-        const cv::Mat a = cv::imread(dir + "/img1.png", cv::IMREAD_GRAYSCALE);
-        const cv::Mat sharp =
-            cv::imread(dir + "/img" + std::to_string(n) + ".png", cv::IMREAD_GRAYSCALE);
+        const cv::Mat a = readGrey(dir + "/img1.png");
+        const cv::Mat sharp = readGrey(dir + "/img" + std::to_string(n) + ".png");
         const cv::Matx33d truth = readHomography(dir + "/H1to" + std::to_string(n) + "p");
         cv::Mat disk = cv::Mat::zeros(2 * radius + 1, 2 * radius + 1, CV_32F);
         cv::circle(disk, {radius, radius}, radius, cv::Scalar(1), cv::FILLED, cv::LINE_AA);
