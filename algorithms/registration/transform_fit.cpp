@@ -99,18 +99,25 @@ std::vector<int> inliersOf(const cv::Matx33d& H, const std::vector<cv::Point2d>&
   return in;
 }
 
+// Least squares on the pairs of the given indices.
+std::optional<cv::Matx33d> fitSubset(const std::vector<int>& subset,
+                                     const std::vector<cv::Point2d>& src,
+                                     const std::vector<cv::Point2d>& dst, TransformModel model) {
+  std::vector<cv::Point2d> s, d;
+  for (int i : subset) {
+    s.push_back(src[i]);
+    d.push_back(dst[i]);
+  }
+  return fitTransformLeastSquares(s, d, model);
+}
+
 // Least squares on the inliers, re-selecting the inliers after each fit.
 TransformFit polish(TransformFit fit, const std::vector<cv::Point2d>& src,
                     const std::vector<cv::Point2d>& dst, const TransformFitParams& params) {
   const auto minimal = static_cast<std::size_t>(minimalSample(params.model));
   for (int round = 0; round < 3; ++round) {
     if (fit.inliers.size() < minimal) break;
-    std::vector<cv::Point2d> s, d;
-    for (int i : fit.inliers) {
-      s.push_back(src[i]);
-      d.push_back(dst[i]);
-    }
-    const auto H = fitTransformLeastSquares(s, d, params.model);
+    const auto H = fitSubset(fit.inliers, src, dst, params.model);
     if (!H) break;
     std::vector<int> in = inliersOf(*H, src, dst, params.inlierThreshold);
     if (in.size() < fit.inliers.size()) break;
@@ -311,12 +318,7 @@ std::vector<TransformFit> enumerateConsensusSets(const std::vector<cv::Point2d>&
     TransformFit fit;
     for (std::size_t i = 0; i < n; ++i)
       if (sets[c] >> i & 1) fit.inliers.push_back(static_cast<int>(i));
-    std::vector<cv::Point2d> fs, fd;
-    for (int i : fit.inliers) {
-      fs.push_back(src[i]);
-      fd.push_back(dst[i]);
-    }
-    const auto H = fitTransformLeastSquares(fs, fd, params.model);
+    const auto H = fitSubset(fit.inliers, src, dst, params.model);
     if (!H) continue;
     fit.H = *H;
     fit = polish(std::move(fit), src, dst, params);
