@@ -528,11 +528,8 @@ std::size_t gridPointsSeen(const std::vector<HarrisCorner>& grid, const cv::Matx
   return seen;
 }
 
-// The warp-and-re-match of one global fit, then its confirmation (refineStage); a fit that needs
-// confirming must also have `seenShare` of the grid points it puts in the image among its
-// inliers.
-void rematchFit(StageCache& cache, const RegistrationParams& params, RegistrationResult& result,
-                double seenShare) {
+// The warp-and-re-match of one global fit, then its confirmation (refineStage).
+void rematchFit(StageCache& cache, const RegistrationParams& params, RegistrationResult& result) {
   StageCache::State& s = *cache.state;
   const auto globalInliers = static_cast<std::size_t>(result.globalInliers);
   if (params.refineIterations > 0) {
@@ -583,29 +580,28 @@ void rematchFit(StageCache& cache, const RegistrationParams& params, Registratio
     }
     result.defocus = views.defocus.value_or(0.0);
     // A transform resting on very few global matches must be confirmed by the re-matching: at
-    // least confirmInliers pairs, and most of those it found. Around the right transform nearly
-    // every re-matched pair agrees with it; around a wrong one the pairs are chance hits of
-    // the correlation (a fine repetitive texture gives many), of which one homography explains
-    // a few dozen among a hundred and more.
+    // least confirmInliers pairs, most of those it found, and a share of the grid points it
+    // puts in the image. Around the right transform most grid points re-match and nearly every
+    // re-matched pair agrees with it; around a wrong one the pairs are chance hits of the
+    // correlation (a fine repetitive texture gives many), of which one homography explains a
+    // few dozen among a hundred and more, out of the thousands of grid points it was tried at.
     // Only pairs the re-matching found confirm: where it found none, the inliers are still the
     // global ones it was to confirm.
     const std::size_t confirmed = rematched > 0 ? result.inliers.size() : 0;
     const double seen = static_cast<double>(gridPointsSeen(dense, result.H, s.img.size()));
     if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
         (static_cast<int>(confirmed) < params.confirmInliers || 2 * confirmed < rematched ||
-         static_cast<double>(confirmed) < seenShare * seen))
+         static_cast<double>(confirmed) < params.confirmSeenShare * seen))
       result.status = Status<RegistrationFailure>::failed(
           RegistrationFailure::TooFewInliers,
           std::to_string(globalInliers) + " global inliers, not confirmed by re-matching (" +
               (rematched > 0 ? std::to_string(confirmed) + " inliers of " +
                                    std::to_string(rematched) + " re-matched pairs; "
                              : "no re-matched fit; ") +
-              std::to_string(params.confirmInliers) + " inliers and most pairs needed" +
-              (seenShare > 0 ? ", and " + std::to_string(seenShare) + " of the " +
-                                   std::to_string(static_cast<long>(seen)) +
-                                   " grid points it puts in the image"
-                             : std::string()) +
-              ")");
+              std::to_string(params.confirmInliers) + " inliers, most pairs and " +
+              std::to_string(static_cast<int>(std::lround(100 * params.confirmSeenShare))) +
+              " % of the " + std::to_string(static_cast<long>(seen)) +
+              " grid points it puts in the image needed)");
   }
 }
 
@@ -613,25 +609,25 @@ void rematchFit(StageCache& cache, const RegistrationParams& params, Registratio
 
 void refineStage(StageCache& cache, const RegistrationParams& params, RegistrationResult& result) {
   if (params.refineIterations <= 0 || result.runnersUp.empty()) {
-    rematchFit(cache, params, result, 0.0);
+    rematchFit(cache, params, result);
     return;
   }
   // A fit that needs confirming and is not confirmed gives way to the first runner-up that is.
-  // Around a wrong fit the re-matching finds few pairs and stops after a pass or two. Each
-  // runner-up tried is one more chance for chance pairs to pass for a confirmation (a fine
-  // texture gives many: baboon.jpg magnified 3 times, a wrong fit confirmed by 48 of 58 pairs),
-  // so a runner-up must also re-match a share of the grid points it puts in the image
-  // (runnerUpSeenShare): the true fit on graf 1-6 re-matches 1196 of 1565, that wrong one 48 of
-  // 17118.
+  // Around a wrong fit the re-matching finds few pairs and stops after a pass or two. Each fit
+  // tried is one more chance for chance pairs to pass for a confirmation (a fine or repeated
+  // texture gives many: baboon.jpg magnified 3 times, a wrong runner-up confirmed by 48 of 58
+  // pairs; sudoku.png magnified 3 times, a wrong best fit by 38 of 64), so a confirmed fit must
+  // also re-match a share of the grid points it puts in the image (confirmSeenShare): the true
+  // fit on graf 1-6 re-matches 1196 of 1565, those wrong ones 48 of 17118 and 38 of over 152.
   const RegistrationResult global = result;
-  rematchFit(cache, params, result, 0.0);
+  rematchFit(cache, params, result);
   for (const GlobalFit& other : global.runnersUp) {
     if (result.status.ok()) break;
     RegistrationResult candidate = global;
     candidate.H = other.H;
     candidate.inliers = other.inliers;
     candidate.globalInliers = static_cast<int>(other.inliers.size());
-    rematchFit(cache, params, candidate, params.runnerUpSeenShare);
+    rematchFit(cache, params, candidate);
     if (candidate.status.ok()) result = std::move(candidate);
   }
   if (!result.status.ok() && result.status.cause == RegistrationFailure::TooFewInliers)

@@ -35,20 +35,19 @@ struct RegistrationParams {
   double inlierThreshold = 3.0;  // pixels; RANSAC reprojection threshold in the image
   int minInliers = 5;            // fewer global inliers than this -> failure "too_few_inliers"
   // A global fit with fewer than `confirmBelowInliers` inliers is accepted only when the
-  // re-matching (refineIterations > 0) then finds at least `confirmInliers` inliers, and they
-  // are most of the pairs it re-matched.
+  // re-matching (refineIterations > 0) then finds at least `confirmInliers` inliers, they are
+  // most of the pairs it re-matched, and at least `confirmSeenShare` of the re-matching's grid
+  // points that the fit puts in the image (refineStage, register_images.cpp, says why).
   int confirmBelowInliers = 10;
   int confirmInliers = 20;
+  double confirmSeenShare = 0.25;
   // Such a fit may be one of several the window matches support about as well (a 60 degree
   // viewpoint change leaves 5-8 true matches among 40-400, and chance ones agree as often): the
   // distinct consensus sets of at most 64 pruned matches are enumerated (transform_fit.hpp,
   // up to `consensusSamples` minimal samples), and up to `runnersUp` of them besides the best
   // are re-matched in turn when the best one is not confirmed. 0 disables it.
-  // A runner-up is confirmed only when its inliers are also `runnerUpSeenShare` of the
-  // re-matching's grid points it puts in the image (refineStage, register_images.cpp, says why).
   int runnersUp = 8;
   long consensusSamples = 200000;
-  double runnerUpSeenShare = 0.25;
   // Per-match rotation/scale estimates prune matches that disagree with the dominant pair of
   // rotation (degrees) and log2-scale before RANSAC (rotation_scale_vote.hpp). <= 0 disables
   // the pruning.
