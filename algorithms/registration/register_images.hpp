@@ -126,8 +126,10 @@ struct RegistrationResult {
   int refCorners = 0;                  // points detected in the reference / image
   int imageCorners = 0;
   int globalInliers = 0;  // inliers of the global (feature) fit, before the re-matching
-  // The global fit's runners-up (RegistrationParams::runnersUp), tried when it is not confirmed.
+  // The global fit's runners-up (RegistrationParams::runnersUp), tried when it is not confirmed,
+  // and which of the fits this result rests on: 0 the best, k its k-th runner-up.
   std::vector<GlobalFit> runnersUp;
+  int consensusRank = 0;
   // The stage whose result this is: "harris" (plain multi-scale Harris windows),
   // "harris-affine" (Harris-Affine regions) or "harris-lookalikes" (the plain windows' best few
   // partners each, the last resort); `escalated` when more than one ran (the plain one first).

@@ -46,6 +46,7 @@ void run(const RegisterOptions& o) {
                        {"matches", r.matches.size()},
                        {"inliers", r.inliers.size()},
                        {"global_inliers", r.globalInliers},
+                       {"consensus_rank", r.consensusRank},
                        {"stage", r.stage},
                        {"escalated", r.escalated},
                        {"defocus_px", r.defocus},
@@ -67,6 +68,9 @@ void run(const RegisterOptions& o) {
     std::cout << r.matches.size() << " matches, " << r.inliers.size() << " inliers, " << ms
               << " ms, stage " << r.stage << (r.escalated ? " (after the plain Harris stage)" : "")
               << "\n";
+    if (r.consensusRank > 0)
+      std::cout << "the global fit's runner-up " << r.consensusRank << " was confirmed ("
+                << r.globalInliers << " global inliers)\n";
     std::cout << "re-matched in " << r.refinePasses << " passes, the last moving H by "
               << r.refineLastMove << " px\n";
     std::cout << "the part of the reference the image sees is placed within "

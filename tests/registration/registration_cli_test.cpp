@@ -86,6 +86,7 @@ TEST_F(RegisterCli, PrintsTheTransformAndTheInlierPairsOnRequest) {
   EXPECT_EQ(j.at("stage").get<std::string>(), "harris");
   EXPECT_FALSE(j.at("escalated").get<bool>());
   EXPECT_GE(j.at("global_inliers").get<int>(), 20);
+  EXPECT_EQ(j.at("consensus_rank").get<int>(), 0);
   // The warp-and-re-match passes kept, and how far the last moved H.
   EXPECT_GE(j.at("refine_passes").get<int>(), 1);
   EXPECT_LE(j.at("refine_passes").get<int>(), facet::RegistrationParams{}.refineIterations);

@@ -431,6 +431,8 @@ TEST(RegisterImages, AStrongViewpointChangeIsFoundAmongTheGlobalFitsRunnersUp) {
   const RegistrationResult r = registerImages(ref, image, {});
   ASSERT_TRUE(r.status.ok()) << toString(r.status.cause) << ": " << r.status.message;
   EXPECT_LT(r.globalInliers, RegistrationParams{}.confirmBelowInliers);
+  EXPECT_GT(r.consensusRank, 0);
+  EXPECT_EQ(alone.consensusRank, 0);
   EXPECT_GE(r.inliers.size(), 1000u);
   EXPECT_LT(cornerError(r.H, truth, ref.size()), 2.0);
 }
