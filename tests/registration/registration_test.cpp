@@ -249,6 +249,15 @@ cv::Mat dataImage(const std::string& relative) {
   return photo;
 }
 
+// An image of the test data as `facet register` reads it: decoded as stored, colour turned grey
+// by toGrey (cv::imread's IMREAD_GRAYSCALE rounds differently, by a grey level here and there).
+cv::Mat commandImage(const std::string& relative) {
+  const std::string path = std::string(FACET_TEST_DATA_DIR) + "/" + relative;
+  cv::Mat image = toGrey(cv::imread(path, cv::IMREAD_UNCHANGED));
+  EXPECT_FALSE(image.empty()) << "cannot read " << path;
+  return image;
+}
+
 // The defaults but for the corners: kept only at a strict maximum of the Laplacian over scales
 // (scalePlateau 1), as the detector was before corners of straight edges were kept at the finest
 // scales; the cases below were built on those corners.
@@ -415,10 +424,10 @@ TEST(RegisterImages, DefaultsEscalateToHarrisAffineUnderAStrongTilt) {
 // by toGrey. Its global fit rests on 5 matches; cv::imread's own grey conversion, +-1 grey level
 // apart, gave a true fit of 6 instead, and facet registered one and refused the other.
 TEST(RegisterImages, AStrongViewpointChangeIsFoundAmongTheGlobalFitsRunnersUp) {
+  const cv::Mat ref = commandImage("oxford-graf/img1.png");
+  const cv::Mat image = commandImage("oxford-graf/img6.png");
+  ASSERT_FALSE(ref.empty() || image.empty());
   const std::string dir = std::string(FACET_TEST_DATA_DIR) + "/oxford-graf/";
-  const cv::Mat ref = toGrey(cv::imread(dir + "img1.png", cv::IMREAD_UNCHANGED));
-  const cv::Mat image = toGrey(cv::imread(dir + "img6.png", cv::IMREAD_UNCHANGED));
-  ASSERT_FALSE(ref.empty() || image.empty()) << "cannot read " << dir;
   cv::Matx33d truth;
   std::ifstream file(dir + "H1to6p");
   for (double& h : truth.val) file >> h;
@@ -441,10 +450,9 @@ TEST(RegisterImages, AStrongViewpointChangeIsFoundAmongTheGlobalFitsRunnersUp) {
 // re-matched into 25 pairs that agree with it out of 28, which passed for a confirmation; out of
 // the 1734 grid points the fit puts in the image they are not the quarter a true fit re-matches.
 TEST(RegisterImages, ChancePairsAroundAWrongFitAreNoConfirmation) {
-  const std::string dir = std::string(FACET_TEST_DATA_DIR) + "/";
-  const cv::Mat ref = toGrey(cv::imread(dir + "oxford-bikes/img1.png", cv::IMREAD_UNCHANGED));
-  const cv::Mat image = toGrey(cv::imread(dir + "oxford-leuven/img1.png", cv::IMREAD_UNCHANGED));
-  ASSERT_FALSE(ref.empty() || image.empty()) << "cannot read " << dir;
+  const cv::Mat ref = commandImage("oxford-bikes/img1.png");
+  const cv::Mat image = commandImage("oxford-leuven/img1.png");
+  ASSERT_FALSE(ref.empty() || image.empty());
   RegistrationParams anyShare;
   anyShare.confirmSeenShare = 0;
   const RegistrationResult passed = registerImages(ref, image, anyShare);
