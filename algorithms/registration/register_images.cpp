@@ -328,9 +328,13 @@ GlobalStage fitWindowMatches(const Features& a, const Features& b,
   // The detector sees structures over params.corners.octaves octaves: a fit that magnifies the
   // view beyond that was made of chance matches (and its re-matching would blur the image by
   // hundreds of pixels to match resolutions).
-  const double magnification = magnificationAt(fit->H, refCentre);
   const double reach = std::ldexp(1.0, params.corners.octaves);
-  if (!(magnification <= reach && magnification >= 1.0 / reach)) {
+  const auto withinReach = [&](const cv::Matx33d& H) {
+    const double m = magnificationAt(H, refCentre);
+    return m <= reach && m >= 1.0 / reach;
+  };
+  if (!withinReach(fit->H)) {
+    const double magnification = magnificationAt(fit->H, refCentre);
     g.status.cause = RegistrationFailure::DegenerateTransform;
     g.status.message = "the fit magnifies the view " + std::to_string(magnification) +
                        " times, beyond the detector's " + std::to_string(params.corners.octaves) +
@@ -340,9 +344,8 @@ GlobalStage fitWindowMatches(const Features& a, const Features& b,
   g.H = fit->H;
   for (int i : fit->inliers) g.inliers.push_back(kept[i]);
   for (const TransformFit& f : others) {
-    const double m = magnificationAt(f.H, refCentre);
     if (static_cast<int>(g.runnersUp.size()) >= params.runnersUp ||
-        static_cast<int>(f.inliers.size()) < params.minInliers || !(m <= reach && m >= 1.0 / reach))
+        static_cast<int>(f.inliers.size()) < params.minInliers || !withinReach(f.H))
       continue;
     GlobalFit runnerUp{f.H, {}};
     for (int i : f.inliers) runnerUp.inliers.push_back(kept[i]);
@@ -587,11 +590,11 @@ void rematchFit(StageCache& cache, const RegistrationParams& params, Registratio
     // few dozen among a hundred and more, out of the thousands of grid points it was tried at.
     // Only pairs the re-matching found confirm: where it found none, the inliers are still the
     // global ones it was to confirm.
+    if (static_cast<int>(globalInliers) >= params.confirmBelowInliers) return;
     const std::size_t confirmed = rematched > 0 ? result.inliers.size() : 0;
     const double seen = static_cast<double>(gridPointsSeen(dense, result.H, s.img.size()));
-    if (static_cast<int>(globalInliers) < params.confirmBelowInliers &&
-        (static_cast<int>(confirmed) < params.confirmInliers || 2 * confirmed < rematched ||
-         static_cast<double>(confirmed) < params.confirmSeenShare * seen))
+    if (static_cast<int>(confirmed) < params.confirmInliers || 2 * confirmed < rematched ||
+        static_cast<double>(confirmed) < params.confirmSeenShare * seen)
       result.status = Status<RegistrationFailure>::failed(
           RegistrationFailure::TooFewInliers,
           std::to_string(globalInliers) + " global inliers, not confirmed by re-matching (" +
